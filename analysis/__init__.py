@@ -1,0 +1,3 @@
+"""analysis package of microcyl."""
+
+__all__ = []

@@ -1,0 +1,3 @@
+"""brdf package of microcyl."""
+
+__all__ = []

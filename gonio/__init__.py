@@ -1,0 +1,3 @@
+"""gonio package of microcyl."""
+
+__all__ = []

@@ -1,0 +1,77 @@
+"""The ``microcyl`` command line.
+
+Each verb lives in its own module under :mod:`reports` (``cmd_*.py``) that defines
+``register(subparsers)``; the parser it adds sets ``func=run`` through
+``set_defaults``.  ``main`` turns every expected failure (bad input, unreadable or
+corrupt files, interrupts) into one line on stderr and a non-zero exit status, never a
+traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+__all__ = ["main", "build_parser", "COMMAND_MODULES"]
+
+#: Modules that each contribute one or more verbs, in the order ``--help`` lists them.
+COMMAND_MODULES = (
+    "reports.cmd_model",
+)
+
+
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose usage errors are one line and exit status 2."""
+
+    def error(self, message):  # noqa: D401 - argparse API
+        self.exit(2, f"microcyl {self.prog.split(' ', 1)[-1]}: error: {message}\n"
+                  if " " in self.prog else f"microcyl: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the full ``microcyl`` parser with every registered verb."""
+    parser = _Parser(
+        prog="microcyl",
+        description="Measure and analyse the microcylinder cloth BRDF "
+                    "(Sadeghi et al., ACM TOG 2013).",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; return the exit status.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments without the program name; ``sys.argv[1:]`` when None.
+
+    Returns
+    -------
+    int
+        0 on success, 1 on a reported error, 130 on interrupt (2 for usage errors,
+        raised by argparse as ``SystemExit``).
+    """
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        status = args.func(args)
+    except KeyboardInterrupt:
+        print("microcyl: interrupted", file=sys.stderr)
+        return 130
+    except (ValueError, OSError, KeyError, RuntimeError) as exc:
+        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        if isinstance(exc, OSError) and getattr(exc, "filename", None) and exc.filename not in message:
+            message = f"{exc.filename}: {message}"
+        print(f"microcyl {args.command}: error: {message}", file=sys.stderr)
+        return 1
+    return int(status or 0)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

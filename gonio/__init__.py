@@ -1,3 +1,5 @@
-"""gonio package of microcyl."""
+"""gonio: a virtual gonioreflectometer, and BRDF tables in the formats of the field."""
 
-__all__ = []
+from gonio.table import Table
+
+__all__ = ["Table"]

@@ -1,0 +1,437 @@
+"""Parameter specification for fitting the microcylinder model: names, bounds, priors, ties.
+
+Model parameters are named by quantity and thread number: ``eta1``, ``kd1``, ``gamma_s1``,
+``gamma_v1``, ``area1``, ``albedo1_r``, ``albedo1_g``, ``albedo1_b`` and the same with ``2``.
+Extra parameters: ``tangent_scale1``/``tangent_scale2`` (a factor on a thread's tangent offsets),
+``scale`` (a nuisance overall factor on f_r, for relative data such as CUReT) and ``log_noise``
+(natural log of the noise standard deviation in the likelihood's residual space, for tables
+without sigma).
+
+Each parameter is free (sampled), fixed (at its default, normally the preset's value) or tied to
+another one (``eta2=eta1``: eta2 takes eta1's value; ``area2=1-area1``: the complement).
+
+The sampler works in *internal* coordinates: the value itself for a uniform prior, its natural
+log for a log-uniform prior. Both priors are then flat in internal coordinates between the
+bounds, so the log-prior is 0 inside and -inf outside (plus area1 + area2 <= 1).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from pathlib import Path
+from typing import Iterable, Mapping, Sequence
+
+import numpy as np
+
+__all__ = ["Param", "ParamSpec", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
+           "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric", "parse_free", "parse_ties"]
+
+
+@dataclasses.dataclass(frozen=True)
+class Param:
+    """One scalar parameter: bounds (natural units), prior, unit, default.
+
+    Parameters
+    ----------
+    name : str
+        Full name, e.g. ``"gamma_s1"``.
+    lo, hi : float
+        Bounds in natural units (``lo < hi``; ``lo > 0`` for a log-uniform prior).
+    prior : {"uniform", "log-uniform"}
+        Flat in the value, or flat in its logarithm.
+    unit : str
+        Unit of the value (``"deg"``, ``"1"``, ...).
+    default : float
+        Starting / fixed value in natural units.
+    """
+
+    name: str
+    lo: float
+    hi: float
+    prior: str
+    unit: str
+    default: float
+
+    def __post_init__(self):
+        if self.prior not in ("uniform", "log-uniform"):
+            raise ValueError(f"prior of {self.name} must be 'uniform' or 'log-uniform'; "
+                             f"got {self.prior!r}")
+        if not (math.isfinite(self.lo) and math.isfinite(self.hi) and self.lo < self.hi):
+            raise ValueError(f"bounds of {self.name} must be finite with lo < hi; "
+                             f"got ({self.lo}, {self.hi})")
+        if self.prior == "log-uniform" and self.lo <= 0:
+            raise ValueError(f"log-uniform prior of {self.name} needs lo > 0; got {self.lo}")
+
+    @property
+    def is_log(self) -> bool:
+        return self.prior == "log-uniform"
+
+    def to_internal(self, x):
+        """Natural value -> internal coordinate (log for log-uniform)."""
+        x = np.asarray(x, dtype=np.float64)
+        if self.is_log:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                return np.log(x)
+        return x
+
+    def to_natural(self, u):
+        """Internal coordinate -> natural value."""
+        u = np.asarray(u, dtype=np.float64)
+        return np.exp(u) if self.is_log else u
+
+    @property
+    def internal_bounds(self) -> tuple[float, float]:
+        return (float(self.to_internal(self.lo)), float(self.to_internal(self.hi)))
+
+
+#: Base quantities: (lo, hi, prior, unit, fallback default), per thread.
+BASE_PARAMS: dict[str, tuple[float, float, str, str, float]] = {
+    "eta": (1.01, 3.0, "uniform", "1", 1.46),
+    "kd": (0.0, 1.0, "uniform", "1", 0.3),
+    "gamma_s": (0.3, 60.0, "log-uniform", "deg", 10.0),
+    "gamma_v": (0.3, 90.0, "log-uniform", "deg", 20.0),
+    "area": (0.0, 1.0, "uniform", "1", 0.5),
+    "albedo_r": (0.0, 1.0, "uniform", "1", 0.2),
+    "albedo_g": (0.0, 1.0, "uniform", "1", 0.2),
+    "albedo_b": (0.0, 1.0, "uniform", "1", 0.2),
+    "tangent_scale": (0.25, 2.0, "uniform", "1", 1.0),
+}
+_EXTRA = {
+    "scale": (1e-4, 1e4, "log-uniform", "1", 1.0),
+    "log_noise": (-12.0, 3.0, "uniform", "ln(residual unit)", -3.0),
+}
+
+
+def _thread_name(base: str, j: int) -> str:
+    if base.startswith("albedo_"):
+        return f"albedo{j}_{base[-1]}"
+    return f"{base}{j}"
+
+
+#: Names of the model parameters proper (what ``prepare(...).eval`` takes), both threads.
+MODEL_PARAM_NAMES: tuple[str, ...] = tuple(
+    _thread_name(b, j) for j in (1, 2) for b in BASE_PARAMS if b != "tangent_scale")
+#: Every parameter name a spec knows.
+PARAM_NAMES: tuple[str, ...] = MODEL_PARAM_NAMES + ("tangent_scale1", "tangent_scale2") \
+    + tuple(_EXTRA)
+#: Group aliases accepted by ``--free``.
+_ALIASES = {f"albedo{j}": tuple(f"albedo{j}_{c}" for c in "rgb") for j in (1, 2)}
+
+#: The default free set (8 parameters) and ties: one eta for both threads, area2 = 1 - area1.
+DEFAULT_FREE = ("eta1", "kd1", "kd2", "gamma_s1", "gamma_v1", "gamma_s2", "gamma_v2", "area1")
+DEFAULT_TIES = ("eta2=eta1", "area2=1-area1")
+
+
+def _base_of(name: str) -> tuple[str, int | None]:
+    m = re.fullmatch(r"albedo([12])_([rgb])", name)
+    if m:
+        return f"albedo_{m.group(2)}", int(m.group(1))
+    m = re.fullmatch(r"([a-z_]+?)([12])", name)
+    if m and m.group(1) in BASE_PARAMS:
+        return m.group(1), int(m.group(2))
+    return name, None
+
+
+def _unknown(name: str, what: str = "parameter") -> ValueError:
+    return ValueError(f"unknown {what} {name!r}; valid names: {', '.join(PARAM_NAMES)} "
+                      f"(aliases: {', '.join(_ALIASES)})")
+
+
+def parse_free(free) -> tuple[str, ...]:
+    """Parse ``"eta1,kd1,albedo1"`` (or a sequence) into full names, aliases expanded.
+
+    Raises
+    ------
+    ValueError
+        A name that is not a parameter (the message lists the valid ones) or an empty list.
+
+    Examples
+    --------
+    >>> parse_free("eta1, albedo2")
+    ('eta1', 'albedo2_r', 'albedo2_g', 'albedo2_b')
+    """
+    items = [s.strip() for s in free.split(",")] if isinstance(free, str) else list(free)
+    out: list[str] = []
+    for s in items:
+        if not s:
+            continue
+        for name in _ALIASES.get(s, (s,)):
+            if name not in PARAM_NAMES:
+                raise _unknown(name, "free parameter")
+            if name not in out:
+                out.append(name)
+    if not out:
+        raise ValueError(f"free parameters: none given ({free!r}); valid names: "
+                         f"{', '.join(PARAM_NAMES)}")
+    return tuple(out)
+
+
+def parse_ties(ties) -> dict[str, tuple[str, str]]:
+    """Parse ties ``"eta2=eta1"`` or ``"area2=1-area1"`` into {target: (source, kind)}.
+
+    ``a=b`` makes a follow b (a is the target). :class:`ParamSpec` swaps the two when only the
+    target is listed free, so ``--free eta1 --tie eta1=eta2`` samples eta1 and sets eta2 equal.
+    ``kind`` is ``"equal"`` or ``"complement"`` (target = 1 - source).
+
+    Examples
+    --------
+    >>> parse_ties(["eta2=eta1", "area2=1-area1"])
+    {'eta2': ('eta1', 'equal'), 'area2': ('area1', 'complement')}
+    """
+    if isinstance(ties, str):
+        ties = [t for t in ties.split(",")]
+    out: dict[str, tuple[str, str]] = {}
+    for t in ties or ():
+        t = t.replace(" ", "")
+        if not t:
+            continue
+        m = re.fullmatch(r"([a-z0-9_]+)=(1-)?([a-z0-9_]+)", t)
+        if not m:
+            raise ValueError(f"tie {t!r}: expected 'a=b' or 'a=1-b' with parameter names")
+        target, comp, source = m.group(1), m.group(2), m.group(3)
+        for name in (target, source):
+            if name not in PARAM_NAMES:
+                raise _unknown(name, "tied parameter")
+        if target == source:
+            raise ValueError(f"tie {t!r}: a parameter cannot be tied to itself")
+        out[target] = (source, "complement" if comp else "equal")
+    return out
+
+
+def defaults_from_fabric(fab) -> dict[str, float]:
+    """Default values of every model parameter from a fabric's threads (natural units).
+
+    Parameters
+    ----------
+    fab : object with ``threads``
+        Two threads with ``eta``, ``albedo`` (3), ``kd``, ``gamma_s``, ``gamma_v`` (degrees)
+        and ``area``.
+    """
+    out: dict[str, float] = {}
+    for j, th in enumerate(fab.threads, start=1):
+        out[f"eta{j}"] = float(th.eta)
+        out[f"kd{j}"] = float(th.kd)
+        out[f"gamma_s{j}"] = float(th.gamma_s)
+        out[f"gamma_v{j}"] = float(th.gamma_v)
+        out[f"area{j}"] = float(th.area)
+        for c, a in zip("rgb", np.broadcast_to(np.asarray(th.albedo, float), (3,))):
+            out[f"albedo{j}_{c}"] = float(a)
+    return out
+
+
+class ParamSpec:
+    """Which parameters are free, fixed or tied, and their bounds, priors and defaults.
+
+    Parameters
+    ----------
+    free : str or sequence of str
+        Free parameter names (aliases ``albedo1``/``albedo2`` expand to the three channels).
+    defaults : mapping, optional
+        Natural-unit defaults (e.g. :func:`defaults_from_fabric`); missing ones use the
+        built-in fallbacks. Free parameters start here; fixed ones stay here.
+    ties : str, sequence or mapping, optional
+        ``"eta2=eta1"`` (equal) or ``"area2=1-area1"`` (complement). A target that is also
+        listed as free is dropped from the free set.
+    bounds : mapping name -> (lo, hi), optional
+        Override bounds (natural units).
+    priors : mapping name -> "uniform" | "log-uniform", optional
+        Override priors.
+
+    Raises
+    ------
+    ValueError
+        Unknown names (listing the valid ones), a tie whose source is itself tied, a free
+        parameter whose default lies outside its bounds, bad bounds or priors.
+
+    Examples
+    --------
+    >>> spec = ParamSpec("eta1,gamma_s1", defaults={"eta1": 1.5, "gamma_s1": 5.0},
+    ...                  ties="eta2=eta1")
+    >>> spec.free, spec.ndim
+    (('eta1', 'gamma_s1'), 2)
+    >>> v = spec.values(np.array([[1.6, np.log(4.0)]]))
+    >>> float(v["eta2"][0]), round(float(v["gamma_s1"][0]), 6)
+    (1.6, 4.0)
+    """
+
+    def __init__(self, free, defaults: Mapping[str, float] | None = None, ties=None,
+                 bounds: Mapping[str, Sequence[float]] | None = None,
+                 priors: Mapping[str, str] | None = None):
+        defaults = dict(defaults or {})
+        for name in list(defaults) + list(bounds or {}) + list(priors or {}):
+            if name not in PARAM_NAMES:
+                raise _unknown(name)
+        ties = parse_ties(ties) if not isinstance(ties, Mapping) else dict(ties)
+        free = list(parse_free(free))
+        self.ties = {}
+        for target, (source, kind) in ties.items():
+            if target in free and source not in free:
+                target, source = source, target
+            self.ties[target] = (source, kind)
+        free = [f for f in free if f not in self.ties]
+        for target, (source, _) in self.ties.items():
+            if source in self.ties:
+                raise ValueError(f"tie {target}={source}: {source} is itself tied; tie both "
+                                 f"to the same free parameter")
+        self.params: dict[str, Param] = {}
+        for name in PARAM_NAMES:
+            base, _ = _base_of(name)
+            lo, hi, prior, unit, fallback = BASE_PARAMS.get(base) or _EXTRA[name]
+            if bounds and name in bounds:
+                b = tuple(float(x) for x in bounds[name])
+                if len(b) != 2:
+                    raise ValueError(f"bounds of {name} must be (lo, hi); got {bounds[name]!r}")
+                lo, hi = b
+            if priors and name in priors:
+                prior = priors[name]
+            self.params[name] = Param(name, float(lo), float(hi), prior, unit,
+                                      float(defaults.get(name, fallback)))
+        self.free: tuple[str, ...] = tuple(free)
+        if not self.free:
+            raise ValueError("no free parameter left after applying ties")
+        for name in self.free:
+            p = self.params[name]
+            if not (p.lo <= p.default <= p.hi) or (p.is_log and p.default <= 0):
+                raise ValueError(f"start value of {name} = {p.default:g} {p.unit} lies outside "
+                                 f"its bounds [{p.lo:g}, {p.hi:g}]; widen the bounds or set a "
+                                 f"start inside them")
+        self._index = {n: i for i, n in enumerate(self.free)}
+        self.lower = np.array([self.params[n].internal_bounds[0] for n in self.free])
+        self.upper = np.array([self.params[n].internal_bounds[1] for n in self.free])
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_toml(cls, path, defaults: Mapping[str, float] | None = None,
+                  free=None, ties=None) -> "ParamSpec":
+        """Read a spec from a TOML file.
+
+        Keys: ``free`` (list), ``tie`` (list of ``"a=b"``), tables ``[bounds]``
+        (name = [lo, hi]), ``[prior]`` (name = "uniform" | "log-uniform") and ``[start]``
+        (name = value, overriding the defaults). ``free``/``ties`` given here are added.
+
+        Raises
+        ------
+        ValueError
+            The file is not valid TOML or holds unknown keys (the message names the file).
+        """
+        import tomllib
+        path = Path(path)
+        try:
+            with open(path, "rb") as fh:
+                doc = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"{path}: not valid TOML: {exc}") from None
+        allowed = {"free", "tie", "bounds", "prior", "start", "fabric"}
+        extra = set(doc) - allowed
+        if extra:
+            raise ValueError(f"{path}: unknown keys {sorted(extra)}; allowed: {sorted(allowed)}")
+        d = dict(defaults or {})
+        d.update({k: float(v) for k, v in doc.get("start", {}).items()})
+        fr = list(parse_free(doc["free"])) if "free" in doc else []
+        if free:
+            fr += [f for f in parse_free(free) if f not in fr]
+        tie_list = list(doc.get("tie", []))
+        if isinstance(ties, str):
+            ties = ties.split(",")
+        tie_list += list(ties or [])
+        return cls(fr, defaults=d, ties=tie_list, bounds=doc.get("bounds"),
+                   priors=doc.get("prior"))
+
+    # ------------------------------------------------------------------ accessors
+    @property
+    def ndim(self) -> int:
+        return len(self.free)
+
+    @property
+    def units(self) -> tuple[str, ...]:
+        return tuple(self.params[n].unit for n in self.free)
+
+    def start(self) -> np.ndarray:
+        """Internal coordinates of the free parameters' defaults, shape (ndim,)."""
+        return np.array([float(self.params[n].to_internal(self.params[n].default))
+                         for n in self.free])
+
+    def with_defaults(self, **values: float) -> "ParamSpec":
+        """A copy whose defaults (start values) are changed."""
+        new = object.__new__(ParamSpec)
+        new.__dict__.update(self.__dict__)
+        new.params = dict(self.params)
+        for k, v in values.items():
+            if k not in new.params:
+                raise _unknown(k)
+            new.params[k] = dataclasses.replace(new.params[k], default=float(v))
+        return new
+
+    def to_natural(self, theta) -> np.ndarray:
+        """Internal (..., ndim) -> natural values of the free parameters (..., ndim)."""
+        theta = np.asarray(theta, dtype=np.float64)
+        out = np.empty_like(theta)
+        for i, n in enumerate(self.free):
+            out[..., i] = self.params[n].to_natural(theta[..., i])
+        return out
+
+    def to_internal(self, x) -> np.ndarray:
+        """Natural (..., ndim) -> internal coordinates."""
+        x = np.asarray(x, dtype=np.float64)
+        out = np.empty_like(x)
+        for i, n in enumerate(self.free):
+            out[..., i] = self.params[n].to_internal(x[..., i])
+        return out
+
+    def values(self, theta) -> dict[str, np.ndarray]:
+        """Every parameter's natural value for internal coordinates ``theta`` (B..., ndim).
+
+        Returns a dict name -> array of shape B... (fixed ones broadcast).
+        """
+        theta = np.asarray(theta, dtype=np.float64)
+        batch = theta.shape[:-1]
+        nat = self.to_natural(theta)
+        out: dict[str, np.ndarray] = {}
+        for name, p in self.params.items():
+            if name in self._index:
+                out[name] = nat[..., self._index[name]]
+            else:
+                out[name] = np.full(batch, p.default)
+        for target, (source, kind) in self.ties.items():
+            out[target] = out[source] if kind == "equal" else 1.0 - out[source]
+        return out
+
+    def log_prior(self, theta) -> np.ndarray:
+        """Log prior (up to a constant) for internal ``theta`` (B..., ndim) -> (B...,).
+
+        Flat in internal coordinates within the bounds, -inf outside or where
+        area1 + area2 > 1 or a tied value leaves its own bounds.
+        """
+        theta = np.asarray(theta, dtype=np.float64)
+        ok = np.all((theta >= self.lower) & (theta <= self.upper) & np.isfinite(theta), axis=-1)
+        if self.ties or any(n.startswith("area") for n in self.free):
+            v = self.values(theta)
+            ok &= v["area1"] + v["area2"] <= 1.0 + 1e-12
+            for target in self.ties:
+                p = self.params[target]
+                ok &= (v[target] >= p.lo) & (v[target] <= p.hi)
+        return np.where(ok, 0.0, -np.inf)
+
+    def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Keyword arguments of ``prepare(...).eval``: each (B..., 2), albedo (B..., 2, 3)."""
+        kw = {}
+        for q in ("eta", "kd", "gamma_s", "gamma_v", "area"):
+            kw[q] = np.stack([values[f"{q}1"], values[f"{q}2"]], axis=-1)
+        kw["albedo"] = np.stack(
+            [np.stack([values[f"albedo{j}_{c}"] for c in "rgb"], axis=-1) for j in (1, 2)],
+            axis=-2)
+        return kw
+
+    def describe(self) -> dict:
+        """A JSON-ready description (for checkpoints and reports)."""
+        return {
+            "free": list(self.free),
+            "ties": {k: list(v) for k, v in self.ties.items()},
+            "params": {n: {"lo": p.lo, "hi": p.hi, "prior": p.prior, "unit": p.unit,
+                           "default": p.default} for n, p in self.params.items()},
+        }
+
+    def __repr__(self) -> str:
+        return f"ParamSpec(free={list(self.free)}, ties={self.ties})"

@@ -1,0 +1,135 @@
+"""The ``microcyl fit`` verb: Bayesian parameter estimation from a BRDF table.
+
+``microcyl fit TABLE --fabric PRESET [--free eta1,kd1,...] [--tie eta2=eta1] -o DIR``
+
+The preset gives the fixed values and the starting point. Writes ``DIR/results.json`` and
+``DIR/results.csv`` (medians, 68%/95% intervals, tau, R-hat, ESS, verdict), the plots, and the
+checkpoints ``DIR/chains_<k>.h5``; the same command run again resumes from them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import brdf
+from reports import cliutil
+
+__all__ = ["register", "run", "read_table"]
+
+
+def read_table(path, sample=None):
+    """Read a table with ``gonio.read`` (CUReT needs ``sample``)."""
+    try:
+        from gonio import read
+    except ImportError:  # pragma: no cover - until gonio's readers are merged
+        raise ValueError("reading tables needs gonio.read, which this installation lacks") \
+            from None
+    opts = {} if sample is None else {"sample": sample}
+    return read(path, **opts)
+
+
+def register(sub):
+    """Add ``fit`` to the ``microcyl`` sub-parsers."""
+    from analysis.likelihood import KINDS
+    from analysis.params import DEFAULT_FREE, DEFAULT_TIES
+    p = sub.add_parser(
+        "fit", help="estimate model parameters from a BRDF table (emcee)",
+        description="Fit the microcylinder model to a BRDF table: point estimate, then several "
+                    "independent emcee ensembles until every parameter has N > 50 tau, tau is "
+                    "stable and R-hat < 1.01, or a step limit. Resumes from DIR's checkpoints.")
+    p.add_argument("table", metavar="TABLE", help="table file (.exr, .csv, .binary, .alta, "
+                                                  ".bsdf, CUReT abrdf.dat with --sample)")
+    p.add_argument("--fabric", required=True, metavar="PRESET",
+                   help=f"preset giving fixed values and the start: {', '.join(brdf.PRESETS)}")
+    p.add_argument("--free", default=None, metavar="NAMES",
+                   help="comma-separated free parameters, or a TOML file (default "
+                        f"{','.join(DEFAULT_FREE)})")
+    p.add_argument("--spec", default=None, metavar="TOML",
+                   help="TOML file with free, tie, [bounds], [prior], [start]")
+    p.add_argument("--tie", action="append", default=None, metavar="A=B",
+                   help="tie A to B (A=B or A=1-B); repeatable; 'none' for no tie (default "
+                        f"{','.join(DEFAULT_TIES)} when --free is not given)")
+    p.add_argument("--likelihood", choices=KINDS, default="gaussian")
+    p.add_argument("--nu", type=float, default=4.0, help="Student-t degrees of freedom")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--max-steps", type=int, default=20000, metavar="N",
+                   help="step limit per ensemble (default 20000)")
+    p.add_argument("--ensembles", type=int, default=4, metavar="K")
+    p.add_argument("--walkers", type=int, default=None, metavar="W",
+                   help="walkers per ensemble (default 2 x ndim + 2)")
+    p.add_argument("--check-every", type=int, default=100, metavar="N")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS")
+    p.add_argument("--sample", type=int, default=None, metavar="N",
+                   help="CUReT sample number (for abrdf.dat)")
+    p.add_argument("--no-plots", action="store_true", help="skip the plots")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    cliutil.add_fabric_options(p)
+    p.set_defaults(func=run)
+
+
+def _spec_from_args(args, fab):
+    from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
+    defaults = defaults_from_fabric(fab)
+    ties = args.tie
+    if ties is not None:
+        ties = [t for item in ties for t in item.split(",") if t.strip().lower() != "none"]
+    free = args.free
+    toml = args.spec
+    if free is not None and free.lower().endswith(".toml"):
+        toml, free = free, None
+    if ties is None and free is None and toml is None:
+        ties = list(DEFAULT_TIES)
+    if toml is not None:
+        return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties)
+    return ParamSpec(free if free is not None else DEFAULT_FREE, defaults=defaults,
+                     ties=ties or ())
+
+
+def run(args) -> int:
+    from analysis.fit import FabricModel, fit, write_results
+    if args.fabric not in brdf.PRESETS:
+        raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
+                         f"{', '.join(brdf.PRESETS)}")
+    fab = cliutil.fabric_from_args(args.fabric, args)
+    spec = _spec_from_args(args, fab)
+    out = cliutil.check_writable_dir(Path(args.output))
+    table = read_table(args.table, args.sample)
+    model = FabricModel(fab, table.wi, table.wo)
+    result = fit(table, spec, model, likelihood=args.likelihood, nu=args.nu,
+                 ensembles=args.ensembles, walkers=args.walkers, seed=args.seed,
+                 max_steps=args.max_steps, check_every=args.check_every, out_dir=out,
+                 time_limit=args.time_limit, progress=not args.no_progress,
+                 config_extra={"fabric": args.fabric, "options": fab.options,
+                               "sample": args.sample})
+    jpath, _ = write_results(result, out)
+    if not args.no_plots:
+        from reports.fitplots import write_fit_plots
+        extra = write_fit_plots(result, table, lambda wi, wo: FabricModel(fab, wi, wo), out)
+        doc = json.loads(jpath.read_text())
+        doc["_fit"]["report"] = extra
+        cliutil.atomic_write_text(jpath, json.dumps(doc, indent=2) + "\n")
+    print(format_summary(result))
+    print(f"results: {jpath}")
+    return 0
+
+
+def format_summary(result) -> str:
+    """The fit's summary as a text table."""
+    lines = [f"{'parameter':12s} {'median':>10s} {'68% interval':>23s} {'95% interval':>23s} "
+             f"{'tau':>6s} {'N/tau':>7s} {'R-hat':>7s} {'ESS':>8s}"]
+    for n in result.names:
+        s = result.summary[n]
+        lines.append(f"{n:12s} {s['median']:10.5g} [{s['lo68']:10.5g},{s['hi68']:10.5g}] "
+                     f"[{s['lo95']:10.5g},{s['hi95']:10.5g}] {s['tau']:6.1f} "
+                     f"{s['n_over_tau']:7.1f} {s['rhat']:7.4f} {s['ess']:8.0f}")
+    c = result.counts
+    lines.append(f"values used {c['used']} of {c['total']} (masked: {c['invalid_value']} NaN or "
+                 f"negative, {c['below_horizon']} below horizon, {c['bad_sigma']} bad sigma)")
+    lines.append(f"acceptance {min(result.acceptance):.2f}-{max(result.acceptance):.2f}; "
+                 f"{result.ensembles} ensembles x {result.walkers} walkers x {result.steps} "
+                 f"steps; wall {result.timing['wall_s']:.1f} s")
+    lines.append(("CONVERGED: " if result.converged else "") + result.reason)
+    return "\n".join(lines)

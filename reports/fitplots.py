@@ -1,0 +1,253 @@
+r"""Plots of a Bayesian fit: corner, traces, posterior-predictive lobes, residual maps, and the
+CIEDE2000 colour difference between predicted and measured albedo.
+
+Every function takes ``ax=`` (or ``fig=`` for the corner plot), returns ``(fig, ax)``, saves only
+when given ``filename`` and never calls ``show()``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "albedo_colours",
+           "albedo_delta_e", "posterior_draws", "write_fit_plots"]
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _save(fig, filename):
+    if filename is not None:
+        fig.savefig(filename, dpi=110, bbox_inches="tight")
+
+
+def corner_plot(result, truths=None, fig=None, filename=None):
+    """Corner plot of the free parameters (``corner`` package), natural units.
+
+    Parameters
+    ----------
+    result : analysis.fit.FitResult
+    truths : mapping name -> value, optional
+        Drawn as lines (e.g. the simulation's parameters).
+    """
+    import corner
+    samples = result.samples()
+    if samples.shape[0] > 40000:
+        samples = samples[np.random.default_rng(0).choice(samples.shape[0], 40000, False)]
+    labels = [f"{n} [{u}]" if u not in ("1", "") else n for n, u in zip(result.names,
+                                                                        result.units)]
+    tr = None if truths is None else [truths.get(n, None) for n in result.names]
+    fig = corner.corner(samples, labels=labels, truths=tr, quantiles=[0.025, 0.5, 0.975],
+                        show_titles=True, title_fmt=".4g", fig=fig)
+    _save(fig, filename)
+    return fig, fig.axes
+
+
+def trace_plot(result, ax=None, filename=None, max_walkers: int = 8):
+    """Trace of every free parameter, a few walkers of each ensemble (post burn-in)."""
+    plt = _plt()
+    d = len(result.names)
+    if ax is None:
+        fig, ax = plt.subplots(d, 1, figsize=(8, 1.4 * d + 0.6), sharex=True, squeeze=False)
+        ax = ax[:, 0]
+    else:
+        ax = np.atleast_1d(ax)
+        fig = ax[0].figure
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    steps = np.arange(result.burn, result.burn + result.chains.shape[1])
+    for i, name in enumerate(result.names):
+        for k in range(result.chains.shape[0]):
+            ax[i].plot(steps, result.chains[k, :, :max_walkers, i], color=colours[k % 10],
+                       lw=0.5, alpha=0.5)
+        ax[i].set_ylabel(name, fontsize=8)
+    ax[-1].set_xlabel("step (after burn-in)")
+    ax[0].set_title(f"traces ({result.chains.shape[0]} ensembles, colour = ensemble)")
+    _save(fig, filename)
+    return fig, ax
+
+
+def posterior_draws(result, n: int = 64, seed: int = 0) -> np.ndarray:
+    """``n`` posterior draws in the sampler's internal coordinates, shape (n, ndim)."""
+    flat = result.chains_internal.reshape(-1, len(result.names))
+    idx = np.random.default_rng(seed).choice(flat.shape[0], min(n, flat.shape[0]), False)
+    return flat[idx]
+
+
+def _predict_at(result, model_factory, wi, wo, theta):
+    from analysis.fit import LogPosterior
+    lp = LogPosterior(result.spec, None, model_factory(wi, wo))
+    return lp.predict(theta)
+
+
+def lobe_plot(result, table, model_factory, theta_i_deg=None, phi_i_deg=None, ax=None,
+              filename=None, n_draws: int = 48, plane_tol_deg: float = 8.0,
+              theta_tol_deg: float = 4.0):
+    """Posterior-predictive bands of f_r cos(theta_o) in the plane of incidence, over the data.
+
+    For up to three incidence angles, the 5-95% band and median of f_r cos(theta_o) (luminance-
+    free mean of R, G, B) of ``n_draws`` posterior draws is drawn against the signed outgoing
+    angle (negative on the incidence side), on polar axes (normal up); table points within
+    ``theta_tol_deg`` of the incidence angle and ``plane_tol_deg`` of the plane are overlaid.
+
+    Parameters
+    ----------
+    model_factory : callable
+        ``model_factory(wi, wo) -> model`` for new directions (e.g. ``FabricModel`` of the
+        fitted fabric).
+    theta_i_deg : sequence of float, optional
+        Incidence angles; default: up to three of the table's most common ones.
+    """
+    plt = _plt()
+    ang = np.degrees(table.angles)
+    if theta_i_deg is None:
+        vals, cnt = np.unique(np.round(ang[:, 0]), return_counts=True)
+        if len(vals) > 12:   # scattered directions: use quantiles
+            theta_i_deg = list(np.percentile(ang[:, 0], [20, 50, 80]).round())
+        else:
+            theta_i_deg = list(vals[np.argsort(-cnt)[:3]])
+    if phi_i_deg is None:
+        phi_i_deg = 0.0
+    if ax is None:
+        fig, ax = plt.subplots(1, len(theta_i_deg), subplot_kw={"projection": "polar"},
+                               figsize=(4.2 * len(theta_i_deg), 3.6), squeeze=False)
+        ax = ax[0]
+    else:
+        ax = np.atleast_1d(ax)
+        fig = ax[0].figure
+    draws = posterior_draws(result, n_draws)
+    signed = np.linspace(-89, 89, 121)
+    for a, ti in zip(ax, theta_i_deg):
+        ti_r, pi_r = np.radians(ti), np.radians(phi_i_deg)
+        wi = np.tile([np.sin(ti_r) * np.cos(pi_r), np.sin(ti_r) * np.sin(pi_r), np.cos(ti_r)],
+                     (signed.size, 1))
+        po = np.where(signed >= 0, pi_r + np.pi, pi_r)
+        to = np.radians(np.abs(signed))
+        wo = np.stack([np.sin(to) * np.cos(po), np.sin(to) * np.sin(po), np.cos(to)], -1)
+        pred = _predict_at(result, model_factory, wi, wo, draws).mean(-1) * np.cos(to)
+        lo, med, hi = np.percentile(pred, [5, 50, 95], axis=0)
+        th = np.radians(signed)
+        a.set_theta_zero_location("N")
+        a.set_thetamin(-90)
+        a.set_thetamax(90)
+        a.fill_between(th, lo, hi, alpha=0.35, color="C0", label="90% band")
+        a.plot(th, med, color="C0", lw=1)
+        # data near this plane
+        dphi = np.angle(np.exp(1j * np.radians(ang[:, 3] - phi_i_deg)))
+        near_i = np.abs(ang[:, 0] - ti) <= theta_tol_deg
+        fwd = np.abs(np.abs(dphi) - np.pi) <= np.radians(plane_tol_deg)
+        back = np.abs(dphi) <= np.radians(plane_tol_deg)
+        dphi_i = np.abs(np.angle(np.exp(1j * np.radians(ang[:, 1] - phi_i_deg))))
+        near_i &= dphi_i <= np.radians(plane_tol_deg)
+        sel = near_i & (fwd | back)
+        if np.any(sel):
+            s = np.where(fwd[sel], 1.0, -1.0) * np.radians(ang[sel, 2])
+            v = np.nanmean(np.where(table.valid[sel], table.values[sel], np.nan), -1) \
+                * np.cos(np.radians(ang[sel, 2]))
+            a.plot(s, v, "k.", ms=3, label="data")
+        a.set_title(f"theta_i = {ti:g} deg", fontsize=9)
+    ax[0].legend(fontsize=7, loc="lower left")
+    _save(fig, filename)
+    return fig, ax
+
+
+def residual_map(result, table, prediction, ax=None, filename=None):
+    """Normalized residuals (data - prediction in the likelihood's space, over its sigma)
+    mapped on the half-vector disk (h_x, h_y), mean over channels.
+
+    Parameters
+    ----------
+    prediction : ndarray (n, 3)
+        Model f_r at the table's pairs (e.g. the posterior median's).
+    """
+    plt = _plt()
+    lik = result.logpost.lik
+    y_model = lik.transform(prediction[None])[0]
+    r = lik.y - y_model
+    s2 = lik.sigma_y2 if lik.sigma_y2 is not None else 0.0
+    if "log_noise" in result.names:
+        s2 = s2 + np.exp(2 * result.summary["log_noise"]["median"])
+    z = r / np.sqrt(s2)
+    n = len(table)
+    zsum = np.bincount(lik.pt, weights=z, minlength=n)
+    cnt = np.bincount(lik.pt, minlength=n)
+    keep = cnt > 0
+    zmean = zsum[keep] / cnt[keep]
+    h = table.wi + table.wo
+    h /= np.linalg.norm(h, axis=1, keepdims=True)
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(5, 4.4))
+    else:
+        fig = ax.figure
+    lim = max(3.0, float(np.nanpercentile(np.abs(zmean), 98)))
+    sc = ax.scatter(h[keep, 0], h[keep, 1], c=zmean, cmap="RdBu_r", vmin=-lim, vmax=lim, s=6)
+    fig.colorbar(sc, ax=ax, label="normalized residual")
+    ax.add_patch(plt.Circle((0, 0), 1, fill=False, lw=0.5))
+    ax.set_aspect("equal")
+    ax.set_xlabel("h_x (warp)")
+    ax.set_ylabel("h_y (weft)")
+    ax.set_title(f"residuals: rms {np.sqrt(np.mean(z * z)):.2f} over {z.size} values",
+                 fontsize=9)
+    _save(fig, filename)
+    return fig, ax
+
+
+def albedo_colours(table, prediction):
+    r"""Albedo colours (linear RGB) of the table and of a prediction, by the same estimator.
+
+    rho = 2 pi mean over valid points of f_r cos(theta_o): the uniform-hemisphere Monte Carlo
+    estimate of the directional albedo averaged over the table's incidences; the prediction uses
+    the same points and mask, so the two are comparable whatever the sampling.
+
+    Returns
+    -------
+    measured, predicted : ndarray (3,)
+    """
+    valid = table.valid & np.isfinite(prediction)
+    cos_o = np.clip(table.wo[:, 2], 0, None)[:, None]
+    meas = np.where(valid, table.values, 0.0) * cos_o
+    pred = np.where(valid, prediction, 0.0) * cos_o
+    cnt = np.maximum(valid.sum(0), 1)
+    return 2 * np.pi * meas.sum(0) / cnt, 2 * np.pi * pred.sum(0) / cnt
+
+
+def albedo_delta_e(measured, predicted) -> float:
+    """CIEDE2000 difference between two linear-sRGB colours (colour-science).
+
+    Examples
+    --------
+    >>> albedo_delta_e([0.2, 0.2, 0.2], [0.2, 0.2, 0.2])
+    0.0
+    >>> albedo_delta_e([0.2, 0.1, 0.05], [0.2, 0.2, 0.2]) > 5
+    True
+    """
+    import colour
+    labs = [colour.XYZ_to_Lab(colour.sRGB_to_XYZ(np.clip(np.asarray(c, float), 0, None),
+                                                 apply_cctf_decoding=False))
+            for c in (measured, predicted)]
+    return float(colour.delta_E(labs[0], labs[1], method="CIE 2000"))
+
+
+def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
+    """Write corner.png, traces.png, lobes.png, residuals.png into ``out_dir``; return the
+    albedo colours and their CIEDE2000 difference (JSON-ready)."""
+    from pathlib import Path
+    plt = _plt()
+    out = Path(out_dir)
+    files = {}
+    med = np.median(result.chains_internal.reshape(-1, len(result.names)), axis=0)
+    pred = _predict_at(result, model_factory, table.wi, table.wo, med[None])[0]
+    for name, call in (
+            ("corner.png", lambda f: corner_plot(result, truths=truths, filename=f)),
+            ("traces.png", lambda f: trace_plot(result, filename=f)),
+            ("lobes.png", lambda f: lobe_plot(result, table, model_factory, filename=f)),
+            ("residuals.png", lambda f: residual_map(result, table, pred, filename=f))):
+        fig, _ = call(out / name)
+        plt.close(fig)
+        files[name[:-4]] = str(out / name)
+    meas, prd = albedo_colours(table, pred)
+    return {"plots": files, "albedo_measured": meas.tolist(), "albedo_predicted": prd.tolist(),
+            "albedo_delta_e2000": albedo_delta_e(meas, prd)}

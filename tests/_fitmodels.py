@@ -69,3 +69,16 @@ def simulated_table(model_factory, truth, n=2000, rel=0.05, seed=0, with_sigma=T
     sig = rel * f + 1e-4
     vals = f + sig * rng.normal(size=f.shape)
     return Table(wi, wo, vals, sigma=sig if with_sigma else None), model
+
+
+def fabric_table(name, n=400, rel=0.05, seed=0, with_sigma=True, fab=None):
+    """A noisy table of a preset from brdf's own eval: values = f (1 + rel N), sigma = rel f
+    + 1e-4 (1/sr); random pairs with cos(theta) in [0.1, 1]."""
+    import brdf
+    fab = fab or brdf.fabric(name)
+    wi, wo = random_pairs(n, seed)
+    f = fab.eval(wi, wo)
+    sig = rel * f + 1e-4
+    vals = f + sig * np.random.default_rng(seed + 1).normal(size=f.shape)
+    return Table(wi, wo, vals, sigma=sig if with_sigma else None,
+                 meta={"source": f"simulated {name}"}), fab

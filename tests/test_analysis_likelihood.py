@@ -1,0 +1,94 @@
+"""Tests of analysis.likelihood against scipy.stats transliterations."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from analysis.likelihood import Likelihood, is_relative
+from gonio.table import Table
+
+
+def _table(sigma=True, meta=None):
+    rng = np.random.default_rng(3)
+    n = 40
+    ct = rng.uniform(0.2, 1, (2, n))
+    ph = rng.uniform(-np.pi, np.pi, (2, n))
+    w = np.stack([np.sqrt(1 - ct**2) * np.cos(ph), np.sqrt(1 - ct**2) * np.sin(ph), ct], -1)
+    f = rng.uniform(0.05, 2.0, (n, 3))
+    sig = 0.1 * f if sigma else None
+    return Table(w[0], w[1], f, sigma=sig, meta=meta or {})
+
+
+def test_gaussian_matches_delta_method_by_hand():
+    t = _table()
+    lik = Likelihood(t)
+    m = t.values * 1.1
+    c = t.wi[:, 2:3]
+    y, mu = np.log(1 + t.values * c), np.log(1 + m * c)
+    s = c * t.sigma / (1 + t.values * c)
+    expect = stats.norm.logpdf(y, mu, s).sum()
+    assert lik(m[None])[0] == pytest.approx(expect, rel=1e-12)
+    # scale multiplies the model
+    assert lik(t.values[None], scale=np.array([1.1]))[0] == pytest.approx(expect, rel=1e-12)
+
+
+def test_delta_method_sigma_matches_monte_carlo():
+    t = _table()
+    lik = Likelihood(t)
+    rng = np.random.default_rng(0)
+    small = t.replace(sigma=0.01 * t.values)
+    lik = Likelihood(small)
+    draws = small.values + small.sigma * rng.normal(size=(20000,) + small.values.shape)
+    sd = np.log1p(draws * small.wi[:, 2:3]).std(axis=0)
+    np.testing.assert_allclose(np.sqrt(lik.sigma_y2), sd[lik.pt, lik.ch], rtol=0.03)
+
+
+def test_student_t_and_relative():
+    t = _table()
+    m = t.values * 0.8
+    c = t.wi[:, 2:3]
+    r = np.log(1 + t.values * c) - np.log(1 + m * c)
+    s = c * t.sigma / (1 + t.values * c)
+    expect = (stats.t.logpdf(r / s, 3.0) - np.log(s)).sum()
+    assert Likelihood(t, "student-t", nu=3.0)(m[None])[0] == pytest.approx(expect, rel=1e-12)
+    expect_rel = stats.norm.logpdf(np.log(t.values), np.log(m), t.sigma / t.values).sum()
+    assert Likelihood(t, "relative")(m[None])[0] == pytest.approx(expect_rel, rel=1e-12)
+
+
+def test_log_noise_without_sigma():
+    t = _table(sigma=False)
+    lik = Likelihood(t)
+    assert not lik.has_sigma
+    m = t.values * 1.2
+    c = t.wi[:, 2:3]
+    r = np.log(1 + t.values * c) - np.log(1 + m * c)
+    expect = stats.norm.logpdf(r, 0, np.exp(-2.0)).sum()
+    got = lik(np.stack([m, m]), log_noise=np.array([-2.0, -1.0]))
+    assert got.shape == (2,) and got[0] == pytest.approx(expect, rel=1e-12)
+    with pytest.raises(ValueError, match="log_noise"):
+        lik(m[None])
+
+
+def test_masks_are_counted():
+    t = _table()
+    v = t.values.copy()
+    s = t.sigma.copy()
+    v[0, 0] = np.nan
+    v[1, :] = -1.0
+    s[2, 1] = 0.0
+    wi = t.wi.copy()
+    wi[3] = [1.0, 0.0, 0.0]                 # grazing: at the horizon
+    lik = Likelihood(Table(wi, t.wo, v, sigma=s))
+    c = lik.counts
+    assert c["invalid_value"] == 4 and c["bad_sigma"] == 1 and c["below_horizon"] == 3
+    assert c["used"] == 120 - 8 == lik.n_used
+    assert np.isfinite(lik(v[None])[0])      # masked entries are never read
+
+
+def test_bad_options_and_relative_meta():
+    with pytest.raises(ValueError, match="likelihood must be one of"):
+        Likelihood(_table(), "cauchy")
+    with pytest.raises(ValueError, match="nu"):
+        Likelihood(_table(), "student-t", nu=0)
+    assert is_relative({"units": "relative"}) and Likelihood(
+        _table(meta={"units": "relative"})).relative_data

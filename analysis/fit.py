@@ -9,7 +9,9 @@ Pipeline (:func:`fit`):
    batch; then a Laplace approximation (batched finite-difference Hessian) gives the scale of the
    starting ball.
 3. ``ensembles`` independent emcee ensembles (different seeds), each with ``walkers`` walkers,
-   a vectorized log-probability, moves DEMove (0.8) + DESnookerMove (0.2), and an HDF5
+   a vectorized log-probability, moves: an independence Metropolis-Hastings step from a
+   Student-t fitted to the Laplace approximation (:class:`LaplaceMove`, share ``laplace_move``,
+   default 0.75) mixed with DEMove (0.8 of the rest) and DESnookerMove (0.2), and an HDF5
    checkpoint ``DIR/chains_<k>.h5``. The ensembles run in lock-step threads whose model
    evaluations are stacked into one batch (:class:`LockStep`), split over ``threads`` worker
    threads.
@@ -492,7 +494,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         nu: float = 4.0, ensembles: int = 4, walkers: int | None = None, seed: int = 0,
         max_steps: int = 20000, check_every: int = 100, min_ratio: float = 50.0,
         tau_tol: float = 0.05, rhat_max: float = 1.01, burn_fraction: float = 0.2,
-        n_starts: int = 4, laplace_move: float = 0.5, threads: int | None = None, out_dir=None,
+        n_starts: int = 4, laplace_move: float = 0.75, threads: int | None = None, out_dir=None,
         time_limit: float | None = None, progress: bool = True,
         config_extra: Mapping | None = None) -> FitResult:
     """Fit the free parameters of ``spec`` to ``table``; see the module notes.

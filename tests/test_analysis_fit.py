@@ -134,13 +134,27 @@ def test_split_rhat_flags_a_stuck_ensemble():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["silk_crepe_de_chine", "polyester_satin_charmeuse", "velvet"])
-def test_recovery_default_free_set(name):
-    table, fab = fabric_table(name, n=600, seed=11)
+@pytest.mark.parametrize("name,free", [
+    ("silk_crepe_de_chine", DEFAULT_FREE),
+    ("polyester_satin_charmeuse", ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1")),
+    ("velvet", ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1"))])
+def test_recovery(name, free):
+    """Silk with the default 8 free parameters; the other two with 5 to keep the suite short
+    (bench/bench_fit.py --recovery runs all three with the default set)."""
+    table, fab = fabric_table(name, n=300, seed=11)
     truth = defaults_from_fabric(fab)
-    spec = ParamSpec(DEFAULT_FREE, defaults=truth, ties=DEFAULT_TIES)
+    spec = ParamSpec(free, defaults=truth, ties=DEFAULT_TIES)
     r = fit(table, spec, FabricModel(fab, table.wi, table.wo), seed=4, max_steps=1500,
-            check_every=50, progress=False)
+            check_every=40, progress=False)
+    # With 8 parameters each 95% interval misses its truth 5% of the time, so "all 8 inside"
+    # fails 1 time in 3 for a perfect sampler. Assert what a calibrated posterior satisfies
+    # with high probability: at most 2 of 8 (1 of 5) outside their 95% interval (binomial
+    # tails 0.6% and 2.3%),
+    # and every truth within 4 posterior standard deviations (half-width of the 95% / 1.96).
     inside = _inside95(r, truth)
-    assert all(inside.values()), (inside, r.summary)
+    assert sum(not v for v in inside.values()) <= (2 if len(free) > 5 else 1), (inside,
+                                                                                 r.summary)
+    z = {n: abs(r.summary[n]["median"] - truth[n])
+         / ((r.summary[n]["hi95"] - r.summary[n]["lo95"]) / 3.92) for n in r.names}
+    assert max(z.values()) < 4.0, z
     assert r.converged, r.reason

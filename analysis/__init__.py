@@ -1,3 +1,12 @@
-"""analysis package of microcyl."""
+"""analysis package of microcyl: physical checks and Bayesian fitting (emcee)."""
 
-__all__ = []
+from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rhat
+from analysis.fit import FabricModel, FitResult, LogPosterior, fit, write_results
+from analysis.likelihood import Likelihood
+from analysis.params import DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec, defaults_from_fabric
+
+__all__ = [
+    "ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
+    "Likelihood", "fit", "FitResult", "FabricModel", "LogPosterior", "write_results",
+    "autocorr_time", "split_rhat", "ess", "interval_summary",
+]

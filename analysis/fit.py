@@ -492,7 +492,7 @@ def _open_backend(path: Path, nwalkers: int, ndim: int):
 # ---------------------------------------------------------------------------- main entry
 def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian",
         nu: float = 4.0, ensembles: int = 4, walkers: int | None = None, seed: int = 0,
-        max_steps: int = 20000, check_every: int = 100, min_ratio: float = 50.0,
+        max_steps: int = 20000, check_every: int = 50, min_ratio: float = 50.0,
         tau_tol: float = 0.05, rhat_max: float = 1.01, burn_fraction: float = 0.2,
         n_starts: int = 4, laplace_move: float = 0.75, threads: int | None = None, out_dir=None,
         time_limit: float | None = None, progress: bool = True,

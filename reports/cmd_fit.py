@@ -59,7 +59,8 @@ def register(sub):
     p.add_argument("--ensembles", type=int, default=4, metavar="K")
     p.add_argument("--walkers", type=int, default=None, metavar="W",
                    help="walkers per ensemble (default 2 x ndim + 2)")
-    p.add_argument("--check-every", type=int, default=100, metavar="N")
+    p.add_argument("--check-every", type=int, default=50, metavar="N",
+                   help="steps between convergence checks (default 50)")
     p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS")
     p.add_argument("--sample", type=int, default=None, metavar="N",
                    help="CUReT sample number (for abrdf.dat)")

@@ -148,7 +148,12 @@ def lobe_plot(result, table, model_factory, theta_i_deg=None, phi_i_deg=None, ax
             v = np.nanmean(np.where(table.valid[sel], table.values[sel], np.nan), -1) \
                 * np.cos(np.radians(ang[sel, 2]))
             a.plot(s, v, "k.", ms=3, label="data")
-        a.set_title(f"theta_i = {ti:g} deg", fontsize=9)
+        from matplotlib.ticker import MaxNLocator
+        a.yaxis.set_major_locator(MaxNLocator(3))
+        a.tick_params(labelsize=7)
+        a.set_title(f"theta_i = {ti:g} deg: f_r cos(theta_o), mean RGB\n"
+                    f"(+ forward, - backward in the plane phi_i = {phi_i_deg:g} deg)",
+                    fontsize=8)
     ax[0].legend(fontsize=7, loc="lower left")
     _save(fig, filename)
     return fig, ax

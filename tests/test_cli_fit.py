@@ -1,0 +1,77 @@
+"""Tests of ``microcyl fit`` (reports.cmd_fit) end to end on small simulated tables."""
+
+import json
+
+import numpy as np
+import pytest
+
+import reports.cmd_fit as cmd_fit
+from gonio.table import Table
+from reports.cli import main
+from _fitmodels import fabric_table
+
+
+def _write_csv(table, path):
+    """CSV in gonio's table format: angles in degrees, r,g,b and sigma_r,g,b columns."""
+    a = np.degrees(table.angles)
+    cols = np.concatenate([a, table.values, table.sigma], axis=1)
+    with open(path, "w") as fh:
+        fh.write("# microcyl BRDF table\n")
+        fh.write("theta_i,phi_i,theta_o,phi_o,r,g,b,sigma_r,sigma_g,sigma_b\n")
+        for row in cols:
+            fh.write(",".join(f"{x:.17g}" for x in row) + "\n")
+
+
+def _read_csv(path, sample=None):
+    d = np.loadtxt(path, delimiter=",", comments="#", skiprows=2)
+    t, p = np.radians(d[:, 0:4:2]), np.radians(d[:, 1:4:2])
+    w = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+    return Table(w[:, 0], w[:, 1], d[:, 4:7], sigma=d[:, 7:10])
+
+
+@pytest.fixture
+def table_file(tmp_path, monkeypatch):
+    import gonio
+    if not hasattr(gonio, "read"):          # until gonio's readers are merged
+        monkeypatch.setattr(cmd_fit, "read_table", _read_csv)
+    table, _ = fabric_table("silk_crepe_de_chine", n=150, seed=9)
+    path = tmp_path / "silk.csv"
+    _write_csv(table, path)
+    return path
+
+
+def test_fit_writes_results_and_plots(table_file, tmp_path, capsys):
+    out = tmp_path / "fit"
+    args = ["fit", str(table_file), "--fabric", "silk_crepe_de_chine", "--free", "gamma_s1,kd1",
+            "--tie", "eta2=eta1", "--max-steps", "60", "--check-every", "30",
+            "--no-progress", "-o", str(out)]
+    assert main(args) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert set(doc) >= {"gamma_s1", "kd1", "converged"}
+    for k in ("median", "lo68", "hi68", "lo95", "hi95", "tau", "rhat", "ess"):
+        assert np.isfinite(doc["kd1"][k])
+    assert doc["gamma_s1"]["lo95"] < 5.0 < doc["gamma_s1"]["hi95"]
+    rep = doc["_fit"]["report"]
+    assert rep["albedo_delta_e2000"] < 2.0          # same model, 5% noise: barely visible
+    for name in ("corner", "traces", "lobes", "residuals"):
+        assert (out / f"{name}.png").stat().st_size > 1000
+    assert (out / "results.csv").exists()
+    text = capsys.readouterr().out
+    assert "gamma_s1" in text and "results:" in text
+    # same command again: resumes (no new optimisation), same folder accepted
+    assert main(args[:-2] + ["--no-plots", "-o", str(out)]) == 0
+
+
+def test_bad_input_is_one_line(table_file, tmp_path, capsys):
+    out = str(tmp_path / "x")
+    base = ["fit", str(table_file), "--fabric", "silk_crepe_de_chine", "--no-progress", "-o", out]
+    assert main(base + ["--free", "eta1,kd9"]) == 1
+    err = capsys.readouterr().err
+    assert "unknown free parameter 'kd9'" in err and "gamma_s1" in err and len(
+        err.strip().splitlines()) == 1
+    assert main(base[:3] + ["velour"] + base[4:]) == 1
+    assert "unknown fabric 'velour'" in capsys.readouterr().err
+    spec = tmp_path / "s.toml"
+    spec.write_text('free = ["gamma_s1"]\n[bounds]\ngamma_s1 = [6.0, 30.0]\n')
+    assert main(base + ["--spec", str(spec)]) == 1
+    assert "start value of gamma_s1" in capsys.readouterr().err

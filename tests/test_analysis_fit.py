@@ -158,3 +158,44 @@ def test_recovery(name, free):
          / ((r.summary[n]["hi95"] - r.summary[n]["lo95"]) / 3.92) for n in r.names}
     assert max(z.values()) < 4.0, z
     assert r.converged, r.reason
+
+
+def test_tangent_scale_slow_path():
+    fab = brdf.fabric("silk_crepe_de_chine")
+    table, _ = fabric_table("silk_crepe_de_chine", n=40, seed=3, fab=fab)
+    model = FabricModel(fab, table.wi, table.wo)
+    th = fab.threads
+    scaled = fab.replace(threads=(th[0].replace(offsets=tuple(0.8 * np.array(th[0].offsets))),
+                                  th[1]))
+    got = model(tangent_scale=np.array([[0.8, 1.0], [1.0, 1.0]]))
+    np.testing.assert_allclose(got[0], scaled.eval(table.wi, table.wo), rtol=1e-12)
+    np.testing.assert_allclose(got[1], fab.eval(table.wi, table.wo), rtol=1e-12)
+    spec = ParamSpec("tangent_scale1", defaults=dict(defaults_from_fabric(fab),
+                                                     tangent_scale1=0.95))
+    r = fit(table, spec, model, seed=0, **dict(FAST, max_steps=20, check_every=10,
+                                               n_starts=1))
+    assert r.chains.shape[1:] == (16, 4, 1)
+    assert abs(r.best["tangent_scale1"] - 1.0) < 0.05
+
+
+def test_interrupt_keeps_the_checkpoint(tmp_path):
+    table, fab = fabric_table("velvet", n=60, seed=4)
+    spec = ParamSpec("gamma_s1", defaults=defaults_from_fabric(fab))
+    inner = FabricModel(fab, table.wi, table.wo)
+    calls = {"n": 0}
+
+    def model(**kw):
+        if np.shape(kw["eta"])[0] >= 8:     # a sampling batch (4 ensembles x 2+ walkers)
+            calls["n"] += 1
+            if calls["n"] == 30:
+                raise KeyboardInterrupt
+        return inner(**kw)
+
+    with pytest.raises((KeyboardInterrupt, RuntimeError)):
+        fit(table, spec, model, seed=0, out_dir=tmp_path, **dict(FAST, max_steps=200))
+    import emcee
+    done = [emcee.backends.HDFBackend(str(tmp_path / f"chains_{k}.h5"), read_only=True)
+            .iteration for k in range(4)]
+    assert min(done) > 0
+    r = fit(table, spec, inner, seed=0, out_dir=tmp_path, **dict(FAST, max_steps=60))
+    assert r.steps == 60

@@ -922,5 +922,5 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
     except ValueError as exc:
         if str(exc).startswith("geometry spec"):
             raise
-        raise ValueError(f"geometry spec {spec!r}: {exc}") from None
+        raise ValueError(f"geometry spec {spec!r}: {exc}; use {SPEC_HELP}") from None
     raise bad(f"unknown kind {kind!r}")

@@ -323,25 +323,27 @@ class Geometry:
     info: dict = dataclasses.field(default_factory=dict)
 
     def __post_init__(self):
-        wi = np.asarray(self.wi_lab, float).reshape(-1, 3)
-        wo = np.asarray(self.wo_lab, float).reshape(-1, 3)
+        wi = np.array(self.wi_lab, float).reshape(-1, 3)
+        wo = np.array(self.wo_lab, float).reshape(-1, 3)
         if wi.shape != wo.shape:
             raise ValueError(f"Geometry wi has shape {wi.shape} but wo has {wo.shape}")
         n = wi.shape[0]
         coords = {}
         for k, v in dict(self.coords).items():
-            v = np.asarray(v, float).reshape(-1)
+            v = np.array(v, float).reshape(-1)
             if v.shape != (n,):
                 raise ValueError(f"Geometry coordinate {k!r} has {v.size} values; expected {n}")
             coords[k] = v
         rotation = float(self.rotation)
         if not math.isfinite(rotation):
             raise ValueError(f"rotation must be a finite angle in radians; got {self.rotation!r}")
-        index = np.arange(n) if self.index is None else np.asarray(self.index, np.int64).reshape(-1)
+        index = np.arange(n) if self.index is None else np.array(self.index, np.int64).reshape(-1)
         if index.shape != (n,):
             raise ValueError(f"Geometry index has {index.size} values; expected {n}")
         info = {"n_layout": n, "dropped_below_horizon": 0}
         info.update(self.info)
+        for arr in (wi, wo, index, *coords.values()):   # shared by reference: keep them intact
+            arr.flags.writeable = False
         object.__setattr__(self, "wi_lab", wi)
         object.__setattr__(self, "wo_lab", wo)
         object.__setattr__(self, "coords", coords)
@@ -392,7 +394,7 @@ class Geometry:
 
     def subset(self, keep) -> "Geometry":
         """The pairs selected by a boolean mask or an index array, coordinates kept."""
-        keep = np.asarray(keep)
+        keep = keep if isinstance(keep, slice) else np.asarray(keep)
         return dataclasses.replace(
             self, wi_lab=self.wi_lab[keep], wo_lab=self.wo_lab[keep],
             coords={k: v[keep] for k, v in self.coords.items()}, index=self.index[keep])

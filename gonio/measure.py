@@ -113,10 +113,10 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
     instrument : Instrument, optional
         Cones and noise; a noiseless point instrument when None.
     seed : int, numpy.random.Generator or None
-        Seed of the noise. The same integer seed gives the same bytes. The noise is drawn
-        once over the whole table in a fixed order, and the cone averages are plain ordered
-        sums, so ``chunk`` changes no byte unless the BRDF's own rounding depends on the
-        batch size.
+        Seed of the noise. The same integer seed (and the same ``chunk``) gives the same
+        bytes. The noise is drawn once over the whole table in a fixed order and the cone
+        averages are explicitly ordered sums, so another ``chunk`` changes at most the last
+        bit of a value (where NumPy's or the BRDF's rounding depends on the batch).
     chunk : int, optional
         BRDF evaluations per chunk (pairs x cone points); default ``CHUNK_EVALUATIONS``.
         Bounds the memory of each ``eval`` call.
@@ -202,7 +202,7 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
         progress = total >= PROGRESS_MIN_EVALUATIONS and sys.stderr.isatty()
 
     values = np.empty((n, 3))
-    wgt = (ws[:, None] * wd[None, :])[None, :, :, None]
+    wgt = (ws[:, None] * wd[None, :]).reshape(-1)
     rot = geometry.rotation
     bar = None
     if progress and n:
@@ -225,8 +225,13 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
             if per_pair == 1:
                 values[a:b] = f[:, 0, 0]
             else:
-                # a plain ordered reduction: the same bytes whatever the chunk size
-                values[a:b] = (f * wgt).sum(axis=(1, 2))
+                # an explicitly ordered sum (numpy's reductions pick pairwise or sequential
+                # order by memory layout)
+                f = f.reshape(c, per_pair, 3)
+                acc = f[:, 0] * wgt[0]
+                for q in range(1, per_pair):
+                    acc += f[:, q] * wgt[q]
+                values[a:b] = acc
             if bar is not None:
                 bar.update(c)
     finally:
@@ -245,4 +250,5 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
         "software": "microcyl gonio.measure",
         "version": toolkit_version(),
     }
-    return Table(geometry.wi, geometry.wo, noisy, sigma, meta)
+    # copies: Table normalizes its direction arrays in place
+    return Table(np.array(geometry.wi), np.array(geometry.wo), noisy, sigma, meta)

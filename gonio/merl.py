@@ -274,16 +274,20 @@ def _brdf_to_grid(brdf, rotations: int, chunk_rows: int, progress: bool) -> np.n
         i1 = min(i0 + chunk_rows, 90)
         i = np.repeat(np.arange(i0, i1), 90 * 180)
         jj, kk = np.tile(j, i1 - i0), np.tile(k, i1 - i0)
-        acc = np.zeros((i.size, 3))
-        bad = np.zeros(i.size, bool)
+        # the horizon does not depend on the rotation about z: evaluate only bins above it
+        wi, wo = merl_directions(i, jj, kk, 0.0)
+        above = np.flatnonzero((wi[:, 2] > 0) & (wo[:, 2] > 0))
+        i, jj, kk = i[above], jj[above], kk[above]
+        acc = np.zeros((above.size, 3))
+        bad = np.zeros(above.size, bool)
         for phi in phis:
             wi, wo = merl_directions(i, jj, kk, phi)
             f = np.asarray(brdf.eval(wi, wo), np.float64)
-            below = (wi[:, 2] <= 0) | (wo[:, 2] <= 0)
-            bad |= below | ~np.all(np.isfinite(f), axis=1)
-            acc += np.where(np.isfinite(f), f, 0.0)
-        vals = acc / rotations
-        vals[bad] = -1.0
+            finite = np.all(np.isfinite(f), axis=1)
+            bad |= ~finite
+            acc += np.where(finite[:, None], f, 0.0)
+        vals = np.full((16200 * (i1 - i0), 3), -1.0)
+        vals[above] = np.where(bad[:, None], -1.0, acc / rotations)
         grid[:, i0 * 16200:i1 * 16200] = vals.T
     return grid
 

@@ -19,6 +19,7 @@ __all__ = ["main", "build_parser", "COMMAND_MODULES"]
 COMMAND_MODULES = (
     "reports.cmd_model",
     "reports.cmd_measure",
+    "reports.cmd_tables",
 )
 
 

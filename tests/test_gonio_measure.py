@@ -360,5 +360,5 @@ def test_bad_brdf_output_shape():
 
 def test_public_names():
     for name in ("measure", "Geometry", "Instrument", "full_grid", "plane", "rusinkiewicz",
-                 "merl", "pairs", "pairs_from_angles", "Table"):
+                 "merl_grid", "pairs", "pairs_from_angles", "Table"):
         assert name in gonio.__all__ and hasattr(gonio, name)

@@ -204,11 +204,14 @@ _CTX = {}
 def _init_worker(ctx):
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent handles Ctrl-C
     _CTX.clear()
-    _CTX.update(ctx)
+    _CTX.update(ctx, parent=os.getppid())
 
 
 def _render_tile(tile, ctx=None):
-    ctx = ctx or _CTX
+    if ctx is None:
+        ctx = _CTX
+        if os.getppid() != ctx["parent"]:   # the parent was killed: stop, do not linger
+            os._exit(1)
     index, y0, y1, x0, x1 = tile
     width, height, spp = ctx["width"], ctx["height"], ctx["spp"]
     rng = np.random.default_rng([ctx["seed"], index])

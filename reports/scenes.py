@@ -268,8 +268,6 @@ class Curtain:
         Fold amplitude at the top as a fraction of ``depth``.
     z : float
         Mean depth of the drape.
-    steps : int
-        Ray-marching steps through the bounding slab before bisection.
     """
 
     width: float = 2.4
@@ -279,7 +277,6 @@ class Curtain:
     folds: float = 6.0
     top: float = 0.4
     z: float = 0.0
-    steps: int = 48
     material: str = "cloth"
     albedo: float = 0.5
 
@@ -288,7 +285,10 @@ class Curtain:
         return 2 * np.pi * self.folds / self.width
 
     def _height(self, x, y):
-        return self._height_grad(x, y)[0]
+        k = self._k
+        s = (self.y1 - y) * (1.0 / (self.y1 - self.y0))
+        a = self.depth * (self.top + (1 - self.top) * s)
+        return self.z + a * (np.sin(k * x) + 0.4 * np.sin(1.9 * k * x + 0.8 + 1.5 * s))
 
     def _height_grad(self, x, y):
         """Height z(x, y) and its partial derivatives z_x, z_y."""
@@ -308,7 +308,11 @@ class Curtain:
         return p[:, 2] - self._height(p[:, 0], p[:, 1])
 
     def intersect(self, o, d, tmin):
-        """First crossing of the height field: march ``steps`` steps, then bisect."""
+        """First crossing of the height field inside its bounding box.
+
+        March in steps fine enough to see every fold (12 per period of the shortest
+        harmonic, measured along x), then refine the first sign change by bisection.
+        """
         n = len(o)
         lo = np.array([-self.width / 2, self.y0, self.z - 1.4 * self.depth])
         hi = np.array([self.width / 2, self.y1, self.z + 1.4 * self.depth])
@@ -326,30 +330,45 @@ class Curtain:
         if idx.size == 0:
             return result, np.zeros(n, np.int8)
         o2, d2, a, b = o[idx], d[idx], tnear[idx], tfar[idx]
-        # march: first sign change of g between consecutive samples
-        fr = np.linspace(0.0, 1.0, self.steps + 1)
-        ts = a[:, None] + (b - a)[:, None] * fr[None, :]          # (m, steps+1)
-        p = o2[:, None, :] + ts[..., None] * d2[:, None, :]
-        g = p[..., 2] - self._height(p[..., 0], p[..., 1])
-        change = np.signbit(g[:, :-1]) != np.signbit(g[:, 1:])
-        has = change.any(axis=1)
-        first = np.argmax(change, axis=1)
-        sel = np.nonzero(has)[0]
-        if sel.size:
-            rows = sel
-            t_lo = ts[rows, first[rows]]
-            t_hi = ts[rows, first[rows] + 1]
-            g_lo = g[rows, first[rows]]
-            oo, dd = o2[rows], d2[rows]
-            for _ in range(40):
-                tm = 0.5 * (t_lo + t_hi)
-                gm = self._g(oo, dd, tm)
-                same = np.signbit(gm) == np.signbit(g_lo)
-                t_lo = np.where(same, tm, t_lo)
-                g_lo = np.where(same, gm, g_lo)
-                t_hi = np.where(same, t_hi, tm)
-            result[idx[rows]] = 0.5 * (t_lo + t_hi)
+        # march: steps enough to resolve the shortest fold (12 per period) along x
+        period = self.width / (self.folds * 1.9)
+        need = 4 + np.ceil(12 * np.abs(d2[:, 0]) * (b - a) / period)
+        bucket = np.clip(np.ceil(np.log2(need)), 2, 9).astype(int)   # 4 .. 512 steps
+        for e in np.unique(bucket):
+            sel = np.nonzero(bucket == e)[0]
+            t_hit = self._march(o2[sel], d2[sel], a[sel], b[sel], 2 ** e)
+            result[idx[sel]] = t_hit
         return result, np.zeros(n, np.int8)
+
+    def _march(self, o, d, a, b, steps):
+        """First root of g in [a, b] (inf if none): sign change over ``steps`` steps, then
+        24 bisections and one secant step."""
+        out = np.full(len(o), _INF)
+        fr = np.linspace(0.0, 1.0, steps + 1)
+        ts = a[:, None] + (b - a)[:, None] * fr[None, :]          # (m, steps+1)
+        x = o[:, None, 0] + ts * d[:, None, 0]
+        y = o[:, None, 1] + ts * d[:, None, 1]
+        g = o[:, None, 2] + ts * d[:, None, 2] - self._height(x, y)
+        change = np.signbit(g[:, :-1]) != np.signbit(g[:, 1:])
+        rows = np.nonzero(change.any(axis=1))[0]
+        if rows.size == 0:
+            return out
+        first = np.argmax(change[rows], axis=1)
+        t_lo, t_hi = ts[rows, first], ts[rows, first + 1]
+        g_lo, g_hi = g[rows, first], g[rows, first + 1]
+        oo, dd = o[rows], d[rows]
+        for _ in range(24):
+            tm = 0.5 * (t_lo + t_hi)
+            gm = self._g(oo, dd, tm)
+            same = np.signbit(gm) == np.signbit(g_lo)
+            t_lo, g_lo = np.where(same, tm, t_lo), np.where(same, gm, g_lo)
+            t_hi, g_hi = np.where(same, t_hi, tm), np.where(same, g_hi, gm)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = t_lo - g_lo * (t_hi - t_lo) / (g_hi - g_lo)
+        bad = ~((t >= t_lo) & (t <= t_hi))
+        t[bad] = 0.5 * (t_lo[bad] + t_hi[bad])
+        out[rows] = t
+        return out
 
     def frame(self, p, part):
         """Normal ``(-z_x, -z_y, 1)`` normalized and warp ``(1, 0, z_x)`` normalized."""
@@ -535,7 +554,7 @@ def _sphere():
     return Scene(
         primitives=(Sphere(center=(0.0, 0.0, 0.0), radius=1.0),),
         camera=PinholeCamera(position=(0.0, 0.0, 4.5), target=(0.0, 0.0, 0.0), fov=30.0),
-        light=PointLight(position=(-3.0, 3.0, 4.0), intensity=40.0),
+        light=PointLight(position=(-2.0, 2.0, 5.0), intensity=30.0),
         name="sphere", scale=1.0)
 
 

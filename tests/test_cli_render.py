@@ -90,3 +90,26 @@ def test_masking_toggle_changes_the_render(tmp_path):
     assert main(["render", "cylinder", "velvet", "--masking", "off", "--tangent-samples", "4",
                  *SMALL, "-o", str(tmp_path / "m.png")]) == 0
     assert [p.name for p in tmp_path.iterdir()] == ["m.png"]
+
+
+class _Interrupting:
+    """A BRDF whose batched evaluations raise KeyboardInterrupt (as Ctrl-C would)."""
+
+    def eval(self, wi, wo):
+        if np.shape(wi)[0] > 1:
+            raise KeyboardInterrupt
+        return np.zeros(np.broadcast_shapes(np.shape(wi), np.shape(wo)))
+
+    def replace(self, **changes):
+        return self
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_interrupt_leaves_no_file(tmp_path, capsys, monkeypatch, workers):
+    import reports.render
+    monkeypatch.setattr(reports.render, "resolve_fabric", lambda name, **kw: _Interrupting())
+    status = main(["render", "cylinder", "velvet", "--width", "200", "--height", "100",
+                   "--spp", "1", "--quiet", "--workers", workers, "-o", str(tmp_path / "x.exr")])
+    assert status == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

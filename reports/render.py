@@ -312,27 +312,30 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     tiles = _tiles(width, height, tile)
     image = np.zeros((height, width, 3), np.float32)
     workers = min(workers, len(tiles))
-    bar = tqdm(total=len(tiles), unit="tile", desc=f"render {scene.name or 'scene'}",
-               disable=not progress, leave=False)
-    try:
-        if workers == 1:
+    def new_bar():
+        return tqdm(total=len(tiles), unit="tile", desc=f"render {scene.name or 'scene'}",
+                    disable=not progress, leave=False)
+
+    if workers == 1:
+        with new_bar() as bar:
             for t in tiles:
                 (_, y0, y1, x0, x1), img = _render_tile(t, ctx)
                 image[y0:y1, x0:x1] = img
                 bar.update()
-        else:
-            methods = multiprocessing.get_all_start_methods()
-            mp = multiprocessing.get_context("fork" if "fork" in methods else None)
-            pool = ProcessPoolExecutor(workers, mp_context=mp, initializer=_init_worker,
-                                       initargs=(ctx,))
-            try:
-                futures = [pool.submit(_render_tile, t) for t in tiles]
-                for fut in as_completed(futures):
-                    (_, y0, y1, x0, x1), img = fut.result()
-                    image[y0:y1, x0:x1] = img
-                    bar.update()
-            finally:
-                pool.shutdown(wait=True, cancel_futures=True)
+        return image
+    # fork (where available) shares the scene and fabric without pickling; the workers are
+    # started by the first submit, before this process starts any thread of its own (tqdm)
+    methods = multiprocessing.get_all_start_methods()
+    mp = multiprocessing.get_context("fork" if "fork" in methods else None)
+    pool = ProcessPoolExecutor(workers, mp_context=mp, initializer=_init_worker,
+                               initargs=(ctx,))
+    try:
+        futures = [pool.submit(_render_tile, t) for t in tiles]
+        with new_bar() as bar:
+            for fut in as_completed(futures):
+                (_, y0, y1, x0, x1), img = fut.result()
+                image[y0:y1, x0:x1] = img
+                bar.update()
     finally:
-        bar.close()
+        pool.shutdown(wait=True, cancel_futures=True)
     return image

@@ -115,6 +115,15 @@ def read_exr(path):
         raise ValueError(f"{path}: not a readable RGB OpenEXR file ({exc})") from None
 
 
+def _colour():
+    """Import colour-science, keeping NumPy's print options (its import sets legacy="1.13",
+    which would change every later array repr, doctests included)."""
+    options = np.get_printoptions()
+    import colour
+    np.set_printoptions(**options)
+    return colour
+
+
 def encode_srgb(rgb, exposure=0.0):
     """Linear RGB -> sRGB-encoded values in [0, 1] (colour-science's sRGB CCTF).
 
@@ -135,8 +144,7 @@ def encode_srgb(rgb, exposure=0.0):
     >>> np.round(encode_srgb(np.array([0.0, 0.214041, 1.0, 4.0])), 6).tolist()
     [0.0, 0.5, 1.0, 1.0]
     """
-    import colour
-
+    colour = _colour()
     exposure = float(exposure)
     if not np.isfinite(exposure):
         raise ValueError(f"exposure={exposure} must be a finite number of stops")

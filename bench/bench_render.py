@@ -1,7 +1,7 @@
 """Time the cylinder render at 1280 x 720 and 16 samples per pixel (the issue's budget: 2 min).
 
 Usage: python bench/bench_render.py [FABRIC] [--width W] [--height H] [--spp N] [--workers N]
-Prints the wall time, the number of BRDF evaluations and the rate.  Other work on the machine
+Prints the wall time.  Other work on the machine
 slows it down: note the load average printed beside the figure.
 """
 
@@ -26,7 +26,6 @@ def main():
     a = p.parse_args()
     import brdf
     fab = brdf.fabric(a.fabric, masking=a.masking == "on")
-    # count BRDF pairs: a thin wrapper (counts only in this process, so run one probe serially)
     t0 = time.perf_counter()
     img = R.render(a.scene, fab, width=a.width, height=a.height, spp=a.spp, workers=a.workers,
                    progress=True)

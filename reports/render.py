@@ -269,6 +269,13 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
         For an unknown scene or fabric, a size beyond 1280 x 720, or a bad ``spp``,
         ``tile`` or ``workers``, before any rendering.
 
+    Notes
+    -----
+    Each sample's radiance is ``f_r(wi, wo) * E * cos(theta_i) * V`` (see the module
+    docstring); ``wi`` and ``wo`` go to ``fabric.eval`` in the local frame (x = warp,
+    y = n x warp, z = n), all lit cloth samples of a tile in one call (at most
+    131072 pairs each).  Tiles run in ``workers`` processes (fork where available).
+
     Examples
     --------
     >>> class Lambert:

@@ -20,6 +20,7 @@ COMMAND_MODULES = (
     "reports.cmd_model",
     "reports.cmd_measure",
     "reports.cmd_tables",
+    "reports.cmd_render",
 )
 
 

@@ -4,7 +4,9 @@ Half/difference angles follow Rusinkiewicz (1998): theta_h, phi_h locate the hal
 theta_d, phi_d the incident direction in the frame whose pole is h
 (:func:`reports._plotting.half_diff_to_io`). For an anisotropic BRDF such as cloth, phi_h
 matters too: every slice takes it (default 0, the half vector in the warp's plane).
-Pairs with either direction below the horizon evaluate to 0 (the BRDF's own convention).
+Pairs with either direction below the horizon evaluate to 0 (the BRDF's own convention). The
+cartesian slices stop at ``theta_max_deg`` (default 89.5 degrees) short of the horizon, where
+wi and wo can both graze and the model's value is a limit it reaches only in round-off.
 """
 
 from __future__ import annotations
@@ -17,6 +19,13 @@ from reports.colour import line_colour, luminance
 
 __all__ = ["plot_slice_theta_o", "plot_slice_theta_h", "plot_slice_theta_d",
            "plot_slice_image", "slice_image"]
+
+
+def _check_max(theta_max_deg):
+    v = float(theta_max_deg)
+    if not 0.0 < v <= 90.0:
+        raise ValueError(f"theta_max_deg must be in (0, 90] degrees; got {theta_max_deg!r}")
+    return v
 
 
 def _check_res(resolution, least=2):
@@ -40,7 +49,8 @@ def _draw(ax, x_deg, values, quantity, colour, log, gid):
 
 
 def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *,
-                       quantity="rgb", log=False, resolution=181, ax=None, filename=None,
+                       quantity="rgb", log=False, resolution=181, theta_max_deg=89.5, ax=None,
+                       filename=None,
                        title=None):
     """f_r against theta_o at fixed wi and viewing azimuth phi_o.
 
@@ -57,7 +67,9 @@ def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *
     log : bool
         Logarithmic y axis.
     resolution : int
-        Samples of theta_o over [0, 90] degrees.
+        Samples of theta_o over [0, theta_max_deg] degrees.
+    theta_max_deg : float
+        End of the swept angle in degrees (all three cartesian slices take it).
 
     Returns
     -------
@@ -68,7 +80,7 @@ def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *
     check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
     n = _check_res(resolution)
     fig, ax = new_axes(ax)
-    x = np.linspace(0.0, 90.0, n)
+    x = np.linspace(0.0, _check_max(theta_max_deg), n)
     wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
     wo = from_angles(np.radians(x), np.radians(phi_o_deg))
     f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
@@ -80,9 +92,10 @@ def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *
 
 
 def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
-                       quantity="rgb", log=True, resolution=181, ax=None, filename=None,
+                       quantity="rgb", log=True, resolution=181, theta_max_deg=89.5, ax=None,
+                       filename=None,
                        title=None):
-    """f_r against theta_h in [0, 90] degrees at fixed theta_d, phi_d and phi_h (degrees).
+    """f_r against theta_h in [0, theta_max_deg] at fixed theta_d, phi_d and phi_h (degrees).
 
     Returns
     -------
@@ -93,7 +106,7 @@ def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
     check_angle("theta_d_deg", theta_d_deg, 0.0, 90.0)
     n = _check_res(resolution)
     fig, ax = new_axes(ax)
-    x = np.linspace(0.0, 90.0, n)
+    x = np.linspace(0.0, _check_max(theta_max_deg), n)
     wi, wo = half_diff_to_io(np.radians(x), np.radians(theta_d_deg), np.radians(phi_d_deg),
                              np.radians(phi_h_deg))
     f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
@@ -105,9 +118,10 @@ def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
 
 
 def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
-                       quantity="rgb", log=True, resolution=181, ax=None, filename=None,
+                       quantity="rgb", log=True, resolution=181, theta_max_deg=89.5, ax=None,
+                       filename=None,
                        title=None):
-    """f_r against theta_d in [0, 90] degrees at fixed theta_h, phi_d and phi_h (degrees).
+    """f_r against theta_d in [0, theta_max_deg] at fixed theta_h, phi_d and phi_h (degrees).
 
     Returns
     -------
@@ -118,7 +132,7 @@ def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
     check_angle("theta_h_deg", theta_h_deg, 0.0, 90.0)
     n = _check_res(resolution)
     fig, ax = new_axes(ax)
-    x = np.linspace(0.0, 90.0, n)
+    x = np.linspace(0.0, _check_max(theta_max_deg), n)
     wi, wo = half_diff_to_io(np.radians(theta_h_deg), np.radians(x), np.radians(phi_d_deg),
                              np.radians(phi_h_deg))
     f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)

@@ -130,7 +130,7 @@ def test_half_diff_conversion_properties():
 
 
 def test_cartesian_slices_equal_eval(silk):
-    x = np.linspace(0, 90, 7)
+    x = np.linspace(0, 89.5, 7)
     fig, ax = plots.plot_slice_theta_o(silk, 30.0, 180.0, 45.0, resolution=7)
     f = ev(silk, sph(30.0, 180.0), sph(x, 45.0))
     for k, c in enumerate("rgb"):
@@ -138,12 +138,13 @@ def test_cartesian_slices_equal_eval(silk):
     # theta_d slice at theta_h = 0: wi = (theta_d, phi_d), wo = (theta_d, phi_d + 180)
     fig, ax = plots.plot_slice_theta_d(silk, 0.0, 60.0, resolution=7, quantity="luminance")
     x = lines_by_gid(ax)["theta_d luminance"].get_xdata()
+    assert x[-1] == pytest.approx(89.5)
     inside = x < 90
     expected = ev(silk, sph(x, 60.0), sph(x, 240.0)) @ W
     assert np.allclose(lines_by_gid(ax)["theta_d luminance"].get_ydata()[inside],
                        expected[inside])
     fig, ax = plots.plot_slice_theta_h(silk, 10.0, 90.0, 0.0, resolution=7, quantity="g")
-    wi, wo = plots.half_diff_to_io(np.radians(np.linspace(0, 90, 7)), np.radians(10.0),
+    wi, wo = plots.half_diff_to_io(np.radians(np.linspace(0, 89.5, 7)), np.radians(10.0),
                                    np.radians(90.0))
     assert np.allclose(lines_by_gid(ax)["theta_h g"].get_ydata(), ev(silk, wi, wo)[:, 1])
 

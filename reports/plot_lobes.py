@@ -82,8 +82,10 @@ def _setup_polar(ax, scale, floor, rmax):
         ax.set_yticklabels([f"1e{base + k}" if (len(shown) - 1 - k) % every == 0 else ""
                             for k in shown], fontsize=6)
     else:
+        from matplotlib.ticker import MaxNLocator
         ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
-        ax.tick_params(axis="y", labelsize=7)
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(axis="y", labelsize=6)
 
 
 def _check_scale(scale):

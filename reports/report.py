@@ -187,7 +187,7 @@ def _close(fig):
 
 def _figure(ncols=1, nrows=1, figsize=None, polar=False, **kw):
     from matplotlib.figure import Figure
-    fig = Figure(figsize=figsize or (4.6 * ncols, 3.8 * nrows))
+    fig = Figure(figsize=figsize or (4.6 * ncols, 3.8 * nrows), layout="constrained")
     axes = [fig.add_subplot(nrows, ncols, k + 1, projection="polar" if polar else None, **kw)
             for k in range(ncols * nrows)]
     return fig, axes

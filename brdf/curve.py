@@ -37,7 +37,7 @@ class TangentCurve:
     >>> c = TangentCurve((-25, 25), (1,))
     >>> alpha, weight = c.samples(4)
     >>> alpha.tolist(), weight.tolist()
-    [[-18.75, -6.25, 6.25, 18.75], [0.25, 0.25, 0.25, 0.25]]
+    ([-18.75, -6.25, 6.25, 18.75], [0.25, 0.25, 0.25, 0.25])
     """
 
     offsets: tuple[float, ...]

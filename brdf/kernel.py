@@ -244,8 +244,8 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
     batch = np.broadcast_shapes(eta.shape, kd.shape, gamma_s.shape, gamma_v.shape)
     ex = (Ellipsis,) + (None,) * geom.th2.ndim
 
-    def b(x):  # parameter (B...) -> (B..., 1, 1)
-        return x[ex] if batch else x
+    def b(x):  # parameter (B...) -> (B..., 1, 1), broadcast to the whole batch
+        return np.broadcast_to(x, batch)[ex] if batch else x
 
     eta2 = b(eta * eta)
     f = _fresnel_from_cos(eta2, geom.cg, geom.cg2)

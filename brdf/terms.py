@@ -75,7 +75,7 @@ def gaussian(gamma, x):
 
     Examples
     --------
-    >>> round(float(gaussian(1.0, 0.0)) * np.sqrt(2 * np.pi), 12)
+    >>> round(float(gaussian(1.0, 0.0) * np.sqrt(2 * np.pi)), 12)
     1.0
     """
     gamma = np.asarray(gamma, dtype=np.float64)

@@ -125,7 +125,8 @@ def reference_eval(fabric, wi, wo):
     Q += (1 - a1 - a2) * gap
     if not opts["reweighting"]:
         Q = np.ones(len(wi))
-    out = num / (Q * wi[:, 2])[:, None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = num / (Q * wi[:, 2])[:, None]
     out[Q == 0] = 0
     return out
 

@@ -79,7 +79,7 @@ def to_srgb(rgb, exposure: float = 0.0, normalize: bool = False) -> np.ndarray:
     --------
     >>> to_srgb([0.0, 0.5, 1.0]).round(4).tolist()
     [0.0, 0.7354, 1.0]
-    >>> to_srgb([0.1, 0.2, 0.4], normalize=True)[2]
+    >>> round(float(to_srgb([0.1, 0.2, 0.4], normalize=True)[2]), 12)
     1.0
     """
     arr = np.asarray(rgb, dtype=np.float64)

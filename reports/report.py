@@ -240,7 +240,14 @@ def _sec_parameters(p: _Page) -> str:
     header = ["thread", "eta", "A (RGB)", "k_d", "γs (deg)", "γv (deg)", "area a",
               "offsets (deg)", "lengths"]
     opts = ", ".join(f"{k} = {_fmt(v)}" for k, v in params["options"].items()) or "n/a"
-    return f"{_table(header, rows)}<p>Options: {html.escape(opts)}</p><p>Data: {link}</p>"
+    from reports.standard import STANDARD_GEOMETRIES, standard_values
+    values = standard_values(p.fabric)
+    p.summary["standard_geometries"] = values
+    std = _table(["geometry", "θi, φi (deg)", "θo, φo (deg)", "f_r R", "f_r G", "f_r B (1/sr)"],
+                 [[g[0], f"{g[1]:g}, {g[2]:g}", f"{g[3]:g}, {g[4]:g}"]
+                  + [f"{v:.5g}" for v in values[g[0]]] for g in STANDARD_GEOMETRIES])
+    return (f"{_table(header, rows)}<p>Options: {html.escape(opts)}</p>"
+            f"<h3>f_r at standard geometries</h3>{std}<p>Data: {link}</p>")
 
 
 _LOBE_THETAS = (0.0, 30.0, 60.0)

@@ -1,0 +1,181 @@
+"""Speed and validation of ``analysis.fit`` (the default fit, recovery, calibration, real data).
+
+Default: the default fit -- a silk_crepe_de_chine table simulated by ``gonio.measure`` on the
+``full:15:30`` grid (3,721 pairs; SNR 20 multiplicative noise plus a 1e-4 1/sr floor), the
+default 8 free parameters (eta tied, area2 = 1 - area1), 4 ensembles -- and prints
+log-probability evaluations per second, effective samples per second, and the wall time.
+
+    .venv/bin/python bench/bench_fit.py                 # speed of the default fit
+    .venv/bin/python bench/bench_fit.py --recovery      # silk, charmeuse, velvet: truth in 95%?
+    .venv/bin/python bench/bench_fit.py --calibration 20  # coverage over 20 replicas
+    .venv/bin/python bench/bench_fit.py --real          # RGL felts and CUReT fabrics
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+import brdf
+import gonio
+from analysis.fit import FabricModel, fit
+from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
+
+SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+def simulate(name, spec="full:15:30", snr=20.0, seed=0):
+    fab = brdf.fabric(name)
+    table = gonio.measure(fab, spec, gonio.Instrument(snr=snr, floor=1e-4), seed=seed,
+                          progress=False)
+    return table, fab
+
+
+def run_fit(table, fab, free=DEFAULT_FREE, ties=DEFAULT_TIES, out=None, **kw):
+    spec = ParamSpec(free, defaults=defaults_from_fabric(fab), ties=ties)
+    model = FabricModel(fab, table.wi, table.wo)
+    with tempfile.TemporaryDirectory() as tmp:
+        return fit(table, spec, model, out_dir=out or tmp, **kw)
+
+
+def speed(args):
+    table, fab = simulate("silk_crepe_de_chine", seed=args.seed)
+    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, load average "
+          f"{os.getloadavg()[0]:.1f}; table: {len(table)} pairs, silk_crepe_de_chine")
+    r = run_fit(table, fab, seed=args.seed, progress=not args.quiet)
+    t = r.timing
+    print(f"free parameters: {len(r.names)} ({', '.join(r.names)}); "
+          f"{r.ensembles} ensembles x {r.walkers} walkers; values used {r.counts['used']}")
+    print(f"verdict: {r.reason}")
+    print(f"log-probability evaluations per second: {t['evals_per_s']:.0f} "
+          f"({t['log_prob_evals']} in {t['sample_s']:.1f} s of sampling)")
+    print(f"effective samples per second (smallest ESS over parameters): {t['ess_per_s']:.1f}")
+    print(f"wall time of the default fit: {t['wall_s']:.1f} s (point estimate "
+          f"{t['optimize_s']:.1f} s); max tau {max(s['tau'] for s in r.summary.values()):.1f} "
+          f"steps, min N/tau {min(s['n_over_tau'] for s in r.summary.values()):.0f}")
+    return 0 if r.converged and t["wall_s"] < 300 else 1
+
+
+def recovery(args):
+    bad = 0
+    for name in ("silk_crepe_de_chine", "polyester_satin_charmeuse", "velvet"):
+        table, fab = simulate(name, seed=args.seed)
+        truth = defaults_from_fabric(fab)
+        r = run_fit(table, fab, seed=args.seed, progress=False)
+        inside = [r.summary[n]["lo95"] <= truth[n] <= r.summary[n]["hi95"] for n in r.names]
+        bad += sum(not i for i in inside)
+        print(f"{name}: {sum(inside)}/{len(inside)} truths inside their 95% interval; "
+              f"{r.reason} ({r.timing['wall_s']:.0f} s)")
+        for n, ok in zip(r.names, inside):
+            s = r.summary[n]
+            print(f"   {n:10s} truth {truth[n]:9.5g}  median {s['median']:9.5g}  95% "
+                  f"[{s['lo95']:9.5g}, {s['hi95']:9.5g}] {'' if ok else '  <-- outside'}")
+    return 0
+
+
+def calibration(args):
+    """Coverage of the 68% and 95% intervals over replicas (silk, 5 free parameters)."""
+    free = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1")
+    hits68 = hits95 = total = 0
+    t0 = time.perf_counter()
+    for rep in range(args.calibration):
+        table, fab = simulate("silk_crepe_de_chine", spec="full:20:45", seed=1000 + rep)
+        truth = defaults_from_fabric(fab)
+        r = run_fit(table, fab, free=free, seed=rep, progress=False)
+        for n in r.names:
+            s = r.summary[n]
+            hits68 += s["lo68"] <= truth[n] <= s["hi68"]
+            hits95 += s["lo95"] <= truth[n] <= s["hi95"]
+            total += 1
+        print(f"replica {rep}: converged {r.converged}, running coverage 68% "
+              f"{hits68 / total:.3f}, 95% {hits95 / total:.3f} ({time.perf_counter() - t0:.0f} s)",
+              flush=True)
+    ok = True
+    for p, h in ((0.6827, hits68), (0.95, hits95)):
+        lo, hi = stats.binom.interval(0.99, total, p)
+        inside = lo <= h <= hi
+        ok &= inside
+        print(f"coverage of the {100 * p:.0f}% intervals: {h}/{total} = {h / total:.3f}; "
+              f"99% binomial range [{lo / total:.3f}, {hi / total:.3f}]: "
+              f"{'consistent' if inside else 'NOT consistent'}")
+    print("note: the parameters of one replica are correlated, so the binomial range is a "
+          "rough guide")
+    return 0 if ok else 1
+
+
+#: Real tables and the preset each fit starts from.
+REAL = [("rgl", "acrylic_felt_white_rgb", "linen_plain"),
+        ("rgl", "acrylic_felt_pink_rgb", "linen_plain"),
+        ("rgl", "acrylic_felt_purple_rgb", "linen_plain"),
+        ("curet", 1, "linen_plain"), ("curet", 7, "velvet"), ("curet", 44, "linen_plain"),
+        ("curet", 46, "linen_plain"), ("curet", 2, "polyester_satin_charmeuse"),
+        ("curet", 42, "velvet")]
+
+
+def real(args):
+    if not SHARED.is_dir():
+        print(f"measured data not found at {SHARED}")
+        return 1
+    out_root = Path(args.out or tempfile.mkdtemp(prefix="microcyl-real-"))
+    for kind, what, preset in REAL:
+        if kind == "rgl":
+            table = gonio.read(SHARED / "rgl" / f"{what}.bsdf", step=10.0)
+            free = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1", "albedo1")
+            ties = ("eta2=eta1", "area2=1-area1", "albedo2_r=albedo1_r",
+                    "albedo2_g=albedo1_g", "albedo2_b=albedo1_b", "kd2=kd1",
+                    "gamma_s2=gamma_s1", "gamma_v2=gamma_v1")
+        else:
+            table = gonio.load_curet(SHARED / "curet", what)
+            free = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1")
+            ties = ("eta2=eta1", "area2=1-area1", "kd2=kd1", "gamma_s2=gamma_s1",
+                    "gamma_v2=gamma_v1")
+        fab = brdf.fabric(preset)
+        label = f"{kind} {what} (from {preset})"
+        try:
+            r = run_fit(table, fab, free=free, ties=ties, seed=0, progress=False,
+                        likelihood="gaussian", max_steps=args.max_steps,
+                        out=out_root / f"{kind}_{what}")
+        except ValueError as exc:
+            print(f"{label}: {exc}")
+            continue
+        lik = r.logpost.lik
+        med = np.median(r.chains_internal.reshape(-1, len(r.names)), axis=0)
+        pred = r.logpost.predict(med[None])[0]
+        res = lik.y - lik.transform(pred[None])[0]
+        print(f"{label}: {len(table)} pairs, {r.counts['used']} values; converged "
+              f"{r.converged}; rms log residual {np.sqrt(np.mean(res ** 2)):.3f}; "
+              f"{r.timing['wall_s']:.0f} s")
+        print("   " + ", ".join(f"{n}={r.summary[n]['median']:.4g}" for n in r.names))
+    print(f"chains and configs in {out_root}")
+    return 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--recovery", action="store_true")
+    ap.add_argument("--calibration", type=int, default=0, metavar="REPLICAS")
+    ap.add_argument("--real", action="store_true")
+    ap.add_argument("--max-steps", type=int, default=5000)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--quiet", action="store_true")
+    args = ap.parse_args()
+    if args.recovery:
+        return recovery(args)
+    if args.calibration:
+        return calibration(args)
+    if args.real:
+        return real(args)
+    return speed(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

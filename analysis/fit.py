@@ -346,8 +346,17 @@ def _hessian_cov(logpost: LogPosterior, x: np.ndarray, h: np.ndarray):
             fpp, fpm, fmp, fmm = f[k:k + 4]
             H[i, j] = H[j, i] = (fpp - fpm - fmp + fmm) / (4 * h[i] * h[j])
             k += 4
+    if not np.all(np.isfinite(H)):
+        return None
+    # Not positive definite (a parameter against a bound, a flat or rough direction): keep
+    # the curvature where it is positive and cap every standard deviation at a tenth of the
+    # parameter's range, so the proposal and the starting ball stay usable.
+    width = np.where(np.isfinite(spec.upper - spec.lower), spec.upper - spec.lower, 1.0)
+    Hs = H * np.outer(width, width)                       # in units of each range
+    w, v = np.linalg.eigh(0.5 * (Hs + Hs.T))
+    w = np.maximum(w, 100.0)                              # sd <= 0.1 range
+    cov = (v / w) @ v.T * np.outer(width, width)
     try:
-        cov = np.linalg.inv(H)
         np.linalg.cholesky(cov)
     except np.linalg.LinAlgError:
         return None

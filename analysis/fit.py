@@ -363,6 +363,19 @@ def _hessian_cov(logpost: LogPosterior, x: np.ndarray, h: np.ndarray):
     return cov
 
 
+def _proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256) -> float:
+    """Importance-sampling ESS fraction of the Laplace proposal: (sum w)^2 / (n sum w^2) with
+    w = p(x) / q(x) for n draws x ~ q; 1 for a perfect proposal, near 0 for a poor one."""
+    z = rng.standard_normal((n, move.mean.size)) @ move.chol.T
+    x = move.mean + z / np.sqrt(rng.chisquare(move.df, n) / move.df)[:, None]
+    lw = logpost(x) - move._logq(x)
+    if not np.any(np.isfinite(lw)):
+        return 0.0
+    w = np.exp(lw - np.max(lw[np.isfinite(lw)]))
+    w = np.where(np.isfinite(w), w, 0.0)
+    return float(w.sum() ** 2 / (n * (w * w).sum()))
+
+
 def _initial_walkers(logpost, best, cov, nwalkers, rng, spec):
     width = spec.upper - spec.lower
     d = best.size
@@ -639,9 +652,16 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     t_opt = time.perf_counter() - t0
 
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    laplace_info = {"share": 0.0, "importance_ess_fraction": None}
     if cov is not None and laplace_move > 0:
-        moves = [(m, w * (1 - laplace_move)) for m, w in moves] + [
-            (LaplaceMove(best, cov), laplace_move)]
+        lm = LaplaceMove(best, cov)
+        frac = _proposal_quality(logpost, lm, np.random.default_rng(seed))
+        # a poor approximation (non-Gaussian posterior, parameters at bounds) would waste the
+        # move's evaluations: give it a share in proportion to its importance-sampling ESS
+        share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
+        share = max(share, 0.05)
+        laplace_info = {"share": share, "importance_ess_fraction": frac}
+        moves = [(m, w * (1 - share)) for m, w in moves] + [(lm, share)]
     lock = LockStep(logpost, ensembles, threads=threads)
     samplers = []
     for k in range(ensembles):
@@ -749,7 +769,8 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     timing = {"wall_s": wall, "optimize_s": t_opt, "sample_s": t_sample,
               "log_prob_evals": int(n_evals),
               "evals_per_s": n_evals / t_sample if t_sample > 0 else float("nan"),
-              "ess_per_s": float(np.min(ess) / t_sample) if t_sample > 0 else float("nan")}
+              "ess_per_s": float(np.min(ess) / t_sample) if t_sample > 0 else float("nan"),
+              "laplace_move": laplace_info}
     return FitResult(
         names=spec.free, units=spec.units, chains=natural, chains_internal=internal,
         log_prob=diag["log_prob"], summary=summary, converged=converged, reason=reason,

@@ -651,8 +651,8 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                 indent=1, default=_json_default))
     t_opt = time.perf_counter() - t0
 
-    moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     laplace_info = {"share": 0.0, "importance_ess_fraction": None}
+    lm, share = None, 0.0
     if cov is not None and laplace_move > 0:
         lm = LaplaceMove(best, cov)
         frac = _proposal_quality(logpost, lm, np.random.default_rng(seed))
@@ -661,12 +661,23 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
         share = max(share, 0.05)
         laplace_info = {"share": share, "importance_ess_fraction": frac}
-        moves = [(m, w * (1 - share)) for m, w in moves] + [(lm, share)]
+
+    def make_moves():
+        # one set per ensemble: emcee's DE moves set attributes in setup(), not thread-safe
+        g0 = 2.38 / np.sqrt(2 * ndim)
+        moves = [(emcee.moves.DEMove(gamma0=g0), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+        if lm is None:
+            return moves
+        return [(m, w * (1 - share)) for m, w in moves] + [(LaplaceMove(best, cov), share)]
+
     lock = LockStep(logpost, ensembles, threads=threads)
     samplers = []
     for k in range(ensembles):
         s = emcee.EnsembleSampler(walkers, ndim, (lambda x, k=k: lock.call(k, x)),
-                                  moves=moves, vectorize=True, backend=backends[k])
+                                  moves=make_moves(), vectorize=True, backend=backends[k])
+        # emcee's wrapper prints a traceback for any exception (interrupts included); the
+        # errors are reported by fit's caller instead
+        s.log_prob_fn = (lambda x, k=k: lock.call(k, x))
         if s.iteration == 0:
             s.random_state = np.random.RandomState(
                 rng_ens[k].integers(2**31)).get_state()

@@ -126,6 +126,8 @@ def real(args):
         return 1
     out_root = Path(args.out or tempfile.mkdtemp(prefix="microcyl-real-"))
     for kind, what, preset in REAL:
+        if args.only and kind != args.only:
+            continue
         if kind == "rgl":
             table = gonio.read(SHARED / "rgl" / f"{what}.bsdf", step=10.0)
             free = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1", "albedo1")
@@ -142,6 +144,7 @@ def real(args):
         try:
             r = run_fit(table, fab, free=free, ties=ties, seed=0, progress=False,
                         likelihood="gaussian", max_steps=args.max_steps,
+                        time_limit=args.time_limit,
                         out=out_root / f"{kind}_{what}")
         except ValueError as exc:
             print(f"{label}: {exc}")
@@ -150,9 +153,9 @@ def real(args):
         med = np.median(r.chains_internal.reshape(-1, len(r.names)), axis=0)
         pred = r.logpost.predict(med[None])[0]
         res = lik.y - lik.transform(pred[None])[0]
-        print(f"{label}: {len(table)} pairs, {r.counts['used']} values; converged "
-              f"{r.converged}; rms log residual {np.sqrt(np.mean(res ** 2)):.3f}; "
-              f"{r.timing['wall_s']:.0f} s")
+        print(f"{label}: {len(table)} pairs, {r.counts['used']} values; "
+              f"rms residual (log space) {np.sqrt(np.mean(res ** 2)):.3f}; "
+              f"{r.timing['wall_s']:.0f} s; {r.reason}")
         print("   " + ", ".join(f"{n}={r.summary[n]['median']:.4g}" for n in r.names))
     print(f"chains and configs in {out_root}")
     return 0
@@ -165,6 +168,10 @@ def main():
     ap.add_argument("--real", action="store_true")
     ap.add_argument("--max-steps", type=int, default=5000)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--only", choices=("rgl", "curet"), default=None,
+                    help="with --real: only these tables")
+    ap.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                    help="with --real: per fit")
     ap.add_argument("--out", default=None)
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()

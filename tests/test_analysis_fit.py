@@ -12,7 +12,7 @@ from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from
 from gonio.table import Table
 from _fitmodels import fabric_table
 
-FAST = dict(max_steps=300, check_every=50, progress=False, threads=1)
+FAST = dict(max_steps=200, check_every=50, progress=False, threads=1)
 
 
 def _inside95(result, truth):
@@ -45,7 +45,7 @@ def test_lockstep_batches_calls_of_all_threads():
 
 
 def test_recovers_silk_three_parameters():
-    table, fab = fabric_table("silk_crepe_de_chine", n=300, seed=5)
+    table, fab = fabric_table("silk_crepe_de_chine", n=200, seed=5)
     truth = defaults_from_fabric(fab)
     start = dict(truth, gamma_s1=6.0, kd1=0.3, area1=0.7, area2=0.3)
     spec = ParamSpec("gamma_s1,kd1,area1", defaults=start, ties="area2=1-area1")

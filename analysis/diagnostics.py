@@ -38,7 +38,10 @@ def autocorr_time(chain) -> np.ndarray:
     True
     """
     chain = np.asarray(chain, dtype=np.float64)
-    return np.asarray(emcee.autocorr.integrated_time(chain, tol=0, quiet=True), dtype=np.float64)
+    # a walker that never moved in the window has no autocorrelation: tau is NaN (not converged)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.asarray(emcee.autocorr.integrated_time(chain, tol=0, quiet=True),
+                          dtype=np.float64)
 
 
 def split_rhat(chains) -> np.ndarray:

@@ -749,9 +749,11 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                           f"parameter (min {ratio.min():.1f}), tau changed {100 * dtau:.1f}% "
                           f"< {100 * tau_tol:g}% since the last check, R-hat < {rhat_max:g}")
                 break
-            why = (f"min N/tau {ratio.min():.1f} (need > {min_ratio:g}), tau change "
+            stuck = ("; tau undefined for some parameter (a walker did not move)"
+                     if np.any(~np.isfinite(tau)) else "")
+            why = (f"min N/tau {np.nanmin(ratio):.1f} (need > {min_ratio:g}), tau change "
                    f"{100 * dtau:.1f}% (need < {100 * tau_tol:g}%), max R-hat "
-                   f"{np.nanmax(diag['rhat']):.3f} (need < {rhat_max:g})")
+                   f"{np.nanmax(diag['rhat']):.3f} (need < {rhat_max:g}){stuck}")
             if target >= max_steps:
                 reason = f"NOT converged: step limit {max_steps} reached; {why}"
                 break

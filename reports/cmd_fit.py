@@ -113,6 +113,9 @@ def run(args) -> int:
         doc["_fit"]["report"] = extra
         cliutil.atomic_write_text(jpath, json.dumps(doc, indent=2) + "\n")
     print(format_summary(result))
+    if not args.no_plots:
+        print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "
+              f"{extra['albedo_delta_e2000']:.2f}; plots in {out}")
     print(f"results: {jpath}")
     return 0
 

@@ -22,8 +22,9 @@ Pipeline (:func:`fit`):
    ``max_steps`` (or ``time_limit``) and says so.
 
 Running :func:`fit` again with the same ``out_dir`` and the same configuration resumes from the
-stored chains; a different configuration or an unreadable checkpoint is a ``ValueError`` before
-any sampling.
+stored chains (``progress.json`` keeps the last check, so a finished fit is summarized again
+without sampling more); a different configuration or an unreadable checkpoint is a
+``ValueError`` before any sampling.
 """
 
 from __future__ import annotations
@@ -727,13 +728,33 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     tau_prev = None
     reason, converged = "", False
     diag = None
+    ppath = None if out is None else out / "progress.json"
     try:
         target = min(s.iteration for s in samplers)
+        # resuming right after a check: reuse its tau, and check before sampling more
+        recheck = False
+        if ppath is not None and ppath.exists() and target > 0 and \
+                all(s.iteration == target for s in samplers):
+            try:
+                prog = json.loads(ppath.read_text())
+                if prog.get("step") == target:
+                    tp = prog.get("tau_prev")
+                    tau_prev = None if tp is None else np.asarray(tp, dtype=np.float64)
+                    recheck = True
+            except (ValueError, KeyError):
+                pass
         while True:
-            target = min(max_steps, (target // check_every + 1) * check_every)
-            run_to(target)
+            if not recheck:
+                target = min(max_steps, (target // check_every + 1) * check_every)
+                run_to(target)
+            recheck = False
             diag = _diagnose(samplers, burn_fraction)
             tau = diag["tau"]
+            if ppath is not None:   # lets a resumed run repeat this check's verdict
+                _atomic_write(ppath, json.dumps(
+                    {"step": int(target), "tau": tau.tolist(),
+                     "tau_prev": None if tau_prev is None else tau_prev.tolist()},
+                    default=_json_default))
             n_eff_len = diag["steps"]
             ratio = n_eff_len / tau
             dtau = np.inf if tau_prev is None else np.max(np.abs(tau - tau_prev) / tau)

@@ -199,3 +199,16 @@ def test_interrupt_keeps_the_checkpoint(tmp_path):
     assert min(done) > 0
     r = fit(table, spec, inner, seed=0, out_dir=tmp_path, **dict(FAST, max_steps=60))
     assert r.steps == 60
+
+
+def test_rerun_of_a_converged_fit_samples_nothing_more(tmp_path):
+    table, fab = fabric_table("silk_crepe_de_chine", n=150, seed=8)
+    spec = ParamSpec("gamma_s1", defaults=defaults_from_fabric(fab))
+    model = FabricModel(fab, table.wi, table.wo)
+    kw = dict(FAST, max_steps=2000, check_every=40, out_dir=tmp_path, seed=1)
+    r1 = fit(table, spec, model, **kw)
+    assert r1.converged
+    r2 = fit(table, spec, model, **kw)
+    assert r2.converged and r2.steps == r1.steps and r2.reason == r1.reason
+    assert r2.timing["log_prob_evals"] == 0
+    np.testing.assert_array_equal(r1.chains, r2.chains)

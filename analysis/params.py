@@ -21,7 +21,7 @@ import dataclasses
 import math
 import re
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 

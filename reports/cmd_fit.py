@@ -9,7 +9,6 @@ checkpoints ``DIR/chains_<k>.h5``; the same command run again resumes from them.
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 

@@ -9,7 +9,6 @@ import brdf
 from analysis.diagnostics import split_rhat
 from analysis.fit import FabricModel, LockStep, fit, write_results
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
-from gonio.table import Table
 from _fitmodels import fabric_table
 
 FAST = dict(max_steps=200, check_every=50, progress=False, threads=1)

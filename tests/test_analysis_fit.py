@@ -201,10 +201,10 @@ def test_interrupt_keeps_the_checkpoint(tmp_path):
 
 
 def test_rerun_of_a_converged_fit_samples_nothing_more(tmp_path):
-    table, fab = fabric_table("silk_crepe_de_chine", n=150, seed=8)
+    table, fab = fabric_table("silk_crepe_de_chine", n=100, seed=8)
     spec = ParamSpec("gamma_s1", defaults=defaults_from_fabric(fab))
     model = FabricModel(fab, table.wi, table.wo)
-    kw = dict(FAST, max_steps=2000, check_every=40, out_dir=tmp_path, seed=1)
+    kw = dict(FAST, max_steps=2000, check_every=40, min_ratio=20, out_dir=tmp_path, seed=1)
     r1 = fit(table, spec, model, **kw)
     assert r1.converged
     r2 = fit(table, spec, model, **kw)

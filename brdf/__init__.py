@@ -1,3 +1,17 @@
-"""brdf package of microcyl."""
+"""brdf: the microcylinder cloth BRDF of Sadeghi, Bisker, De Deken and Jensen (2013).
 
-__all__ = []
+The model as ``../shared/spec/MODEL.md`` specifies it: threads with tangent curves, fabrics
+of two threads, the paper's six presets, and every variant. NumPy and SciPy only.
+"""
+
+from brdf import directions, terms
+from brdf.curve import SAMPLING_METHODS, TangentCurve
+from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
+from brdf.presets import PRESETS, fabric, preset_threads
+from brdf.thread import Thread
+
+__all__ = [
+    "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
+    "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions",
+    "terms",
+]

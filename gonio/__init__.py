@@ -1,5 +1,24 @@
 """gonio: a virtual gonioreflectometer, and BRDF tables in the formats of the field."""
 
+from gonio.alta import read_alta, write_alta
+from gonio.atomic import atomic_write
+from gonio.csvtable import read_csv, write_csv
+from gonio.curet import load_curet
+from gonio.errors import FormatError
+from gonio.exr import read_exr, write_exr
+from gonio.geometry import Geometry, full_grid, pairs, pairs_from_angles, plane, rusinkiewicz
+from gonio.geometry import merl as merl_grid
+from gonio.instrument import Instrument
+from gonio.io import read, write
+from gonio.measure import measure
+from gonio.merl import MerlBRDF, load_merl, merl_table, write_merl
+from gonio.rgl import RGLBRDF, load_rgl
 from gonio.table import Table
 
-__all__ = ["Table"]
+__all__ = [
+    "Table", "FormatError", "read", "write", "load_rgl", "load_merl", "load_curet",
+    "read_exr", "write_exr", "read_csv", "write_csv", "read_alta", "write_alta",
+    "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write",
+    "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",
+    "pairs", "pairs_from_angles",
+]

@@ -11,7 +11,7 @@ __all__ = ["Table"]
 
 
 def _as_n3(name: str, value, n: int | None) -> np.ndarray:
-    arr = np.asarray(value, dtype=np.float64)
+    arr = np.array(value, dtype=np.float64)   # a copy: the caller's arrays are never changed
     if arr.ndim == 1 and name in ("values", "sigma"):
         arr = np.repeat(arr[:, None], 3, axis=1)
     if arr.ndim != 2 or arr.shape[1] != 3:

@@ -18,6 +18,9 @@ __all__ = ["main", "build_parser", "COMMAND_MODULES"]
 #: Modules that each contribute one or more verbs, in the order ``--help`` lists them.
 COMMAND_MODULES = (
     "reports.cmd_model",
+    "reports.cmd_measure",
+    "reports.cmd_tables",
+    "reports.cmd_render",
 )
 
 

@@ -1,0 +1,388 @@
+r"""A fabric: two threads woven at right angles, with the options of MODEL.md."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+
+from brdf import validate
+from brdf.curve import SAMPLING_METHODS
+from brdf.directions import as_directions, normalize
+from brdf.kernel import thread_geometry, thread_shade
+from brdf.thread import Thread
+
+__all__ = ["Fabric", "Prepared", "OPTIONS", "TRANSMISSION_METHODS", "GAP_METHODS"]
+
+TRANSMISSION_METHODS = ("half_angle", "longitudinal")
+GAP_METHODS = ("incident", "outgoing")
+
+#: Option names and defaults of a Fabric (MODEL.md's toggles and variants).
+OPTIONS = {
+    "masking": True,
+    "reweighting": True,
+    "tangent_samples": 32,
+    "tangent_sampling": "midpoint",
+    "transmission": "half_angle",
+    "gap": "incident",
+    "rotation": 0.0,
+}
+
+#: Target number of (pair, sample) elements per chunk: large enough to amortize NumPy's
+#: per-call cost, small enough that the working set stays in cache.
+_CHUNK_ELEMENTS = 1 << 14
+
+
+@dataclasses.dataclass(frozen=True)
+class _ThreadConst:
+    """Everything about one thread that does not depend on the directions."""
+
+    ca: np.ndarray        # cos of the distinct tangent offsets
+    sa: np.ndarray        # sin of the distinct tangent offsets
+    weight: np.ndarray    # weight of each distinct offset (sum 1)
+    gamma_s: float        # radians
+    gamma_v: float        # radians
+
+
+class Fabric:
+    r"""The microcylinder BRDF of a woven fabric (Sadeghi et al. 2013).
+
+    Parameters
+    ----------
+    threads : sequence of two Thread
+        Thread 1 (the warp, along +x) and thread 2 (the weft, along +y).
+    masking : bool, default True
+        Shadowing and masking M; off means M = 1.
+    reweighting : bool, default True
+        Reweighting by visible length P and the normalization Q; off means P = Q = 1.
+    tangent_samples : int, default 32
+        Samples N per tangent curve (arc-length midpoints).
+    tangent_sampling : {"midpoint", "control_points"}, default "midpoint"
+    transmission : {"half_angle", "longitudinal"}, default "half_angle"
+    gap : {"incident", "outgoing"}, default "incident"
+        Gap term c_gap of Q: n . wi or n . wo.
+    rotation : float, default 0
+        Rotation of both threads about n, radians.
+    name : str, optional
+        A label (preset name).
+
+    Raises
+    ------
+    ValueError
+        Wrong number of threads, areas summing above 1, unknown option names or values.
+
+    Notes
+    -----
+    .. math::
+        S_j = \frac{1}{N_j}\sum_{t\in T_j} f_s(t) M(t) P(t)\cos\theta_i(t),\quad
+        Q = \sum_j a_j \frac{1}{N_j}\sum_{T_j} P(t) + (1 - a_1 - a_2)\, c_{gap},\quad
+        f_r = \frac{a_1 S_1 + a_2 S_2}{Q\,(n\cdot\omega_i)}.
+
+    Examples
+    --------
+    >>> import brdf
+    >>> fab = brdf.fabric("linen_plain")
+    >>> wi = brdf.directions.from_angles(np.radians(30), 0.0)
+    >>> wo = brdf.directions.from_angles(np.radians(30), np.pi)
+    >>> fab.eval(wi, wo).shape
+    (3,)
+    >>> fab.replace(masking=False).options["masking"]
+    False
+    """
+
+    def __init__(self, threads: Sequence[Thread], *, name: str | None = None, **options):
+        threads = tuple(threads)
+        if len(threads) != 2 or not all(isinstance(t, Thread) for t in threads):
+            raise ValueError(f"threads must be two brdf.Thread objects (warp, weft); got "
+                             f"{len(threads)} item(s)")
+        total = threads[0].area + threads[1].area
+        if total > 1.0 + 1e-12:
+            raise ValueError(f"area: the threads' areas must sum to at most 1; got "
+                             f"{threads[0].area} + {threads[1].area} = {total:g}")
+        unknown = set(options) - set(OPTIONS)
+        if unknown:
+            raise ValueError(f"unknown option(s) {', '.join(sorted(map(repr, unknown)))}; "
+                             f"valid options are {', '.join(OPTIONS)}")
+        opts = dict(OPTIONS, **options)
+        opts["masking"] = validate.flag("masking", opts["masking"])
+        opts["reweighting"] = validate.flag("reweighting", opts["reweighting"])
+        opts["tangent_samples"] = validate.integer("tangent_samples", opts["tangent_samples"],
+                                                   lo=1)
+        validate.choice("tangent_sampling", opts["tangent_sampling"], SAMPLING_METHODS)
+        validate.choice("transmission", opts["transmission"], TRANSMISSION_METHODS)
+        validate.choice("gap", opts["gap"], GAP_METHODS)
+        opts["rotation"] = validate.real("rotation", opts["rotation"],
+                                         what="a finite angle in radians")
+        self._threads = threads
+        self._options = opts
+        self.name = name
+        self._const = tuple(self._thread_const(t) for t in threads)
+
+    def _thread_const(self, t: Thread) -> _ThreadConst:
+        alpha, weight = t.curve.samples(self._options["tangent_samples"],
+                                        self._options["tangent_sampling"])
+        a = np.radians(alpha)
+        return _ThreadConst(np.cos(a), np.sin(a), weight, np.radians(t.gamma_s),
+                            np.radians(t.gamma_v))
+
+    # -- read-only views ---------------------------------------------------------------
+    @property
+    def threads(self) -> tuple[Thread, Thread]:
+        """The two threads (warp, weft)."""
+        return self._threads
+
+    @property
+    def options(self) -> dict:
+        """The options (a copy): masking, reweighting, tangent_samples, ... rotation."""
+        return dict(self._options)
+
+    def replace(self, **changes) -> "Fabric":
+        """Return a variant with options, ``threads`` or ``name`` changed.
+
+        Examples
+        --------
+        >>> import brdf
+        >>> brdf.fabric("velvet").replace(gap="outgoing").options["gap"]
+        'outgoing'
+        """
+        threads = changes.pop("threads", self._threads)
+        name = changes.pop("name", self.name)
+        return Fabric(threads, name=name, **dict(self._options, **changes))
+
+    def as_dict(self) -> dict:
+        """Threads and options as a JSON-ready dict."""
+        return {"name": self.name, "threads": [t.as_dict() for t in self._threads],
+                "options": self.options}
+
+    def __repr__(self) -> str:
+        label = f"{self.name!r}, " if self.name else ""
+        changed = {k: v for k, v in self._options.items() if v != OPTIONS[k]}
+        extra = "".join(f", {k}={v!r}" for k, v in changed.items())
+        return f"Fabric({label}{len(self._threads)} threads{extra})"
+
+    # -- evaluation --------------------------------------------------------------------
+    def eval(self, wi, wo) -> np.ndarray:
+        r"""The BRDF f_r(wi, wo), RGB, in 1/sr (no cosine factor).
+
+        Parameters
+        ----------
+        wi : array_like, shape (..., 3)
+            Directions toward the light, in the local frame (n = +z, warp = +x).
+        wo : array_like, shape (..., 3)
+            Directions toward the viewer. Broadcasts with ``wi``.
+
+        Returns
+        -------
+        ndarray, shape (..., 3)
+            f_r per RGB channel, 1/sr. Zero where either direction is at or below the
+            horizon; NaN in the entries of zero or non-finite vectors. Non-unit vectors are
+            normalized.
+
+        Raises
+        ------
+        ValueError
+            If the arrays lack a last axis of 3 or do not broadcast.
+        """
+        return self._evaluate(wi, wo, split=False)
+
+    def eval_threads(self, wi, wo) -> np.ndarray:
+        r"""Each thread's share of f_r: :math:`a_j S_j / (Q\, n\cdot\omega_i)`, 1/sr.
+
+        Returns
+        -------
+        ndarray, shape (..., 2, 3)
+            Summing over axis -2 gives :meth:`eval`.
+        """
+        return self._evaluate(wi, wo, split=True)
+
+    def _evaluate(self, wi, wo, split):
+        wi, wo, shape, bad, below = _pairs(wi, wo)
+        n = wi.shape[0]
+        out = np.zeros((n, 2, 3) if split else (n, 3))
+        ok = ~(bad | below)
+        if ok.all():
+            self._eval_into(wi, wo, out, split)
+        elif ok.any():
+            res = np.zeros((int(ok.sum()),) + out.shape[1:])
+            self._eval_into(wi[ok], wo[ok], res, split)
+            out[ok] = res
+        out[bad] = np.nan
+        return out.reshape(shape + out.shape[1:])
+
+    def _eval_into(self, wi, wo, out, split):
+        smax = max(c.ca.size for c in self._const)
+        chunk = max(64, _CHUNK_ELEMENTS // smax)
+        for start in range(0, wi.shape[0], chunk):
+            sl = slice(start, start + chunk)
+            sides = self._frames(wi[sl], wo[sl])
+            geoms = [self._geometry(j, sides[j]) for j in range(2)]
+            shades = [thread_shade(g, c.weight, t.eta, t.kd, c.gamma_s, c.gamma_v,
+                                   self._options["transmission"])
+                      for g, c, t in zip(geoms, self._const, self._threads)]
+            out[sl] = self._combine(geoms, shades, wi[sl, 2], wo[sl, 2], split)
+
+    def _frames(self, wi, wo):
+        """Per-pair dot products with each thread's t0 and b, shape (C, 1) each."""
+        rot = self._options["rotation"]
+        c, s = np.cos(rot), np.sin(rot)
+        out = []
+        for w in (wi, wo):
+            t = w[:, 0:1] * c + w[:, 1:2] * s      # w . t0 of thread 1
+            b = w[:, 1:2] * c - w[:, 0:1] * s      # w . b  of thread 1 (= w . t0 of thread 2)
+            out.append((t, b, w[:, 2:3]))
+        (t_i, b_i, z_i), (t_o, b_o, z_o) = out
+        # Thread 2 is thread 1 turned 90 degrees about n: t0' = b, b' = n x b = -t0.
+        return ((t_i, b_i, z_i, t_o, b_o, z_o), (b_i, -t_i, z_i, b_o, -t_o, z_o))
+
+    def _geometry(self, j, side):
+        c = self._const[j]
+        return thread_geometry(*side, c.ca, c.sa, c.weight,
+                               masking=self._options["masking"],
+                               reweighting=self._options["reweighting"],
+                               keep_cos=self._options["transmission"] == "longitudinal")
+
+    def _q(self, geoms, area1, area2, zi, zo):
+        """Q of MODEL.md; 1 with reweighting off. Broadcasts area (B..., 1) over pairs."""
+        if not self._options["reweighting"]:
+            return 1.0
+        gap = zi if self._options["gap"] == "incident" else zo
+        return area1 * geoms[0].pmean + area2 * geoms[1].pmean + (1.0 - area1 - area2) * gap
+
+    def _combine(self, geoms, shades, zi, zo, split):
+        t1, t2 = self._threads
+        q = self._q(geoms, t1.area, t2.area, zi, zo)
+        denom = q * zi
+        parts = [t.area * (s[0][:, None] + np.asarray(t.albedo) * s[1][:, None])
+                 for t, s in zip(self._threads, shades)]
+        inv = np.divide(1.0, denom, out=np.zeros_like(zi), where=denom > 0)[:, None]
+        if split:
+            return np.stack([p * inv for p in parts], axis=1)
+        return (parts[0] + parts[1]) * inv
+
+    def prepare(self, wi, wo) -> "Prepared":
+        """Precompute the geometry of fixed pairs for repeated shading (fits).
+
+        Parameters
+        ----------
+        wi, wo : array_like, shape (n, 3)
+            Direction pairs (broadcast, normalized; below-horizon or bad pairs give 0 / NaN).
+
+        Returns
+        -------
+        Prepared
+            Call ``.eval(eta=..., albedo=..., kd=..., gamma_s=..., gamma_v=..., area=...)``.
+        """
+        return Prepared(self, wi, wo)
+
+
+class Prepared:
+    """Direction-dependent work of a Fabric done once for n fixed pairs.
+
+    ``eval`` shades the pairs for batches of optical parameters; tangent curves and options
+    are those of the fabric it was prepared from.
+
+    Examples
+    --------
+    >>> import brdf
+    >>> fab = brdf.fabric("silk_crepe_de_chine")
+    >>> wi = brdf.directions.from_angles(np.radians([10, 40]), 0.3)
+    >>> wo = brdf.directions.from_angles(np.radians([20, 60]), 2.0)
+    >>> prep = fab.prepare(wi, wo)
+    >>> np.allclose(prep.eval(), fab.eval(wi, wo), rtol=1e-13, atol=0)
+    True
+    >>> prep.eval(eta=np.full((5, 2), 1.4)).shape
+    (5, 2, 3)
+    """
+
+    def __init__(self, fabric: Fabric, wi, wo):
+        wi, wo, shape, bad, below = _pairs(wi, wo)
+        self.fabric = fabric
+        self.shape = shape
+        self._bad = bad
+        self._ok = ~(bad | below)
+        wi_ok, wo_ok = wi[self._ok], wo[self._ok]
+        sides = fabric._frames(wi_ok, wo_ok)
+        self._geoms = [fabric._geometry(j, sides[j]) for j in range(2)]
+        self._zi = wi_ok[:, 2]
+        self._zo = wo_ok[:, 2]
+
+    def eval(self, *, eta=None, albedo=None, kd=None, gamma_s=None, gamma_v=None,
+             area=None) -> np.ndarray:
+        r"""f_r (1/sr) of the prepared pairs for a batch of parameter sets.
+
+        Parameters
+        ----------
+        eta, kd, gamma_s, gamma_v, area : array_like, shape (B..., 2), optional
+            Per thread; gamma in degrees. Omitted ones take the fabric's values.
+        albedo : array_like, shape (B..., 2, 3), optional
+
+        Returns
+        -------
+        ndarray, shape (B..., n..., 3)
+            (B... is the broadcast batch shape; absent when every parameter is omitted or
+            has shape (2,).)
+
+        Raises
+        ------
+        ValueError
+            If a parameter's last axis is not 2 (per thread).
+        """
+        fab = self.fabric
+        th = fab.threads
+
+        def param(name, value, default):
+            if value is None:
+                return np.asarray(default, dtype=np.float64)
+            v = np.asarray(value, dtype=np.float64)
+            want = np.shape(default)
+            if v.shape[v.ndim - len(want):] != want:
+                raise ValueError(f"{name} must have shape (..., {', '.join(map(str, want))}); "
+                                 f"got {v.shape}")
+            return v
+
+        eta = param("eta", eta, [t.eta for t in th])
+        kd = param("kd", kd, [t.kd for t in th])
+        gs = np.radians(param("gamma_s", gamma_s, [t.gamma_s for t in th]))
+        gv = np.radians(param("gamma_v", gamma_v, [t.gamma_v for t in th]))
+        area = param("area", area, [t.area for t in th])
+        alb = param("albedo", albedo, [t.albedo for t in th])
+        batch = np.broadcast_shapes(eta.shape[:-1], kd.shape[:-1], gs.shape[:-1],
+                                    gv.shape[:-1], area.shape[:-1], alb.shape[:-2])
+        parts = []
+        for j, (g, c) in enumerate(zip(self._geoms, fab._const)):
+            surf, vol = thread_shade(g, c.weight, np.broadcast_to(eta[..., j], batch),
+                                     kd[..., j], gs[..., j], gv[..., j],
+                                     fab.options["transmission"])
+            a = area[..., j, None]                           # (B..., 1)
+            parts.append(a[..., None] * (surf[..., None] + alb[..., None, j, :] * vol[..., None]))
+        q = fab._q(self._geoms, area[..., 0, None], area[..., 1, None], self._zi, self._zo)
+        denom = q * self._zi
+        inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
+        vals = (parts[0] + parts[1]) * inv[..., None]
+        out = np.zeros(batch + (self._ok.size, 3))
+        out[..., self._ok, :] = vals
+        out[..., self._bad, :] = np.nan
+        return out.reshape(batch + self.shape + (3,))
+
+
+def _pairs(wi, wo):
+    """Validate, broadcast, flatten and normalize direction pairs.
+
+    Returns wi, wo (n, 3) unit (bad entries replaced), the leading shape, and the masks of
+    bad (zero or non-finite) pairs and of pairs at or below the horizon.
+    """
+    wi = as_directions("wi", wi)
+    wo = as_directions("wo", wo)
+    try:
+        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+    except ValueError:
+        raise ValueError(f"wi and wo must broadcast; got shapes {wi.shape} and {wo.shape}") \
+            from None
+    wi = np.broadcast_to(wi, shape + (3,)).reshape(-1, 3)
+    wo = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
+    wi, bad_i = normalize(wi)
+    wo, bad_o = normalize(wo)
+    bad = bad_i | bad_o
+    below = ~bad & ((wi[:, 2] <= 0.0) | (wo[:, 2] <= 0.0))
+    return wi, wo, shape, bad, below

@@ -1,0 +1,276 @@
+r"""The fast evaluation of the microcylinder model, split into geometry and shading.
+
+``thread_geometry`` computes, for one thread and a chunk of direction pairs, everything that
+depends on the directions and the tangent samples but not on the optical parameters (eta,
+k_d, the gammas, albedo, area). ``thread_shade`` turns that into the thread's weighted sums
+for given parameters. ``Fabric.eval`` runs both per chunk; ``Fabric.prepare`` keeps the
+geometry so that a fit can shade the same pairs for many parameter sets.
+
+No angle is formed by atan2 of single directions: every cosine the model needs comes from
+dot products, and the three angles whose squares enter Gaussians come from one ``arccos`` each:
+
+.. math::
+    \cos(\theta_i + \theta_r) &= \cos\theta_i\cos\theta_r - \sin\theta_i\sin\theta_r,
+        \qquad \theta_h^2 = \arccos(\cdot)^2 / 4,\\
+    \cos\phi_d &= (x_i x_r + y_i y_r) / (\cos\theta_i \cos\theta_r),\\
+    \cos\psi_d &= (x_i x_r + s_i s_r) / (\rho_i \rho_r),
+
+with :math:`s = w\cdot t`, :math:`x = w\cdot n_t`, :math:`y = w\cdot b`,
+:math:`\cos\theta = \sqrt{x^2 + y^2}` and :math:`\rho = \sqrt{x^2 + s^2} = \sqrt{(w\cdot n)^2 +
+(w\cdot t_0)^2}`, which does not depend on the tangent offset. Near zero angles arccos loses
+digits in the angle but not in its square, which is all the Gaussians see.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from brdf.terms import SIGMA_U
+
+__all__ = ["ThreadGeometry", "thread_geometry", "thread_shade", "GAUSS_NORM"]
+
+_K_U = -0.5 / SIGMA_U**2          # u(x) = exp(_K_U x^2)
+GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
+
+
+class ThreadGeometry(NamedTuple):
+    """Direction-dependent, parameter-independent quantities of one thread.
+
+    Arrays have shape (C, S): C pairs by S distinct tangent samples.
+    """
+
+    th2: np.ndarray     # (theta_i + theta_r)^2 = 4 theta_h^2, rad^2
+    cg: np.ndarray      # cos_g = cos(theta_d) cos(phi_d / 2)
+    cg2: np.ndarray     # cos_g^2
+    ks: np.ndarray      # M P cos(theta_i) cos(phi_d / 2) / cos^2(theta_d)
+    kv: np.ndarray      # M P cos(theta_i) / (cos^2(theta_d) (cos(theta_i) + cos(theta_r)))
+    ci: np.ndarray | None   # longitudinal cosines, kept for transmission="longitudinal"
+    cr: np.ndarray | None
+    pmean: np.ndarray | None  # (C,) weighted mean of P over the samples (for Q)
+
+
+def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, masking=True,
+                    reweighting=True, keep_cos=False) -> ThreadGeometry:
+    r"""Geometry of one thread for a chunk of pairs.
+
+    Parameters
+    ----------
+    ti, bi, zi : ndarray, shape (C, 1)
+        wi . t0, wi . b, wi . n for the thread's in-plane tangent t0 and b = n x t0.
+    to, bo, zo : ndarray, shape (C, 1)
+        The same for wo.
+    ca, sa : ndarray, shape (S,)
+        cos and sin of the distinct tangent offsets alpha.
+    weight : ndarray, shape (S,)
+        Weights of the distinct offsets (sum 1).
+    masking, reweighting : bool
+        Toggles of MODEL.md; off means M = 1 (resp. P = 1 and no P-mean).
+    keep_cos : bool
+        Keep cos(theta_i), cos(theta_r) (needed by the longitudinal transmission).
+
+    Returns
+    -------
+    ThreadGeometry
+
+    Notes
+    -----
+    With :math:`t(\alpha) = \cos\alpha\, t_0 + \sin\alpha\, n` and
+    :math:`n_t(\alpha) = \cos\alpha\, n - \sin\alpha\, t_0`:
+    :math:`s = w\cdot t`, :math:`x = w\cdot n_t`, and
+    :math:`M = (1-u(\phi_d)) M_i M_r + u(\phi_d)\min(M_i, M_r)`, :math:`M_i = \max(x_i, 0)/\cos\theta_i`;
+    :math:`P` likewise with :math:`P_i = \max(x_i, 0)/\rho_i` and :math:`\psi_d`.
+    Where a direction lies along the tangent (cos theta = 0) its azimuth phi is taken as 0,
+    as atan2(0, 0) = 0 in MODEL.md's definition; there the thread's term carries the factor
+    cos(theta_i) = 0 (wi side) or is finite (wo side).
+    """
+    # Longitudinal sines s = w.t and normal components x = w.n_t of every (pair, sample).
+    si = ti * ca
+    si += zi * sa
+    xi = zi * ca
+    xi -= ti * sa
+    sr = to * ca
+    sr += zo * sa
+    xr = zo * ca
+    xr -= to * sa
+    bi2 = bi * bi
+    bo2 = bo * bo
+    ci = xi * xi
+    ci += bi2
+    np.sqrt(ci, out=ci)
+    cr = xr * xr
+    cr += bo2
+    np.sqrt(cr, out=cr)
+    cc = ci * cr
+    ss = si * sr
+    # 2 cos^2(theta_d) = 1 + cos(theta_i - theta_r)
+    c2d = cc + ss
+    c2d += 1.0
+    # (theta_i + theta_r)^2 from cos(theta_i + theta_r)
+    th2 = cc - ss
+    np.clip(th2, -1.0, 1.0, out=th2)
+    np.arccos(th2, out=th2)
+    th2 *= th2
+    xx = xi * xr
+    degenerate = ci.min() == 0.0 or cr.min() == 0.0
+    if degenerate:
+        # Directions along a tangent sample: azimuth phi := 0, i.e. (x, y)/cos = (1, 0).
+        zi_, zr_ = ci == 0.0, cr == 0.0
+        xi_p, ci_p = np.where(zi_, 1.0, xi), np.where(zi_, 1.0, ci)
+        xr_p, cr_p = np.where(zr_, 1.0, xr), np.where(zr_, 1.0, cr)
+        yi_p, yr_p = np.where(zi_, 0.0, bi), np.where(zr_, 0.0, bo)
+        cphi = xi_p * xr_p + yi_p * yr_p
+        cphi /= ci_p * cr_p
+        np.copyto(c2d, 1.0, where=c2d == 0.0)   # only where cos(theta_i) = 0: the term is 0
+    else:
+        xi_p, ci_p, xr_p, cr_p = xi, ci, xr, cr
+        cphi = bi * bo
+        cphi = cphi + xx
+        cphi /= cc
+    np.clip(cphi, -1.0, 1.0, out=cphi)
+    # K = 2 cos(theta_i) / (2 cos^2 theta_d), the factor 2 applied with ks and kv below.
+    k = ci / c2d
+    pmean = None
+    if masking or reweighting:
+        mxi = np.maximum(xi, 0.0)
+        mxr = np.maximum(xr, 0.0)
+    if masking:
+        if degenerate:
+            mi = np.maximum(xi_p, 0.0) / ci_p
+            mr = np.maximum(xr_p, 0.0) / cr_p
+        else:
+            mi = mxi / ci
+            mr = mxr / cr
+        _blend(mi, mr, cphi, k)
+    if reweighting:
+        irho_i = 1.0 / np.sqrt(zi * zi + ti * ti)
+        irho_o = 1.0 / np.sqrt(zo * zo + to * to)
+        mxi *= irho_i
+        mxr *= irho_o
+        cpsi = xx + ss
+        cpsi *= irho_i * irho_o
+        np.clip(cpsi, -1.0, 1.0, out=cpsi)
+        p = _blend(mxi, mxr, cpsi, k)
+        pmean = p @ weight
+    # cos^2 g = cos^2(theta_d) cos^2(phi_d / 2) = (c2d / 2) ((1 + cos phi_d) / 2)
+    hp = cphi
+    hp += 1.0
+    cg2 = c2d * hp
+    cg2 *= 0.25
+    cg = np.sqrt(cg2)
+    hp *= 0.5
+    np.sqrt(hp, out=hp)          # cos(phi_d / 2) >= 0
+    k *= 2.0
+    ks = hp
+    ks *= k
+    kv = ci + cr
+    if degenerate:
+        np.copyto(kv, 1.0, where=kv == 0.0)   # both along the tangent: k = 0 there
+    np.divide(k, kv, out=kv)
+    return ThreadGeometry(th2, cg, cg2, ks, kv, ci if keep_cos else None,
+                          cr if keep_cos else None, pmean)
+
+
+def _blend(a, b, cos_delta, k):
+    r"""Pair visibility :math:`(1-u)ab + u\min(a, b)`, with :math:`u = u(\arccos c)`.
+
+    Multiplies ``k`` by the result in place and returns the result (computed in ``a``'s
+    storage). ``a`` and ``b`` are overwritten.
+    """
+    u = np.arccos(cos_delta)
+    u *= u
+    u *= _K_U
+    np.exp(u, out=u)
+    prod = a * b
+    np.minimum(a, b, out=a)
+    a -= prod
+    a *= u
+    a += prod
+    k *= a
+    return a
+
+
+def _fresnel_from_cos(eta2, c, c2):
+    """Unpolarized dielectric Fresnel reflectance from c = cos and c2 = cos^2 (broadcasting)."""
+    g = c2 + (eta2 - 1.0)
+    np.sqrt(g, out=g)
+    rs = c - g
+    rs /= c + g
+    e2c = eta2 * c
+    rp = e2c - g
+    e2c += g
+    rp /= e2c
+    rs *= rs
+    rp *= rp
+    rs += rp
+    rs *= 0.5
+    return rs
+
+
+def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
+                 transmission="half_angle"):
+    r"""Weighted sums of one thread's surface and volume terms.
+
+    Parameters
+    ----------
+    geom : ThreadGeometry
+        From :func:`thread_geometry`, arrays (C, S).
+    weight : ndarray, shape (S,)
+        Weights of the distinct tangent samples.
+    eta, kd : float or ndarray of shape (B...)
+        Index of refraction; isotropic volume share. Arrays shade a batch of parameter sets.
+    gamma_s, gamma_v : float or ndarray of shape (B...)
+        Lobe widths, radians.
+    transmission : {"half_angle", "longitudinal"}
+
+    Returns
+    -------
+    surf, vol : ndarray, shape (B..., C)
+        :math:`\frac1N\sum_t f_{rs} M P \cos\theta_i` and the same for :math:`f_{rv}/A`, in 1/sr
+        (before the division by Q and n . wi).
+
+    Notes
+    -----
+    :math:`f_{rs} = F_r(\eta, \cos g)\cos(\phi_d/2)\, g(\gamma_s, \theta_h) / \cos^2\theta_d`,
+    :math:`f_{rv} = F_T\,((1-k_d) g(\gamma_v, \theta_h) + k_d) / (\cos\theta_i + \cos\theta_r)
+    \,A / \cos^2\theta_d`, with :math:`g(\gamma, x) = e^{-x^2/2\gamma^2}/(\gamma\sqrt{2\pi})`
+    and :math:`\theta_h^2 = \mathrm{th2}/4`.
+    """
+    eta = np.asarray(eta, dtype=np.float64)
+    kd = np.asarray(kd, dtype=np.float64)
+    gamma_s = np.asarray(gamma_s, dtype=np.float64)
+    gamma_v = np.asarray(gamma_v, dtype=np.float64)
+    batch = np.broadcast_shapes(eta.shape, kd.shape, gamma_s.shape, gamma_v.shape)
+    ex = (Ellipsis,) + (None,) * geom.th2.ndim
+
+    def b(x):  # parameter (B...) -> (B..., 1, 1), broadcast to the whole batch
+        return np.broadcast_to(x, batch)[ex] if batch else x
+
+    eta2 = b(eta * eta)
+    f = _fresnel_from_cos(eta2, geom.cg, geom.cg2)
+    # Volume lobe exp(-theta_h^2 / (2 gamma_v^2)); theta_h^2 = th2 / 4.
+    ev = geom.th2 * b(-0.125 / (gamma_v * gamma_v))
+    np.exp(ev, out=ev)
+    if not batch and float(gamma_v) == 2.0 * float(gamma_s):
+        es = ev * ev          # exp(a)^4 = exp(4 a): gamma_s = gamma_v / 2, as in Table II
+        es *= es
+    else:
+        es = geom.th2 * b(-0.125 / (gamma_s * gamma_s))
+        np.exp(es, out=es)
+    es *= f
+    es *= geom.ks
+    surf = es @ weight
+    surf *= b(GAUSS_NORM / gamma_s)[..., 0] if batch else GAUSS_NORM / gamma_s
+    if transmission == "half_angle":
+        ft = np.subtract(1.0, f, out=f)
+        ft *= ft
+    else:
+        ft = 1.0 - _fresnel_from_cos(eta2, geom.ci, geom.ci * geom.ci)
+        ft *= 1.0 - _fresnel_from_cos(eta2, geom.cr, geom.cr * geom.cr)
+    ev *= b((1.0 - kd) * GAUSS_NORM / gamma_v)
+    ev += b(kd)
+    ev *= ft
+    ev *= geom.kv
+    vol = ev @ weight
+    return surf, vol

@@ -1,0 +1,68 @@
+"""Atomic file writes: a file is either written whole or not at all."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+__all__ = ["atomic_write"]
+
+
+@contextlib.contextmanager
+def atomic_write(path, mode: str = "wb"):
+    """Open a temporary file beside ``path``; on success move it onto ``path``.
+
+    The temporary file lives in the destination folder (so ``os.replace`` is atomic on the
+    same file system), is flushed and fsync-ed, then renamed over ``path``. If the body raises
+    anything, KeyboardInterrupt included, the temporary file is removed and ``path`` is left
+    as it was.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination file.
+    mode : {"wb", "w"}
+        Binary or text (UTF-8, ``\\n`` line ends) mode.
+
+    Yields
+    ------
+    file object, with an extra attribute ``tmp_path`` (a :class:`pathlib.Path`) for writers
+    (such as OpenEXR) that need a file name rather than a stream.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> with atomic_write(d / "a.txt", "w") as f:
+    ...     _ = f.write("hello")
+    >>> (d / "a.txt").read_text()
+    'hello'
+    >>> try:
+    ...     with atomic_write(d / "b.txt", "w") as f:
+    ...         _ = f.write("half")
+    ...         raise RuntimeError("writer failed")
+    ... except RuntimeError:
+    ...     pass
+    >>> sorted(p.name for p in d.iterdir())
+    ['a.txt']
+    """
+    if mode not in ("wb", "w"):
+        raise ValueError(f"atomic_write mode must be 'wb' or 'w'; got {mode!r}")
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    tmp = Path(tmp)
+    try:
+        kwargs = {} if mode == "wb" else {"encoding": "utf-8", "newline": "\n"}
+        with os.fdopen(fd, mode, **kwargs) as f:
+            f.tmp_path = tmp
+            yield f
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise

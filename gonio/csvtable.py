@@ -1,0 +1,187 @@
+"""BRDF tables as CSV text (specification: README.md, "The CSV table format")."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+
+from gonio.atomic import atomic_write
+from gonio.errors import FormatError
+from gonio.exr import _jsonable, count_missing, from_angles
+from gonio.table import Table
+
+__all__ = ["read_csv", "write_csv"]
+
+ANGLES = ("theta_i", "phi_i", "theta_o", "phi_o")
+_KEY = re.compile(r"^([A-Za-z_][\w.\-]*)\s*:\s?(.*)$")
+_VALUE_SETS = (("r", "g", "b"), ("value",))
+_SIGMA_SETS = (("sigma_r", "sigma_g", "sigma_b"), ("sigma",))
+
+
+def write_csv(table: Table, path, digits: int = 9) -> None:
+    """Write a table as CSV (atomically).
+
+    Parameters
+    ----------
+    table : Table
+    path : str or os.PathLike
+    digits : int
+        Significant digits printed for every number (angles in degrees, f_r in 1/sr).
+
+    Notes
+    -----
+    A grey table (r = g = b everywhere) is written with one ``value`` column (and ``sigma``);
+    otherwise ``r,g,b`` (and ``sigma_r,sigma_g,sigma_b``). ``meta`` goes in ``# key: value``
+    comment lines, each value as JSON. Missing values are written as ``nan``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> t = Table([[0, 0, 1.0]], [[0.6, 0, 0.8]], [0.25], meta={"source": "doc"})
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "t.csv"
+    >>> write_csv(t, p)
+    >>> print(p.read_text().splitlines()[-2:])
+    ['theta_i,phi_i,theta_o,phi_o,value', '0,0,36.8698976,0,0.25']
+    """
+    if digits < 1:
+        raise ValueError(f"write_csv: digits must be >= 1; got {digits}")
+    fmt = f"%.{digits}g"
+    grey = bool(np.array_equal(table.values[:, 0], table.values[:, 1], equal_nan=True)
+                and np.array_equal(table.values[:, 0], table.values[:, 2], equal_nan=True)
+                and (table.sigma is None
+                     or (np.array_equal(table.sigma[:, 0], table.sigma[:, 1], equal_nan=True)
+                         and np.array_equal(table.sigma[:, 0], table.sigma[:, 2],
+                                            equal_nan=True))))
+    cols = list(ANGLES) + (["value"] if grey else ["r", "g", "b"])
+    data = [np.degrees(table.angles)]
+    data.append(table.values[:, :1] if grey else table.values)
+    if table.sigma is not None:
+        cols += ["sigma"] if grey else ["sigma_r", "sigma_g", "sigma_b"]
+        data.append(table.sigma[:, :1] if grey else table.sigma)
+    data = np.concatenate(data, axis=1)
+    with atomic_write(path, "w") as f:
+        f.write("# microcyl BRDF table. Angles in degrees, f_r in 1/sr, "
+                "comment lines start with #\n")
+        for key, value in table.meta.items():
+            if _KEY.match(f"{key}: x"):
+                f.write(f"# {key}: {json.dumps(value, default=_jsonable)}\n")
+        f.write(",".join(cols) + "\n")
+        for row in data:
+            f.write(",".join(fmt % x if np.isfinite(x) else ("nan" if np.isnan(x) else
+                                                              ("inf" if x > 0 else "-inf"))
+                             for x in row) + "\n")
+
+
+def _parse_float(text: str) -> float:
+    text = text.strip()
+    return float("nan") if text == "" else float(text)
+
+
+def read_csv(path) -> Table:
+    """Read a CSV BRDF table.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    Table
+        ``meta`` holds the ``# key: value`` comments (JSON values decoded when they parse)
+        and ``missing_values``, the count of NaN (or empty) and negative values, which are
+        kept and flagged in ``Table.valid``.
+
+    Raises
+    ------
+    FormatError
+        No header, unknown or missing columns, or a bad row (its line number is given).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
+    meta: dict = {}
+    header = None
+    rows = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            m = _KEY.match(stripped[1:].strip())
+            if m:
+                key, raw = m.group(1), m.group(2).strip()
+                try:
+                    meta[key] = json.loads(raw)
+                except json.JSONDecodeError:
+                    meta[key] = raw
+            continue
+        fields = [c.strip() for c in stripped.split(",")]
+        if header is None:
+            header = fields
+            _check_header(path, lineno, header)
+            continue
+        if len(fields) != len(header):
+            raise FormatError(path, f"line {lineno}: expected {len(header)} columns "
+                                    f"({','.join(header)}), got {len(fields)}")
+        try:
+            row = [_parse_float(x) for x in fields]
+        except ValueError:
+            bad = next(x for x in fields if not _is_float(x))
+            raise FormatError(path, f"line {lineno}: {bad!r} is not a number") from None
+        if not all(np.isfinite(row[header.index(a)]) for a in ANGLES):
+            raise FormatError(path, f"line {lineno}: angles must be finite numbers")
+        rows.append(row)
+    if header is None:
+        raise FormatError(path, "no header row (expected theta_i,phi_i,theta_o,phi_o,r,g,b)")
+    if not rows:
+        raise FormatError(path, "no data rows after the header")
+    data = np.array(rows, dtype=np.float64)
+    col = {name: data[:, k] for k, name in enumerate(header)}
+    ang = [np.radians(col[a]) for a in ANGLES]
+    values = (np.stack([col[c] for c in "rgb"], axis=1) if "r" in col
+              else np.repeat(col["value"][:, None], 3, axis=1))
+    sigma = None
+    if "sigma_r" in col:
+        sigma = np.stack([col[f"sigma_{c}"] for c in "rgb"], axis=1)
+    elif "sigma" in col:
+        sigma = np.repeat(col["sigma"][:, None], 3, axis=1)
+    meta["missing_values"] = count_missing(values)
+    meta.setdefault("file_format", "csv")
+    return Table(from_angles(ang[0], ang[1]), from_angles(ang[2], ang[3]), values, sigma, meta)
+
+
+def _is_float(x: str) -> bool:
+    try:
+        _parse_float(x)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_header(path, lineno, header):
+    known = set(ANGLES) | {c for s in _VALUE_SETS + _SIGMA_SETS for c in s}
+    unknown = [c for c in header if c not in known]
+    if unknown:
+        raise FormatError(path, f"line {lineno}: unknown column(s) {', '.join(unknown)}; "
+                                "the header must be theta_i,phi_i,theta_o,phi_o then r,g,b or "
+                                "value, then optionally sigma_r,sigma_g,sigma_b or sigma")
+    if len(set(header)) != len(header):
+        raise FormatError(path, f"line {lineno}: repeated column in header {','.join(header)}")
+    missing = [a for a in ANGLES if a not in header]
+    if missing:
+        raise FormatError(path, f"line {lineno}: missing column(s) {', '.join(missing)}")
+    for group, what in ((_VALUE_SETS, "values"), (_SIGMA_SETS, "sigma")):
+        present = [s for s in group if any(c in header for c in s)]
+        if len(present) > 1:
+            raise FormatError(path, f"line {lineno}: both {','.join(present[0])} and "
+                                    f"{','.join(present[1])} columns for {what}")
+        if present and not all(c in header for c in present[0]):
+            raise FormatError(path, f"line {lineno}: missing column(s) " + ", ".join(
+                c for c in present[0] if c not in header))
+        if what == "values" and not present:
+            raise FormatError(path, f"line {lineno}: missing columns r,g,b (or value)")

@@ -1,0 +1,95 @@
+"""CUReT BRDF measurements (Dana et al. 1999): ``abrdf.dat`` + ``table.txt``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gonio.errors import FormatError
+from gonio.exr import count_missing, from_angles
+from gonio.table import Table
+
+__all__ = ["load_curet", "N_SAMPLES", "N_CONFIGS"]
+
+N_SAMPLES = 61
+N_CONFIGS = 205
+
+
+def _read_numbers(path: Path, ncols: int, nrows: int, what: str) -> np.ndarray:
+    try:
+        lines = [ln for ln in path.read_text(encoding="ascii").splitlines() if ln.strip()]
+    except UnicodeDecodeError:
+        raise FormatError(path, f"not ASCII text; expected {what}") from None
+    if len(lines) != nrows:
+        raise FormatError(path, f"wrong size: {len(lines)} rows, expected {nrows} ({what})")
+    out = np.empty((nrows, ncols))
+    for k, line in enumerate(lines):
+        fields = line.split()
+        if len(fields) != ncols:
+            raise FormatError(path, f"line {k + 1}: expected {ncols} numbers, got {len(fields)}")
+        try:
+            out[k] = [float(x) for x in fields]
+        except ValueError:
+            raise FormatError(path, f"line {k + 1}: not a number in {line.strip()[:60]!r}") \
+                from None
+    return out
+
+
+def load_curet(folder, sample: int) -> Table:
+    """One CUReT sample's 205 BRDF measurements as a Table.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        Folder holding ``abrdf.dat`` (61 rows: sample number, then 205 values) and
+        ``table.txt`` (205 rows: index, theta_v, phi_v, theta_i, phi_i in radians), e.g.
+        ``../shared/data/curet``.
+    sample : int
+        CUReT sample number, 1..61 (1 felt, 2 polyester, 3 terrycloth, 7 velvet, 44 linen...).
+
+    Returns
+    -------
+    Table
+        205 rows; wi = illumination (i) and wo = viewer (v) directions; values grey (the mean
+        of R, G, B) repeated to 3 channels. CUReT values are **relative** reflectance, not
+        f_r in 1/sr: ``meta["units"] = "relative"``; fit with a free scale.
+
+    Raises
+    ------
+    ValueError
+        ``sample`` outside 1..61.
+    FormatError
+        Either file malformed (wrong row count, column count, or a non-number), or the
+        sample's row missing.
+
+    Examples
+    --------
+    >>> from tests.conftest import SHARED_DATA  # doctest: +SKIP
+    >>> load_curet(SHARED_DATA / "curet", 44).meta["units"]  # doctest: +SKIP
+    'relative'
+    """
+    if isinstance(sample, bool) or not isinstance(sample, (int, np.integer)) \
+            or not 1 <= sample <= N_SAMPLES:
+        raise ValueError(f"load_curet: sample must be an integer in 1..{N_SAMPLES}; got {sample!r}")
+    folder = Path(folder)
+    geometry = _read_numbers(folder / "table.txt", 5, N_CONFIGS, "index theta_v phi_v theta_i phi_i")
+    if not np.array_equal(geometry[:, 0], np.arange(1, N_CONFIGS + 1)):
+        raise FormatError(folder / "table.txt", "first column must count 1..205")
+    data = _read_numbers(folder / "abrdf.dat", N_CONFIGS + 1, N_SAMPLES,
+                         "sample number then 205 values")
+    rows = np.flatnonzero(data[:, 0] == sample)
+    if rows.size != 1:
+        raise FormatError(folder / "abrdf.dat", f"sample {sample} appears {rows.size} times")
+    values = data[rows[0], 1:]
+    theta_v, phi_v, theta_i, phi_i = geometry[:, 1:].T
+    meta = {
+        "source": f"CUReT sample {int(sample)}",
+        "file_format": "curet",
+        "files": [str(folder / "abrdf.dat"), str(folder / "table.txt")],
+        "units": "relative",
+        "note": "CUReT relative reflectance (mean of R, G, B), not f_r in 1/sr",
+        "curet_sample": int(sample),
+        "missing_values": count_missing(np.repeat(values[:, None], 3, axis=1)),
+    }
+    return Table(from_angles(theta_i, phi_i), from_angles(theta_v, phi_v), values, None, meta)

@@ -1,0 +1,36 @@
+"""Errors raised by the gonio readers."""
+
+from __future__ import annotations
+
+import os
+
+__all__ = ["FormatError"]
+
+
+class FormatError(ValueError):
+    """A file is truncated, corrupt or not in the format its name says.
+
+    The message names the file and what is wrong (wrong magic, wrong size, missing channel,
+    bad CSV row with its line number). Readers raise it before returning anything: a table
+    is never returned partially read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The offending file.
+    problem : str
+        What is wrong with it.
+
+    Examples
+    --------
+    >>> err = FormatError("t.csv", "line 3: expected 7 columns, got 5")
+    >>> str(err)
+    't.csv: line 3: expected 7 columns, got 5'
+    >>> isinstance(err, ValueError), err.path
+    (True, 't.csv')
+    """
+
+    def __init__(self, path, problem: str):
+        self.path = os.fspath(path)
+        self.problem = problem
+        super().__init__(f"{self.path}: {problem}")

@@ -1,0 +1,195 @@
+"""The native table format: OpenEXR, float32 channels, metadata in header attributes.
+
+Layout (format ``microcyl-table/1``): one part, a 1 x n scanline image (one pixel per row of
+the table; readers also accept any w x h image and keep the first ``microcyl_rows`` pixels in
+row-major order). Channels, all FLOAT (32-bit):
+
+- ``R``, ``G``, ``B``: f_r in 1/sr (a grey file may carry ``Y`` instead);
+- ``sigma.R``, ``sigma.G``, ``sigma.B``: standard deviations in 1/sr (optional);
+- ``theta_i``, ``phi_i``, ``theta_o``, ``phi_o``: angles in **radians** (theta from the normal,
+  phi from the warp +x toward +y); wi points to the light, wo to the viewer.
+
+Header attributes (strings): ``microcyl_format`` = ``microcyl-table/1``, ``angle_unit`` =
+``radian``, ``value_unit`` = ``1/sr``, ``microcyl_rows`` = n, and ``microcyl_meta``, the table's
+``meta`` as a JSON object.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from gonio.atomic import atomic_write
+from gonio.errors import FormatError
+from gonio.table import Table
+
+__all__ = ["read_exr", "write_exr", "from_angles", "meta_to_json"]
+
+FORMAT = "microcyl-table/1"
+_MAGIC = b"\x76\x2f\x31\x01"
+ANGLE_CHANNELS = ("theta_i", "phi_i", "theta_o", "phi_o")
+
+
+def from_angles(theta, phi) -> np.ndarray:
+    """Unit vectors (..., 3) from polar angle ``theta`` and azimuth ``phi`` in radians.
+
+    Examples
+    --------
+    >>> from_angles(np.pi / 2, 0.0).round(12)
+    array([1., 0., 0.])
+    """
+    theta, phi = np.broadcast_arrays(np.asarray(theta, np.float64), np.asarray(phi, np.float64))
+    s = np.sin(theta)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), np.cos(theta)], axis=-1)
+
+
+def _jsonable(x):
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, (Path, os.PathLike)):
+        return os.fspath(x)
+    return str(x)
+
+
+def meta_to_json(meta: dict) -> str:
+    """The meta dict as compact JSON (numpy scalars and arrays become numbers and lists)."""
+    return json.dumps(meta, default=_jsonable, sort_keys=True, allow_nan=True)
+
+
+def count_missing(values: np.ndarray) -> int:
+    """Number of NaN or negative entries of an (n, 3) value array."""
+    return int(np.count_nonzero(~(np.isfinite(values) & (values >= 0))))
+
+
+def write_exr(table: Table, path) -> None:
+    """Write a table as the native OpenEXR format (atomically).
+
+    Parameters
+    ----------
+    table : Table
+        At least one row.
+    path : str or os.PathLike
+        Destination ``.exr`` file; replaced whole or left untouched.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> t = Table([[0, 0, 1.0]], [[0.6, 0, 0.8]], [[0.1, 0.2, 0.3]], meta={"source": "doc"})
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "t.exr"
+    >>> write_exr(t, p)
+    >>> back = read_exr(p)
+    >>> back.values.astype("f4").tolist(), back.meta["source"]
+    ([[0.1, 0.2, 0.3]], 'doc')
+    """
+    import OpenEXR
+
+    n = len(table)
+    if n == 0:
+        raise ValueError("write_exr: the table is empty; an OpenEXR image needs >= 1 pixel")
+    f32 = lambda a: np.ascontiguousarray(np.asarray(a, np.float32).reshape(1, n))  # noqa: E731
+    channels = {c: f32(table.values[:, k]) for k, c in enumerate("RGB")}
+    if table.sigma is not None:
+        channels.update({f"sigma.{c}": f32(table.sigma[:, k]) for k, c in enumerate("RGB")})
+    angles = table.angles
+    channels.update({name: f32(angles[:, k]) for k, name in enumerate(ANGLE_CHANNELS)})
+    header = {
+        "compression": OpenEXR.ZIP_COMPRESSION,
+        "type": OpenEXR.scanlineimage,
+        "microcyl_format": FORMAT,
+        "angle_unit": "radian",
+        "value_unit": "1/sr",
+        "microcyl_rows": str(n),
+        "microcyl_meta": meta_to_json(table.meta),
+    }
+    with atomic_write(path, "wb") as f:
+        with OpenEXR.File(header, channels) as exr:
+            exr.write(str(f.tmp_path))
+
+
+def read_exr(path) -> Table:
+    """Read a native OpenEXR table.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        An ``.exr`` file written by :func:`write_exr` (or by anyone following the layout in
+        this module's docstring).
+
+    Returns
+    -------
+    Table
+        Values and sigma exactly as stored (float32 widened to float64); directions from the
+        stored angles; ``meta`` from the header plus ``missing_values`` (count of NaN or
+        negative values, kept and flagged in ``Table.valid``).
+
+    Raises
+    ------
+    FormatError
+        Not an OpenEXR file (wrong magic), unreadable or truncated, a missing channel, or a
+        ``microcyl_rows`` larger than the image.
+    """
+    import OpenEXR
+
+    path = Path(path)
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    if head != _MAGIC:
+        raise FormatError(path, f"wrong magic {head!r}, expected {_MAGIC!r} (not an OpenEXR file)")
+    try:
+        with OpenEXR.File(str(path), separate_channels=True) as exr:
+            header = dict(exr.header())
+            chans = {k: np.array(v.pixels) for k, v in exr.channels().items()}
+    except (RuntimeError, OSError, ValueError) as exc:
+        raise FormatError(path, f"unreadable OpenEXR (truncated or corrupt): {exc}") from None
+    need = list(ANGLE_CHANNELS)
+    if not ("Y" in chans and not any(c in chans for c in "RGB")):
+        need += ["R", "G", "B"]
+    missing = [c for c in need if c not in chans]
+    if missing:
+        raise FormatError(path, f"missing channel(s) {', '.join(missing)}; "
+                                f"found {', '.join(sorted(chans)) or 'none'}")
+    sig_names = [f"sigma.{c}" for c in "RGB"]
+    has_sigma = any(s in chans for s in sig_names) or "sigma.Y" in chans
+    if has_sigma and "sigma.Y" not in chans and not all(s in chans for s in sig_names):
+        raise FormatError(path, "missing channel(s) " +
+                          ", ".join(s for s in sig_names if s not in chans))
+    size = next(iter(chans.values())).size
+    n = size
+    if "microcyl_rows" in header:
+        try:
+            n = int(str(header["microcyl_rows"]))
+        except ValueError:
+            raise FormatError(path, f"bad microcyl_rows attribute {header['microcyl_rows']!r}")
+        if not 0 < n <= size:
+            raise FormatError(path, f"wrong size: microcyl_rows = {n} but the image has "
+                                    f"{size} pixels")
+    flat = lambda name: chans[name].astype(np.float64).ravel()[:n]  # noqa: E731
+    if "R" in chans:
+        values = np.stack([flat(c) for c in "RGB"], axis=1)
+    else:
+        values = np.repeat(flat("Y")[:, None], 3, axis=1)
+    sigma = None
+    if has_sigma:
+        sigma = (np.stack([flat(s) for s in sig_names], axis=1) if "sigma.R" in chans
+                 else np.repeat(flat("sigma.Y")[:, None], 3, axis=1))
+    ti, pi_, to, po = (flat(c) for c in ANGLE_CHANNELS)
+    if str(header.get("angle_unit", "radian")).startswith("deg"):
+        ti, pi_, to, po = (np.radians(a) for a in (ti, pi_, to, po))
+    if not all(np.all(np.isfinite(a)) for a in (ti, pi_, to, po)):
+        raise FormatError(path, "non-finite angle in the angle channels")
+    meta = {}
+    if "microcyl_meta" in header:
+        try:
+            meta = json.loads(str(header["microcyl_meta"]))
+        except json.JSONDecodeError as exc:
+            raise FormatError(path, f"microcyl_meta attribute is not JSON: {exc}") from None
+        if not isinstance(meta, dict):
+            raise FormatError(path, "microcyl_meta attribute is not a JSON object")
+    meta["missing_values"] = count_missing(values)
+    meta.setdefault("file_format", "exr")
+    return Table(from_angles(ti, pi_), from_angles(to, po), values, sigma, meta)

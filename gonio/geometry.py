@@ -1,0 +1,928 @@
+"""Measurement geometries: sets of (wi, wo) direction pairs with their own coordinates.
+
+A :class:`Geometry` holds n pairs of unit directions in the *instrument* (lab) frame, the
+coordinates they were built from (a dict of named (n,) arrays in radians, e.g. ``theta_i,
+phi_i, theta_o, phi_o`` or ``theta_h, phi_h, theta_d, phi_d``), a ``kind`` and its
+parameters, and a sample rotation (azimuth of the sample on the instrument's stage).
+
+Conventions
+-----------
+- theta is the polar angle from the normal n = +z; phi the azimuth from +x (the warp of an
+  unrotated sample) toward +y. Coordinates are stored in radians.
+- Constructors take the angles that define a grid (steps, lists of angles) in **degrees**,
+  as the command line does, and the sample ``rotation`` in **radians** (as
+  ``brdf.fabric(rotation=...)`` does).
+- The sample rotation r turns the sample by +r about n: the warp points at lab azimuth r.
+  The directions handed to a BRDF, :attr:`Geometry.wi` and :attr:`Geometry.wo`, are the lab
+  directions turned by -r about z, i.e. expressed in the sample's own frame. Measuring a BRDF
+  f with rotation r therefore equals measuring f rotated by r (f_r(w, w') = f(R(-r) w,
+  R(-r) w')) with rotation 0.
+- Horizon: pairs with either direction at or below the horizon (z <= 1e-9) are **dropped**
+  when the geometry is built (f_r is 0 there by definition and a measurement there is
+  meaningless). ``info["dropped_below_horizon"]`` counts them, ``info["n_layout"]`` is the
+  size of the full layout, and :attr:`Geometry.index` gives each kept pair's position in
+  that layout (the flat MERL index for the MERL layout), so tables can be put back in place.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "Geometry",
+    "full_grid",
+    "plane",
+    "rusinkiewicz",
+    "merl",
+    "pairs",
+    "pairs_from_angles",
+    "from_spec",
+    "directions_from_angles",
+    "angles_from_directions",
+    "half_diff_to_directions",
+    "directions_to_half_diff",
+    "plane_to_directions",
+    "directions_to_plane",
+    "rotate_z",
+    "SPEC_HELP",
+]
+
+#: Directions with z at or below this are at or below the horizon and are dropped.
+HORIZON_EPS = 1e-9
+
+#: One-line description of the spec grammar, used in error messages and CLI help.
+SPEC_HELP = ("full:STEP[:PHI_STEP] | full:TI:PI:TO:PO | plane:{warp,weft,45,AZ}:STEP[:TI,TI,...] | "
+             "rusinkiewicz:STEP | rusinkiewicz:TH:PH:TD:PD | merl[:STRIDE] | pairs:FILE.csv "
+             "(angles in degrees)")
+
+_PLANE_NAMES = {"warp": 0.0, "weft": 90.0, "45": 45.0}
+
+
+# ----------------------------------------------------------------------------- angle helpers
+
+def directions_from_angles(theta, phi) -> np.ndarray:
+    """Unit vectors from polar and azimuth angles.
+
+    Parameters
+    ----------
+    theta, phi : array_like
+        Polar angle from n = +z and azimuth from +x toward +y, in radians; broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        (sin theta cos phi, sin theta sin phi, cos theta).
+
+    Examples
+    --------
+    >>> directions_from_angles(np.pi / 2, np.pi / 2).round(12)
+    array([0., 1., 0.])
+    """
+    theta, phi = np.broadcast_arrays(np.asarray(theta, float), np.asarray(phi, float))
+    s = np.sin(theta)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), np.cos(theta)], axis=-1)
+
+
+def angles_from_directions(w) -> tuple[np.ndarray, np.ndarray]:
+    """Polar angle and azimuth (radians) of (..., 3) directions; phi in (-pi, pi].
+
+    Examples
+    --------
+    >>> t, p = angles_from_directions([0.0, -1.0, 0.0])
+    >>> float(np.degrees(t)), float(np.degrees(p))
+    (90.0, -90.0)
+    """
+    w = np.asarray(w, float)
+    w = w / np.linalg.norm(w, axis=-1, keepdims=True)
+    return np.arccos(np.clip(w[..., 2], -1.0, 1.0)), np.arctan2(w[..., 1], w[..., 0])
+
+
+def rotate_z(w, angle) -> np.ndarray:
+    """Rotate (..., 3) vectors by ``angle`` (radians, broadcast) about +z, counter-clockwise.
+
+    Examples
+    --------
+    >>> rotate_z([1.0, 0.0, 0.0], np.pi / 2).round(12)
+    array([0., 1., 0.])
+    """
+    w = np.asarray(w, float)
+    c, s = np.cos(angle), np.sin(angle)
+    x, y = w[..., 0], w[..., 1]
+    return np.stack(np.broadcast_arrays(c * x - s * y, s * x + c * y, w[..., 2]), axis=-1)
+
+
+def _rotate_y(w, angle) -> np.ndarray:
+    """Rotate (..., 3) vectors by ``angle`` (radians) about +y (right hand: z toward x)."""
+    c, s = np.cos(angle), np.sin(angle)
+    x, z = w[..., 0], w[..., 2]
+    return np.stack(np.broadcast_arrays(c * x + s * z, w[..., 1], -s * x + c * z), axis=-1)
+
+
+def half_diff_to_directions(theta_h, phi_h, theta_d, phi_d) -> tuple[np.ndarray, np.ndarray]:
+    """Rusinkiewicz (1998) half/difference angles to a pair of directions.
+
+    Parameters
+    ----------
+    theta_h, phi_h : array_like
+        Polar angle and azimuth of the half vector h = (wi + wo) / |wi + wo|, radians.
+    theta_d, phi_d : array_like
+        Polar angle and azimuth of the difference vector d, radians: wi expressed in the frame
+        where h is the pole.
+
+    Returns
+    -------
+    wi, wo : ndarray, shape (..., 3)
+        wi = R_z(phi_h) R_y(theta_h) d and wo = R_z(phi_h) R_y(theta_h) d', where d' is d
+        turned by 180 degrees about the pole (d'_x = -d_x, d'_y = -d_y), so that wi + wo is
+        parallel to h.
+
+    Notes
+    -----
+    This is the inverse of :func:`directions_to_half_diff`, which follows Rusinkiewicz:
+    d = R_y(-theta_h) R_z(-phi_h) wi (rotate by -phi_h about n, then by -theta_h about the
+    binormal), as in MERL's reference code ``std_coords_to_half_diff_coords`` (there d comes
+    from its first, "in", direction).
+
+    Examples
+    --------
+    >>> wi, wo = half_diff_to_directions(0.0, 0.0, np.pi / 4, 0.0)
+    >>> wi.round(6), wo.round(6)
+    (array([0.707107, 0.      , 0.707107]), array([-0.707107,  0.      ,  0.707107]))
+    """
+    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(
+        *(np.asarray(a, float) for a in (theta_h, phi_h, theta_d, phi_d)))
+    d = directions_from_angles(theta_d, phi_d)
+    dp = d * np.array([-1.0, -1.0, 1.0])
+    wi = rotate_z(_rotate_y(d, theta_h), phi_h)
+    wo = rotate_z(_rotate_y(dp, theta_h), phi_h)
+    return wi, wo
+
+
+def directions_to_half_diff(wi, wo) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Rusinkiewicz (1998) half/difference angles of direction pairs.
+
+    Parameters
+    ----------
+    wi, wo : array_like, shape (..., 3)
+        Directions (normalized here).
+
+    Returns
+    -------
+    theta_h, phi_h, theta_d, phi_d : ndarray
+        Radians; theta in [0, pi], phi in (-pi, pi]. Where theta_h = 0, phi_h = 0 and phi_d
+        carries the azimuth; where theta_d = 0, phi_d is 0.
+
+    Notes
+    -----
+    h = (wi + wo) / |wi + wo|; d = R_y(-theta_h) R_z(-phi_h) wi.
+
+    Examples
+    --------
+    >>> wi, wo = half_diff_to_directions(0.3, 1.0, 0.5, -2.0)
+    >>> np.round(directions_to_half_diff(wi, wo), 12).tolist()
+    [0.3, 1.0, 0.5, -2.0]
+    """
+    wi = np.asarray(wi, float)
+    wo = np.asarray(wo, float)
+    wi = wi / np.linalg.norm(wi, axis=-1, keepdims=True)
+    wo = wo / np.linalg.norm(wo, axis=-1, keepdims=True)
+    h = wi + wo
+    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+    theta_h, phi_h = angles_from_directions(h)
+    phi_h = np.where(np.hypot(h[..., 0], h[..., 1]) < 1e-12, 0.0, phi_h)
+    d = _rotate_y(rotate_z(wi, -phi_h), -theta_h)
+    theta_d, phi_d = angles_from_directions(d)
+    phi_d = np.where(np.hypot(d[..., 0], d[..., 1]) < 1e-12, 0.0, phi_d)
+    return theta_h, phi_h, theta_d, phi_d
+
+
+def plane_to_directions(theta_i, theta_o, azimuth=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Signed in-plane angles to directions, for a plane of incidence at ``azimuth``.
+
+    Parameters
+    ----------
+    theta_i, theta_o : array_like
+        Signed polar angles, radians, in (-pi/2, pi/2). theta_i > 0 puts wi at azimuth
+        ``azimuth``; theta_o > 0 puts wo on the opposite side (azimuth + pi, the specular
+        side), so theta_o = theta_i is the mirror direction and theta_o = -theta_i is
+        back-scatter (wo = wi).
+    azimuth : float or array_like
+        Azimuth of the plane, radians (0: along the warp, pi/2: along the weft).
+
+    Returns
+    -------
+    wi, wo : ndarray, shape (..., 3)
+
+    Examples
+    --------
+    >>> wi, wo = plane_to_directions(np.pi / 4, np.pi / 4)
+    >>> wi.round(6), wo.round(6)
+    (array([0.707107, 0.      , 0.707107]), array([-0.707107,  0.      ,  0.707107]))
+    """
+    wi = directions_from_angles(theta_i, azimuth)
+    wo = directions_from_angles(theta_o, np.asarray(azimuth, float) + np.pi)
+    return wi, wo
+
+
+def directions_to_plane(wi, wo, azimuth=0.0, *, atol=1e-9) -> tuple[np.ndarray, np.ndarray]:
+    """Signed in-plane angles (radians) of direction pairs lying in a plane of incidence.
+
+    The inverse of :func:`plane_to_directions`.
+
+    Raises
+    ------
+    ValueError
+        If a direction lies off the plane by more than ``atol`` (sine of the angle).
+
+    Examples
+    --------
+    >>> wi, wo = plane_to_directions(0.2, -0.7, np.pi / 2)
+    >>> np.round(directions_to_plane(wi, wo, np.pi / 2), 12).tolist()
+    [0.2, -0.7]
+    """
+    p = np.stack(np.broadcast_arrays(np.cos(azimuth), np.sin(azimuth), 0.0 * np.asarray(azimuth)),
+                 axis=-1)
+    q = rotate_z(p, np.pi / 2)
+    out = []
+    for name, w, sign in (("wi", wi, 1.0), ("wo", wo, -1.0)):
+        w = np.asarray(w, float)
+        w = w / np.linalg.norm(w, axis=-1, keepdims=True)
+        off = np.abs(np.sum(w * q, axis=-1))
+        if np.any(off > atol):
+            raise ValueError(f"{name} lies off the plane at azimuth {np.degrees(azimuth)} deg "
+                             f"(largest |sin| off the plane: {float(np.max(off)):.3g})")
+        out.append(np.arctan2(sign * np.sum(w * p, axis=-1), w[..., 2]))
+    return out[0], out[1]
+
+
+# ----------------------------------------------------------------------------- the class
+
+def _jsonable(value):
+    """Convert numpy scalars/arrays and tuples in a params dict to plain Python."""
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Geometry:
+    """n (wi, wo) direction pairs of a measurement, with their own coordinates.
+
+    Build one with a constructor (:func:`full_grid`, :func:`plane`, :func:`rusinkiewicz`,
+    :func:`merl`, :func:`pairs`, :func:`pairs_from_angles`) or :meth:`from_spec`.
+
+    Parameters
+    ----------
+    wi_lab, wo_lab : ndarray, shape (n, 3)
+        Unit directions toward the light and toward the detector in the instrument (lab) frame.
+    coords : dict of str to ndarray
+        The geometry's own coordinates, each of shape (n,), in radians (for example
+        ``theta_i, phi_i, theta_o, phi_o``; ``theta_h, phi_h, theta_d, phi_d``; or the signed
+        ``theta_i, theta_o`` of a plane). They describe the lab directions (before rotation).
+    kind : str
+        "full", "plane", "rusinkiewicz", "merl" or "pairs".
+    params : dict
+        The constructor's parameters (angles in degrees), JSON-serializable.
+    rotation : float
+        Sample azimuth on the stage, radians. See the module notes.
+    index : ndarray of int, shape (n,)
+        Position of each pair in the full layout of ``kind`` (before pairs below the horizon
+        were dropped); for "merl", the flat MERL index phi_d + 180 (theta_d + 90 theta_h).
+    info : dict
+        ``n_layout`` (size of the full layout), ``dropped_below_horizon`` (pairs dropped).
+
+    Examples
+    --------
+    >>> g = full_grid(30)
+    >>> len(g), g.kind, sorted(g.coords)
+    (625, 'full', ['phi_i', 'phi_o', 'theta_i', 'theta_o'])
+    >>> g.spec
+    'full:30:30:30:30'
+    """
+
+    wi_lab: np.ndarray
+    wo_lab: np.ndarray
+    coords: dict
+    kind: str = "pairs"
+    params: dict = dataclasses.field(default_factory=dict)
+    rotation: float = 0.0
+    index: np.ndarray | None = None
+    info: dict = dataclasses.field(default_factory=dict)
+
+    def __post_init__(self):
+        wi = np.array(self.wi_lab, float).reshape(-1, 3)
+        wo = np.array(self.wo_lab, float).reshape(-1, 3)
+        if wi.shape != wo.shape:
+            raise ValueError(f"Geometry wi has shape {wi.shape} but wo has {wo.shape}")
+        n = wi.shape[0]
+        coords = {}
+        for k, v in dict(self.coords).items():
+            v = np.array(v, float).reshape(-1)
+            if v.shape != (n,):
+                raise ValueError(f"Geometry coordinate {k!r} has {v.size} values; expected {n}")
+            coords[k] = v
+        rotation = float(self.rotation)
+        if not math.isfinite(rotation):
+            raise ValueError(f"rotation must be a finite angle in radians; got {self.rotation!r}")
+        index = np.arange(n) if self.index is None else np.array(self.index, np.int64).reshape(-1)
+        if index.shape != (n,):
+            raise ValueError(f"Geometry index has {index.size} values; expected {n}")
+        info = {"n_layout": n, "dropped_below_horizon": 0}
+        info.update(self.info)
+        for arr in (wi, wo, index, *coords.values()):   # shared by reference: keep them intact
+            arr.flags.writeable = False
+        object.__setattr__(self, "wi_lab", wi)
+        object.__setattr__(self, "wo_lab", wo)
+        object.__setattr__(self, "coords", coords)
+        object.__setattr__(self, "params", _jsonable(dict(self.params)))
+        object.__setattr__(self, "rotation", rotation)
+        object.__setattr__(self, "index", index)
+        object.__setattr__(self, "info", _jsonable(info))
+
+    def __len__(self) -> int:
+        return self.wi_lab.shape[0]
+
+    def __repr__(self) -> str:
+        rot = f", rotation={self.rotation:.6g} rad" if self.rotation else ""
+        return f"Geometry({self.spec or self.kind!r}, n={len(self)}{rot})"
+
+    @property
+    def wi(self) -> np.ndarray:
+        """(n, 3) light directions in the sample frame (lab directions turned by -rotation)."""
+        return rotate_z(self.wi_lab, -self.rotation) if self.rotation else self.wi_lab
+
+    @property
+    def wo(self) -> np.ndarray:
+        """(n, 3) detector directions in the sample frame (lab directions turned by -rotation)."""
+        return rotate_z(self.wo_lab, -self.rotation) if self.rotation else self.wo_lab
+
+    @property
+    def spec(self) -> str | None:
+        """The compact spec string that rebuilds this layout (without rotation), or None."""
+        p = self.params
+        if self.kind == "full":
+            return f"full:{_fmt(p['theta_i_step'])}:{_fmt(p['phi_i_step'])}:" \
+                   f"{_fmt(p['theta_o_step'])}:{_fmt(p['phi_o_step'])}"
+        if self.kind == "plane":
+            ti = ",".join(_fmt(t) for t in p["theta_i"])
+            return f"plane:{_fmt(p['azimuth'])}:{_fmt(p['theta_o_step'])}:{ti}"
+        if self.kind == "rusinkiewicz":
+            return (f"rusinkiewicz:{_fmt(p['theta_h_step'])}:{_fmt(p['phi_h_step'])}:"
+                    f"{_fmt(p['theta_d_step'])}:{_fmt(p['phi_d_step'])}")
+        if self.kind == "merl":
+            return f"merl:{p['stride']}"
+        if self.kind == "pairs" and p.get("file"):
+            return f"pairs:{p['file']}"
+        return None
+
+    def with_rotation(self, rotation: float) -> "Geometry":
+        """The same layout with the sample turned to ``rotation`` (radians, absolute)."""
+        return dataclasses.replace(self, rotation=rotation)
+
+    def subset(self, keep) -> "Geometry":
+        """The pairs selected by a boolean mask or an index array, coordinates kept."""
+        keep = keep if isinstance(keep, slice) else np.asarray(keep)
+        return dataclasses.replace(
+            self, wi_lab=self.wi_lab[keep], wo_lab=self.wo_lab[keep],
+            coords={k: v[keep] for k, v in self.coords.items()}, index=self.index[keep])
+
+    def describe(self) -> dict[str, Any]:
+        """A JSON-serializable description (what :func:`gonio.measure` puts in ``meta``).
+
+        Examples
+        --------
+        >>> d = plane("weft", 30, theta_i=[30]).describe()
+        >>> d["kind"], d["n"], d["spec"], d["coords"]
+        ('plane', 5, 'plane:90:30:30', ['theta_i', 'theta_o'])
+        """
+        return {"kind": self.kind, "spec": self.spec, "params": self.params,
+                "rotation": self.rotation, "rotation_deg": math.degrees(self.rotation),
+                "n": len(self), "coords": list(self.coords), "coords_unit": "rad",
+                **self.info}
+
+    # --------------------------------------------------------------------- alternative builds
+
+    @classmethod
+    def from_spec(cls, spec: str, rotation: float = 0.0) -> "Geometry":
+        """Build a geometry from a compact string (the command line's ``--geometry``).
+
+        Parameters
+        ----------
+        spec : str
+            One of (angles in degrees)::
+
+                full:STEP                 full grid, all four steps STEP
+                full:STEP:PHI_STEP        theta steps STEP, phi steps PHI_STEP
+                full:TI:PI:TO:PO          four steps
+                plane:WHICH:STEP          plane of incidence; WHICH is warp (0), weft (90),
+                                          45 or an azimuth in degrees; theta_o every STEP
+                plane:WHICH:STEP:T1,T2    ... with these incidence angles
+                rusinkiewicz:STEP         half/difference grid, all four steps STEP
+                rusinkiewicz:TH:PH:TD:PD  four steps
+                merl                      the MERL 90 x 90 x 180 layout
+                merl:STRIDE               ... every STRIDE-th node in each dimension
+                pairs:FILE.csv            a CSV with columns theta_i,phi_i,theta_o,phi_o (deg)
+        rotation : float
+            Sample rotation, radians.
+
+        Raises
+        ------
+        ValueError
+            On an unknown kind or a malformed or out-of-range parameter; the message quotes
+            the spec and the allowed forms.
+
+        Examples
+        --------
+        >>> len(Geometry.from_spec("plane:warp:5"))
+        210
+        >>> Geometry.from_spec("merl:10").params
+        {'stride': 10}
+        >>> Geometry.from_spec("sphere:3")  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: geometry spec 'sphere:3': unknown kind 'sphere'; use full:STEP[:PHI_STEP] | ...
+        """
+        return from_spec(spec, rotation=rotation)
+
+    @classmethod
+    def from_table(cls, table) -> "Geometry":
+        """Rebuild the geometry of a table made by :func:`gonio.measure`.
+
+        Uses ``table.meta["geometry"]`` (kind, params, rotation) and the table's directions;
+        the coordinates are recomputed from the directions (exact up to rounding, except at
+        degenerate points such as theta_h = 0 where an azimuth is arbitrary). Tables without
+        that metadata become a "pairs" geometry.
+        """
+        g = dict(table.meta.get("geometry") or {})
+        kind = g.get("kind", "pairs")
+        rotation = float(g.get("rotation", 0.0))
+        params = g.get("params", {})
+        wi = rotate_z(table.wi, rotation)
+        wo = rotate_z(table.wo, rotation)
+        if kind in ("rusinkiewicz", "merl"):
+            names = ("theta_h", "phi_h", "theta_d", "phi_d")
+            coords = dict(zip(names, directions_to_half_diff(wi, wo)))
+        elif kind == "plane":
+            coords = dict(zip(("theta_i", "theta_o"),
+                              directions_to_plane(wi, wo, math.radians(params["azimuth"]),
+                                                  atol=1e-5)))
+        else:
+            kind = kind if kind in ("full", "pairs") else "pairs"
+            ti, pi_ = angles_from_directions(wi)
+            to, po = angles_from_directions(wo)
+            coords = {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}
+        index = None
+        if kind == "merl":
+            th = np.rint(90 * np.sqrt(coords["theta_h"] / (np.pi / 2))).astype(np.int64)
+            td = np.floor(np.degrees(coords["theta_d"])).astype(np.int64)
+            pd = np.floor(np.degrees(np.mod(coords["phi_d"], np.pi))).astype(np.int64)
+            index = np.clip(pd, 0, 179) + 180 * (np.clip(td, 0, 89) + 90 * np.clip(th, 0, 89))
+        return cls(wi, wo, coords, kind=kind, params=params, rotation=rotation, index=index,
+                   info={k: g[k] for k in ("n_layout", "dropped_below_horizon") if k in g})
+
+
+def _fmt(x) -> str:
+    """Format a degree value compactly: 10.0 -> '10', 2.5 -> '2.5'."""
+    return f"{float(x):g}"
+
+
+def _build(kind, params, wi, wo, coords, rotation) -> Geometry:
+    """Drop pairs at or below the horizon, record the count, and make the Geometry."""
+    wi = np.asarray(wi, float).reshape(-1, 3)
+    wo = np.asarray(wo, float).reshape(-1, 3)
+    n_layout = wi.shape[0]
+    keep = (wi[:, 2] > HORIZON_EPS) & (wo[:, 2] > HORIZON_EPS)
+    idx = np.flatnonzero(keep)
+    coords = {k: np.asarray(v, float).reshape(-1)[idx] for k, v in coords.items()}
+    return Geometry(wi[idx], wo[idx], coords, kind=kind, params=params, rotation=rotation,
+                    index=idx, info={"n_layout": n_layout,
+                                     "dropped_below_horizon": int(n_layout - idx.size)})
+
+
+def _step(name, value, upper=90.0) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number of degrees; got {value!r}") from None
+    if not (math.isfinite(v) and 0 < v <= upper):
+        raise ValueError(f"{name} must be in (0, {upper:g}] degrees; got {value!r}")
+    return v
+
+
+def _range(step, stop) -> np.ndarray:
+    """Degrees 0, step, 2 step, ... strictly below ``stop`` (robust to rounding)."""
+    k = int(math.ceil(stop / step - 1e-9))
+    return step * np.arange(k)
+
+
+def _hemisphere(theta_step, phi_step, theta_max=90.0):
+    """Directions of a (theta, phi) grid, one direction at theta = 0; degrees in, radians out."""
+    thetas = _range(theta_step, theta_max)
+    phis = _range(phi_step, 360.0)
+    t = [0.0] + [th for th in thetas[1:] for _ in phis]
+    p = [0.0] + [ph for _ in thetas[1:] for ph in phis]
+    return np.radians(t), np.radians(p)
+
+
+# ----------------------------------------------------------------------------- constructors
+
+def full_grid(theta_step: float = 10.0, phi_step: float | None = None, *,
+              theta_o_step: float | None = None, phi_o_step: float | None = None,
+              rotation: float = 0.0) -> Geometry:
+    """A full hemispherical grid of light and view directions.
+
+    Parameters
+    ----------
+    theta_step : float
+        Step of theta_i in degrees (and of theta_o unless ``theta_o_step`` is given). The polar
+        angles are 0, step, 2 step, ... strictly below 90 (the horizon is excluded).
+    phi_step : float, optional
+        Step of phi_i in degrees over [0, 360) (and of phi_o unless ``phi_o_step``); defaults
+        to ``theta_step``.
+    theta_o_step, phi_o_step : float, optional
+        Steps of the view directions in degrees.
+    rotation : float
+        Sample rotation, radians.
+
+    Returns
+    -------
+    Geometry
+        kind "full", coordinates theta_i, phi_i, theta_o, phi_o (radians). At theta = 0 every
+        azimuth gives the same direction, so the grid keeps one (phi = 0) there: each side has
+        1 + (n_theta - 1) n_phi directions and the geometry is their product (light-major).
+
+    Examples
+    --------
+    >>> g = full_grid(45, 90)
+    >>> len(g)  # (1 + 1 * 4) ** 2
+    25
+    >>> float(np.degrees(g.coords["theta_i"]).max())
+    45.0
+    """
+    ti_s = _step("theta_step", theta_step)
+    pi_s = _step("phi_step", ti_s if phi_step is None else phi_step, 360.0)
+    to_s = _step("theta_o_step", ti_s if theta_o_step is None else theta_o_step)
+    po_s = _step("phi_o_step", pi_s if phi_o_step is None else phi_o_step, 360.0)
+    ti, pi_ = _hemisphere(ti_s, pi_s)
+    to, po = _hemisphere(to_s, po_s)
+    TI = np.repeat(ti, to.size)
+    PI = np.repeat(pi_, to.size)
+    TO = np.tile(to, ti.size)
+    PO = np.tile(po, ti.size)
+    wi = directions_from_angles(TI, PI)
+    wo = directions_from_angles(TO, PO)
+    params = {"theta_i_step": ti_s, "phi_i_step": pi_s, "theta_o_step": to_s, "phi_o_step": po_s}
+    return _build("full", params, wi, wo,
+                  {"theta_i": TI, "phi_i": PI, "theta_o": TO, "phi_o": PO}, rotation)
+
+
+def plane(azimuth="warp", theta_o_step: float = 5.0,
+          theta_i=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0), *, rotation: float = 0.0) -> Geometry:
+    """Measurements in a plane of incidence (phi_o = phi_i + 180 degrees).
+
+    Parameters
+    ----------
+    azimuth : {"warp", "weft", "45"} or float
+        The plane: along the warp (0 degrees), the weft (90), at 45, or any azimuth in degrees.
+    theta_o_step : float
+        Step of the signed view angle in degrees; theta_o sweeps k * step strictly inside
+        (-90, 90) (the horizon excluded). theta_o > 0 is the specular side.
+    theta_i : sequence of float
+        Signed incidence angles in degrees, each in (-90, 90); theta_i > 0 puts the light at
+        the plane's azimuth.
+    rotation : float
+        Sample rotation, radians.
+
+    Returns
+    -------
+    Geometry
+        kind "plane"; coordinates theta_i, theta_o (signed, radians); see
+        :func:`plane_to_directions`. Pairs are ordered incidence-major.
+
+    Examples
+    --------
+    >>> g = plane("weft", 30, theta_i=[0, 30])
+    >>> np.degrees(g.coords["theta_o"]).round(6).tolist()
+    [-60.0, -30.0, 0.0, 30.0, 60.0, -60.0, -30.0, 0.0, 30.0, 60.0]
+    >>> g.wi[-1].round(6)  # the light at theta_i = 30 in the weft (y) plane
+    array([0.      , 0.5     , 0.866025])
+    """
+    if isinstance(azimuth, str):
+        key = azimuth.strip().lower()
+        if key in _PLANE_NAMES:
+            az = _PLANE_NAMES[key]
+        else:
+            try:
+                az = float(key)
+            except ValueError:
+                raise ValueError(f"plane azimuth must be warp, weft, 45 or degrees; "
+                                 f"got {azimuth!r}") from None
+    else:
+        az = float(azimuth)
+    if not math.isfinite(az):
+        raise ValueError(f"plane azimuth must be finite degrees; got {azimuth!r}")
+    step = _step("theta_o_step", theta_o_step)
+    ti = np.atleast_1d(np.asarray(theta_i, float))
+    if ti.ndim != 1 or ti.size == 0 or not np.all(np.isfinite(ti)) or np.any(np.abs(ti) >= 90):
+        raise ValueError(f"theta_i must be a non-empty list of degrees in (-90, 90); "
+                         f"got {theta_i!r}")
+    k = int(math.ceil(90.0 / step - 1e-9)) - 1
+    to = step * np.arange(-k, k + 1)
+    TI = np.radians(np.repeat(ti, to.size))
+    TO = np.radians(np.tile(to, ti.size))
+    wi, wo = plane_to_directions(TI, TO, math.radians(az))
+    params = {"azimuth": az, "theta_o_step": step, "theta_i": ti.tolist()}
+    return _build("plane", params, wi, wo, {"theta_i": TI, "theta_o": TO}, rotation)
+
+
+def rusinkiewicz(theta_h_step: float = 5.0, phi_h_step: float | None = None,
+                 theta_d_step: float | None = None, phi_d_step: float | None = None, *,
+                 rotation: float = 0.0) -> Geometry:
+    """The anisotropic Rusinkiewicz half/difference grid.
+
+    Parameters
+    ----------
+    theta_h_step, phi_h_step, theta_d_step, phi_d_step : float
+        Steps in degrees (each defaults to ``theta_h_step``). theta_h and theta_d take the
+        nodes 0, step, ... strictly below 90; phi_h and phi_d the nodes 0, step, ... below
+        360 (the full circle, since neither isotropy nor reciprocity is assumed).
+    rotation : float
+        Sample rotation, radians.
+
+    Returns
+    -------
+    Geometry
+        kind "rusinkiewicz"; coordinates theta_h, phi_h, theta_d, phi_d (radians), ordered
+        with phi_d fastest, then theta_d, phi_h, theta_h; pairs below the horizon dropped.
+        All grid nodes are kept, including the degenerate ones (theta_d = 0 repeats one
+        direction pair for every phi_d), so the layout stays a regular 4-D grid.
+
+    Examples
+    --------
+    >>> g = rusinkiewicz(30, 90, 30, 90)
+    >>> g.info["n_layout"], len(g) + g.info["dropped_below_horizon"]
+    (144, 144)
+    """
+    th_s = _step("theta_h_step", theta_h_step)
+    ph_s = _step("phi_h_step", th_s if phi_h_step is None else phi_h_step, 360.0)
+    td_s = _step("theta_d_step", th_s if theta_d_step is None else theta_d_step)
+    pd_s = _step("phi_d_step", th_s if phi_d_step is None else phi_d_step, 360.0)
+    axes = [np.radians(_range(th_s, 90.0)), np.radians(_range(ph_s, 360.0)),
+            np.radians(_range(td_s, 90.0)), np.radians(_range(pd_s, 360.0))]
+    TH, PH, TD, PD = (a.reshape(-1) for a in np.meshgrid(*axes, indexing="ij"))
+    wi, wo = half_diff_to_directions(TH, PH, TD, PD)
+    params = {"theta_h_step": th_s, "phi_h_step": ph_s, "theta_d_step": td_s, "phi_d_step": pd_s}
+    return _build("rusinkiewicz", params, wi, wo,
+                  {"theta_h": TH, "phi_h": PH, "theta_d": TD, "phi_d": PD}, rotation)
+
+
+def merl(stride: int = 1, *, rotation: float = 0.0) -> Geometry:
+    """The MERL isotropic layout: 90 theta_h x 90 theta_d x 180 phi_d, phi_h = 0.
+
+    Parameters
+    ----------
+    stride : int
+        Keep every ``stride``-th index in each of the three dimensions (1: the full
+        1,458,000-entry layout).
+    rotation : float
+        Sample rotation, radians. An isotropic table of an anisotropic sample is what one
+        rotation gives; average several rotations for the rotation-averaged table.
+
+    Returns
+    -------
+    Geometry
+        kind "merl"; coordinates theta_h, phi_h (= 0), theta_d, phi_d in radians;
+        ``index`` = the flat MERL index phi_d + 180 (theta_d + 90 theta_h) of each pair.
+
+    Notes
+    -----
+    MERL's reference code (``BRDFRead.cpp``) indexes by truncation:
+    theta_h index = floor(sqrt(theta_h / 90 deg) * 90), theta_d index = floor(theta_d / 1 deg),
+    phi_d index = floor(phi_d / 1 deg) for phi_d in [0, 180) (phi_d + 180 folds onto phi_d).
+    Entry (i, j, k) is placed at theta_h = (i / 90)^2 * 90 deg (the node of bin i, as the
+    data README states), theta_d = j + 1/2 deg and phi_d = k + 1/2 deg (the centres of their
+    uniform bins, so that a truncating lookup of the placed directions finds (j, k) again).
+    Pairs with a direction below the horizon are dropped (``index`` keeps the others' places).
+
+    Examples
+    --------
+    >>> g = merl(30)
+    >>> g.info["n_layout"], sorted(set(g.index.tolist()))[:3]
+    (54, [0, 30, 60])
+    >>> np.degrees(g.coords["theta_h"][g.index == 30 * 180 * 90]).round(6).tolist()
+    [10.0]
+    """
+    if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or not 1 <= stride <= 90:
+        raise ValueError(f"MERL stride must be an integer in [1, 90]; got {stride!r}")
+    i = np.arange(0, 90, stride)
+    j = np.arange(0, 90, stride)
+    k = np.arange(0, 180, stride)
+    I, J, K = (a.reshape(-1) for a in np.meshgrid(i, j, k, indexing="ij"))
+    TH = np.radians((I / 90.0) ** 2 * 90.0)
+    TD = np.radians(J + 0.5)
+    PD = np.radians(K + 0.5)
+    PH = np.zeros_like(TH)
+    wi, wo = half_diff_to_directions(TH, PH, TD, PD)
+    g = _build("merl", {"stride": int(stride)}, wi, wo,
+               {"theta_h": TH, "phi_h": PH, "theta_d": TD, "phi_d": PD}, rotation)
+    flat = (K + 180 * (J + 90 * I))[g.index]
+    return dataclasses.replace(g, index=flat)
+
+
+def pairs(wi, wo, *, rotation: float = 0.0, params: dict | None = None) -> Geometry:
+    """An arbitrary list of direction pairs (lab frame).
+
+    Parameters
+    ----------
+    wi, wo : array_like, shape (n, 3)
+        Directions toward the light and the detector (normalized here).
+    rotation : float
+        Sample rotation, radians.
+
+    Returns
+    -------
+    Geometry
+        kind "pairs", coordinates theta_i, phi_i, theta_o, phi_o (radians) of the directions;
+        pairs below the horizon dropped.
+
+    Examples
+    --------
+    >>> g = pairs([[0, 0, 1], [1, 0, 0]], [[0, 0, 1], [0, 0, 1]])
+    >>> len(g), g.info["dropped_below_horizon"]
+    (1, 1)
+    """
+    wi = np.asarray(wi, float)
+    wo = np.asarray(wo, float)
+    if wi.ndim != 2 or wi.shape[1] != 3 or wo.shape != wi.shape:
+        raise ValueError(f"wi and wo must both have shape (n, 3); got {wi.shape} and {wo.shape}")
+    ni = np.linalg.norm(wi, axis=1, keepdims=True)
+    no = np.linalg.norm(wo, axis=1, keepdims=True)
+    if not (np.all(np.isfinite(ni) & (ni > 0)) and np.all(np.isfinite(no) & (no > 0))):
+        raise ValueError("wi and wo must hold finite, non-zero directions")
+    wi, wo = wi / ni, wo / no
+    ti, pi_ = angles_from_directions(wi)
+    to, po = angles_from_directions(wo)
+    return _build("pairs", dict(params or {}), wi, wo,
+                  {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}, rotation)
+
+
+def pairs_from_angles(theta_i, phi_i, theta_o, phi_o, *, degrees: bool = True,
+                      rotation: float = 0.0, params: dict | None = None) -> Geometry:
+    """An arbitrary list of pairs from their angles (such as CUReT's 205 configurations).
+
+    Parameters
+    ----------
+    theta_i, phi_i, theta_o, phi_o : array_like, shape (n,)
+        Polar angles and azimuths of light and view; degrees, or radians with
+        ``degrees=False``.
+    rotation : float
+        Sample rotation, radians.
+
+    Returns
+    -------
+    Geometry
+        kind "pairs"; the coordinates are the given angles (in radians), pairs below the
+        horizon dropped.
+
+    Examples
+    --------
+    >>> g = pairs_from_angles([30, 95], [0, 0], [30, 30], [180, 180])
+    >>> len(g), g.wo[0].round(6)
+    (1, array([-0.5     ,  0.      ,  0.866025]))
+    """
+    arrs = [np.atleast_1d(np.asarray(a, float)) for a in (theta_i, phi_i, theta_o, phi_o)]
+    try:
+        arrs = np.broadcast_arrays(*arrs)
+    except ValueError:
+        raise ValueError("theta_i, phi_i, theta_o, phi_o must have the same length; got "
+                         + ", ".join(str(a.shape) for a in arrs)) from None
+    arrs = [a.reshape(-1) for a in arrs]
+    if not all(np.all(np.isfinite(a)) for a in arrs):
+        raise ValueError("pair angles must be finite")
+    if degrees:
+        arrs = [np.radians(a) for a in arrs]
+    ti, pi_, to, po = arrs
+    wi = directions_from_angles(ti, pi_)
+    wo = directions_from_angles(to, po)
+    return _build("pairs", dict(params or {}), wi, wo,
+                  {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}, rotation)
+
+
+def _read_pairs_csv(path) -> Geometry:
+    """Read theta_i,phi_i,theta_o,phi_o (degrees) from a CSV; '#' lines are comments."""
+    path = Path(path)
+    need = ("theta_i", "phi_i", "theta_o", "phi_o")
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot read pairs file: {exc.strerror}", str(path)) from None
+    rows, header, cols = [], None, None
+    for lineno, line in enumerate(text.splitlines(), 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        fields = [f.strip() for f in next(csv.reader([line]))]
+        if header is None:
+            header = fields
+            missing = [c for c in need if c not in header]
+            if missing:
+                raise ValueError(f"{path}: line {lineno}: header lacks column(s) "
+                                 f"{', '.join(missing)}; need {','.join(need)} (degrees)")
+            cols = [header.index(c) for c in need]
+            continue
+        if len(fields) != len(header):
+            raise ValueError(f"{path}: line {lineno}: {len(fields)} fields, header has "
+                             f"{len(header)}")
+        try:
+            rows.append([float(fields[c]) for c in cols])
+        except ValueError:
+            raise ValueError(f"{path}: line {lineno}: not a number in "
+                             f"{','.join(fields[c] for c in cols)!r}") from None
+    if not rows:
+        raise ValueError(f"{path}: no pairs (need a header {','.join(need)} and rows)")
+    a = np.asarray(rows)
+    return pairs_from_angles(*a.T, degrees=True, params={"file": str(path)})
+
+
+def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
+    """Build a geometry from a compact string; see :meth:`Geometry.from_spec`.
+
+    Examples
+    --------
+    >>> from_spec("full:30").spec
+    'full:30:30:30:30'
+    >>> from_spec("plane:45:45:0").spec
+    'plane:45:45:0'
+    """
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"geometry spec must be a non-empty string; got {spec!r}; use {SPEC_HELP}")
+    s = spec.strip()
+    kind, _, rest = s.partition(":")
+    kind = kind.lower()
+    args = rest.split(":") if rest else []
+
+    def bad(why):
+        return ValueError(f"geometry spec {spec!r}: {why}; use {SPEC_HELP}")
+
+    def num(x, what):
+        try:
+            return float(x)
+        except ValueError:
+            raise bad(f"{what} {x!r} is not a number") from None
+
+    try:
+        if kind == "full":
+            if len(args) not in (1, 2, 4):
+                raise bad("full takes 1, 2 or 4 steps")
+            v = [num(a, "step") for a in args]
+            if len(v) == 1:
+                return full_grid(v[0], rotation=rotation)
+            if len(v) == 2:
+                return full_grid(v[0], v[1], rotation=rotation)
+            return full_grid(v[0], v[1], theta_o_step=v[2], phi_o_step=v[3], rotation=rotation)
+        if kind == "plane":
+            if len(args) not in (2, 3):
+                raise bad("plane takes WHICH:STEP[:THETA_I,...]")
+            which = args[0].lower()
+            if which not in _PLANE_NAMES and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
+                raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
+            step = num(args[1], "step")
+            if len(args) == 3:
+                ti = [num(t, "theta_i") for t in args[2].split(",") if t.strip()]
+                return plane(which, step, ti, rotation=rotation)
+            return plane(which, step, rotation=rotation)
+        if kind in ("rusinkiewicz", "rus"):
+            if len(args) not in (1, 4):
+                raise bad("rusinkiewicz takes 1 or 4 steps")
+            v = [num(a, "step") for a in args]
+            return rusinkiewicz(*v, rotation=rotation) if len(v) == 4 else \
+                rusinkiewicz(v[0], rotation=rotation)
+        if kind == "merl":
+            if len(args) > 1:
+                raise bad("merl takes at most a stride")
+            if args:
+                if not re.fullmatch(r"\d+", args[0]):
+                    raise bad(f"stride {args[0]!r} is not a positive integer")
+                return merl(int(args[0]), rotation=rotation)
+            return merl(rotation=rotation)
+        if kind == "pairs":
+            if not rest:
+                raise bad("pairs needs a file name")
+            return _read_pairs_csv(rest)
+    except ValueError as exc:
+        if str(exc).startswith("geometry spec"):
+            raise
+        raise ValueError(f"geometry spec {spec!r}: {exc}; use {SPEC_HELP}") from None
+    raise bad(f"unknown kind {kind!r}")

@@ -1,0 +1,134 @@
+"""Read and write BRDF tables, the format chosen by the file name's suffix."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gonio.table import Table
+
+__all__ = ["read", "write", "READ_SUFFIXES", "WRITE_SUFFIXES"]
+
+READ_SUFFIXES = (".exr", ".csv", ".binary", ".alta", ".bsdf", "abrdf.dat")
+WRITE_SUFFIXES = (".exr", ".csv", ".binary", ".alta")
+
+
+def _kind(path: Path, known) -> str:
+    name = path.name.lower()
+    if name == "abrdf.dat" and "abrdf.dat" in known:
+        return "curet"
+    suffix = path.suffix.lower()
+    kinds = {".exr": "exr", ".csv": "csv", ".binary": "merl", ".alta": "alta", ".bsdf": "rgl"}
+    if suffix not in known or suffix not in kinds:
+        raise ValueError(f"{path}: unknown table format {suffix or '(no suffix)'!r}; known: "
+                         + ", ".join(known))
+    return kinds[suffix]
+
+
+def read(path, **options) -> Table:
+    """Read a BRDF table; the format comes from the suffix.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.exr`` (native), ``.csv``, ``.binary`` (MERL: the full grid at bin centres, or
+        ``stride=`` for a sample), ``.alta`` (1-D slice), ``.bsdf`` (RGL: sampled through
+        :func:`gonio.load_rgl` at its theta_i nodes below 90 deg, phi_i = 0, and wo every
+        ``step`` degrees, default 5), or a CUReT ``abrdf.dat`` (needs ``sample=N``; its
+        ``table.txt`` must be beside it).
+    **options
+        Passed to the reader (``stride`` for MERL, ``step`` for RGL, ``sample`` for CUReT).
+
+    Returns
+    -------
+    Table
+
+    Raises
+    ------
+    ValueError
+        Unknown suffix (the message lists the known ones), or a missing option.
+    FormatError
+        The file is not what its name says, truncated or corrupt.
+    """
+    path = Path(path)
+    kind = _kind(path, READ_SUFFIXES)
+    if not path.exists():
+        raise FileNotFoundError(2, "No such file", str(path))
+    if kind == "exr":
+        from gonio.exr import read_exr
+        return read_exr(path, **options)
+    if kind == "csv":
+        from gonio.csvtable import read_csv
+        return read_csv(path, **options)
+    if kind == "merl":
+        from gonio.merl import merl_table
+        return merl_table(path, **options)
+    if kind == "alta":
+        from gonio.alta import read_alta
+        return read_alta(path, **options)
+    if kind == "curet":
+        from gonio.curet import load_curet
+        if "sample" not in options:
+            raise ValueError(f"{path}: a CUReT abrdf.dat holds 61 samples; give one: "
+                             "gonio.read(path, sample=N) or gonio.load_curet(folder, N)")
+        return load_curet(path.parent, options.pop("sample"), **options)
+    return _rgl_table(path, **options)
+
+
+def _rgl_table(path: Path, step: float = 5.0) -> Table:
+    from gonio.exr import count_missing, from_angles
+    from gonio.rgl import load_rgl, read_tensor_file
+
+    fields = read_tensor_file(path)
+    brdf = load_rgl(path)
+    theta_i = np.asarray(fields["theta_i"], np.float64)
+    theta_i = theta_i[theta_i < np.radians(89.9)]
+    if not 0 < step <= 90:
+        raise ValueError(f"read: step must be in (0, 90] degrees; got {step!r}")
+    th_o = np.radians(np.arange(0.0, 90.0 - 1e-9, step))
+    ph_o = np.radians(np.arange(-180.0 + step, 180.0 + 1e-9, step))
+    ti, to, po = (a.ravel() for a in np.meshgrid(theta_i, th_o, ph_o, indexing="ij"))
+    wi, wo = from_angles(ti, np.zeros_like(ti)), from_angles(to, po)
+    values = brdf.eval(wi, wo)
+    meta = {"source": f"RGL {path.name}: {brdf.description}", "file_format": "rgl",
+            "file": str(path), "units": "1/sr",
+            "note": "sampled with gonio.load_rgl (Mitsuba 3 measured-plugin evaluation)",
+            "step_deg": step, "missing_values": count_missing(values)}
+    return Table(wi, wo, values, None, meta)
+
+
+def write(obj, path, **options) -> None:
+    """Write a table (or, for ``.binary``, any BRDF) in the format of the suffix, atomically.
+
+    Parameters
+    ----------
+    obj : Table, or an object with ``eval(wi, wo)`` for ``.binary``
+    path : str or os.PathLike
+        ``.exr`` (native, default choice), ``.csv``, ``.binary`` (MERL), ``.alta``
+        (back-scatter rows only).
+    **options
+        Passed to the writer (``digits`` for CSV/ALTA, ``rotations`` for MERL).
+
+    Raises
+    ------
+    ValueError
+        Unknown suffix (the message lists the known ones), or an object the format cannot
+        hold.
+    """
+    path = Path(path)
+    kind = _kind(path, WRITE_SUFFIXES)
+    if kind == "merl":
+        from gonio.merl import write_merl
+        return write_merl(obj, path, **options)
+    if not isinstance(obj, Table):
+        raise ValueError(f"write: {path.suffix} holds a Table, got {type(obj).__name__} "
+                         "(measure a BRDF first, or write it to .binary)")
+    if kind == "exr":
+        from gonio.exr import write_exr
+        return write_exr(obj, path, **options)
+    if kind == "csv":
+        from gonio.csvtable import write_csv
+        return write_csv(obj, path, **options)
+    from gonio.alta import write_alta
+    return write_alta(obj, path, **options)

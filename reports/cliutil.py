@@ -1,0 +1,109 @@
+"""Pieces shared by the command-line verbs: fabric options, angle pairs, atomic writes."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import brdf
+
+__all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "atomic_write_text",
+           "check_writable_dir"]
+
+
+def _on_off(value: str) -> bool:
+    v = value.lower()
+    if v in ("on", "true", "yes", "1"):
+        return True
+    if v in ("off", "false", "no", "0"):
+        return False
+    raise argparse.ArgumentTypeError(f"expected on or off, got {value!r}")
+
+
+def add_fabric_options(parser: argparse.ArgumentParser) -> None:
+    """Add the model's variant flags (MODEL.md toggles) to a sub-command parser."""
+    g = parser.add_argument_group("model variants")
+    g.add_argument("--masking", type=_on_off, default=True, metavar="on|off",
+                   help="shadowing and masking M (default on)")
+    g.add_argument("--reweighting", type=_on_off, default=True, metavar="on|off",
+                   help="reweighting by visible length P and Q (default on)")
+    g.add_argument("--tangent-samples", type=int, default=32, metavar="N",
+                   help="samples per tangent curve (default 32)")
+    g.add_argument("--tangent-sampling", default="midpoint",
+                   choices=brdf.SAMPLING_METHODS, help="tangent curve rule (default midpoint)")
+    g.add_argument("--transmission", default="half_angle", choices=brdf.TRANSMISSION_METHODS,
+                   help="F_T variant (default half_angle)")
+    g.add_argument("--gap", default="incident", choices=brdf.GAP_METHODS,
+                   help="gap term c_gap of Q (default incident)")
+    g.add_argument("--rotation", type=float, default=0.0, metavar="DEG",
+                   help="fabric rotation about the normal, degrees (default 0)")
+
+
+def fabric_from_args(name: str, args: argparse.Namespace) -> brdf.Fabric:
+    """The preset ``name`` with the variant flags of ``add_fabric_options``."""
+    return brdf.fabric(name, masking=args.masking, reweighting=args.reweighting,
+                       tangent_samples=args.tangent_samples,
+                       tangent_sampling=args.tangent_sampling,
+                       transmission=args.transmission, gap=args.gap,
+                       rotation=math.radians(args.rotation))
+
+
+def parse_angle_pair(text: str) -> tuple[float, float]:
+    """Parse ``THETA,PHI`` in degrees (argparse type)."""
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        theta, phi = (float(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected THETA,PHI in degrees (e.g. 30,0), got {text!r}") from None
+    if not (math.isfinite(theta) and math.isfinite(phi)):
+        raise argparse.ArgumentTypeError(f"angles must be finite, got {text!r}")
+    return theta, phi
+
+
+def check_writable_dir(path: Path) -> Path:
+    """Create ``path`` if needed and check that files can be written in it.
+
+    Raises
+    ------
+    OSError
+        If the folder cannot be created or written, naming it.
+    """
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path, prefix=".write-test-"):
+            pass
+    except OSError as exc:
+        raise OSError(f"output folder {str(path)!r} is not writable: {exc.strerror or exc}") \
+            from None
+    return path
+
+
+def atomic_write_text(path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file renamed into place."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def atomic_write_json(path, data) -> None:
+    """JSON version of :func:`atomic_write_text` (indented, NaN as null is not attempted)."""
+    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=False) + "\n")

@@ -1,0 +1,121 @@
+"""The ``microcyl render`` verb: render a scene of cloth to OpenEXR and PNG.
+
+    microcyl render SCENE FABRIC [--masking on|off] [--reweighting on|off]
+        [--tangent-samples N] [--tangent-sampling midpoint|control_points]
+        [--transmission half_angle|longitudinal] [--gap incident|outgoing] [--rotation DEG]
+        [--width 1280] [--height 720] [--spp 16] [--exposure 0] [--seed 0]
+        [--light-radius R] [--workers N] [--quiet] -o out.exr
+
+``-o out.exr`` writes the float32 linear EXR and an sRGB PNG beside it (``out.png``);
+``-o out.png`` writes the PNG only.  Every argument is checked (scene, fabric and its
+options, size, output folder) before rendering starts.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+__all__ = ["register", "run"]
+
+
+def _on_off(value):
+    v = value.lower()
+    if v in ("on", "true", "yes", "1"):
+        return True
+    if v in ("off", "false", "no", "0"):
+        return False
+    raise ValueError(f"{value!r} must be on or off")
+
+
+def register(sub):
+    """Add ``render`` to the ``microcyl`` sub-parsers."""
+    p = sub.add_parser(
+        "render", help="render a scene of cloth (curtain, cylinder, sphere, patch)",
+        description="Render a scene of cloth shaded with the microcylinder BRDF to a float32 "
+                    "OpenEXR (linear RGB) and an sRGB PNG.")
+    p.add_argument("scene", metavar="SCENE", help="curtain, cylinder, sphere or patch")
+    p.add_argument("fabric", metavar="FABRIC", help="a preset name (see `microcyl fabrics`)")
+    p.add_argument("--masking", metavar="on|off", help="shadowing and masking (default on)")
+    p.add_argument("--reweighting", metavar="on|off",
+                   help="reweighting by visible length (default on)")
+    p.add_argument("--tangent-samples", type=int, metavar="N", help="samples per tangent curve")
+    p.add_argument("--tangent-sampling", metavar="RULE", help="midpoint or control_points")
+    p.add_argument("--transmission", metavar="RULE", help="half_angle or longitudinal")
+    p.add_argument("--gap", metavar="RULE", help="incident or outgoing")
+    p.add_argument("--rotation", type=float, metavar="DEG",
+                   help="fabric rotation about the normal, degrees")
+    p.add_argument("--width", type=int, default=1280, help="pixels, at most 1280 (1280)")
+    p.add_argument("--height", type=int, default=720, help="pixels, at most 720 (720)")
+    p.add_argument("--spp", type=int, default=16, help="samples per pixel (16)")
+    p.add_argument("--exposure", type=float, default=0.0, help="PNG exposure, stops (0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    p.add_argument("--light-radius", type=float, default=None, metavar="R",
+                   help="turn the scene's point light into a disc of this radius")
+    p.add_argument("--workers", type=int, default=None, help="processes (all cores)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("-o", "--output", required=True, metavar="FILE",
+                   help="out.exr (writes out.png beside it) or out.png")
+    p.set_defaults(func=run)
+
+
+def _fabric_options(args):
+    opts = {}
+    for name in ("masking", "reweighting"):
+        value = getattr(args, name)
+        if value is not None:
+            try:
+                opts[name] = _on_off(value)
+            except ValueError:
+                raise ValueError(f"--{name} {value!r}: must be on or off") from None
+    if args.tangent_samples is not None:
+        if args.tangent_samples < 1:
+            raise ValueError(f"--tangent-samples {args.tangent_samples}: must be at least 1")
+        opts["tangent_samples"] = args.tangent_samples
+    for name in ("tangent_sampling", "transmission", "gap"):
+        value = getattr(args, name)
+        if value is not None:
+            opts[name] = value
+    if args.rotation is not None:
+        opts["rotation"] = math.radians(args.rotation)
+    return opts
+
+
+def run(args):
+    """Check every argument, render, write the files; return 0."""
+    from reports import imageio
+    from reports.render import check_size, render, resolve_fabric
+    from reports.scenes import make_scene
+
+    scene = make_scene(args.scene)
+    check_size(args.width, args.height, args.spp)
+    if not math.isfinite(args.exposure):
+        raise ValueError(f"--exposure {args.exposure}: must be a finite number of stops")
+    out = Path(args.output)
+    suffix = out.suffix.lower()
+    if suffix not in (".exr", ".png"):
+        raise ValueError(f"-o {args.output}: the output must end in .exr or .png")
+    imageio.check_output(out)
+    fabric = resolve_fabric(args.fabric, **_fabric_options(args))
+    if args.light_radius is not None:
+        if not (args.light_radius >= 0 and math.isfinite(args.light_radius)):
+            raise ValueError(f"--light-radius {args.light_radius}: must be >= 0")
+        from dataclasses import replace
+        if not hasattr(scene.light, "radius"):
+            raise ValueError(f"--light-radius: scene {args.scene!r} has a directional light")
+        scene = scene.replace(light=replace(scene.light, radius=args.light_radius))
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers {args.workers}: must be at least 1")
+
+    image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
+                   seed=args.seed, progress=not args.quiet, workers=args.workers)
+    written = []
+    if suffix == ".exr":
+        written.append(imageio.write_exr(out, image))
+        written.append(imageio.write_png(out.with_suffix(".png"), image, args.exposure))
+    else:
+        written.append(imageio.write_png(out, image, args.exposure))
+    if not args.quiet:
+        print("wrote " + ", ".join(str(w) for w in written), file=sys.stderr)
+    return 0

@@ -1,0 +1,181 @@
+"""Image files: float32 OpenEXR (linear RGB) and 8-bit sRGB PNG, written atomically.
+
+Both writers put the file in a temporary file in the target folder and move it into place
+with :func:`os.replace`, so an interrupted write (Ctrl-C included) leaves no partial file.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["write_exr", "read_exr", "write_png", "encode_srgb", "check_output"]
+
+
+def _check_rgb(rgb):
+    a = np.asarray(rgb)
+    if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1 or a.shape[1] < 1:
+        raise ValueError(f"image of shape {a.shape} must be (height, width, 3)")
+    return a
+
+
+def check_output(path):
+    """Raise OSError at once unless the folder of ``path`` exists and is writable.
+
+    Examples
+    --------
+    >>> check_output("/nonexistent-folder/out.exr")
+    Traceback (most recent call last):
+    ...
+    FileNotFoundError: output folder /nonexistent-folder does not exist
+    """
+    folder = Path(path).resolve().parent
+    if not folder.is_dir():
+        raise FileNotFoundError(f"output folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise PermissionError(f"output folder {folder} is not writable")
+    if Path(path).is_dir():
+        raise IsADirectoryError(f"output {path} is a folder")
+
+
+def _atomic(path, write):
+    """Call ``write(tmp_path)`` then move the temporary file onto ``path``."""
+    path = Path(path)
+    check_output(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.resolve().parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
+
+
+def write_exr(path, rgb):
+    """Write linear RGB as a float32 OpenEXR file (one ``RGB`` channel group, ZIP).
+
+    Parameters
+    ----------
+    path : str or Path
+        Output file.
+    rgb : (height, width, 3) array_like
+        Linear radiance; stored as float32.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "x.exr"
+    >>> _ = write_exr(out, np.full((2, 3, 3), 0.25))
+    >>> read_exr(out)[1, 2].tolist()
+    [0.25, 0.25, 0.25]
+    """
+    import OpenEXR
+
+    a = np.ascontiguousarray(_check_rgb(rgb), dtype=np.float32)
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+
+    def write(tmp):
+        with OpenEXR.File(header, {"RGB": a}) as f:
+            f.write(str(tmp))
+
+    return _atomic(path, write)
+
+
+def read_exr(path):
+    """Read an RGB OpenEXR file written by :func:`write_exr`: (height, width, 3) float32.
+
+    Raises
+    ------
+    ValueError
+        If the file is not a readable OpenEXR image with R, G and B channels.
+    """
+    import OpenEXR
+
+    try:
+        with OpenEXR.File(str(path)) as f:
+            ch = f.channels()
+            if "RGB" in ch:
+                return np.asarray(ch["RGB"].pixels, dtype=np.float32)
+            return np.stack([np.asarray(ch[c].pixels, np.float32) for c in "RGB"], axis=-1)
+    except (KeyError, RuntimeError) as exc:
+        raise ValueError(f"{path}: not a readable RGB OpenEXR file ({exc})") from None
+
+
+def _colour():
+    """Import colour-science, keeping NumPy's print options (its import sets legacy="1.13",
+    which would change every later array repr, doctests included)."""
+    options = np.get_printoptions()
+    import colour
+    np.set_printoptions(**options)
+    return colour
+
+
+def encode_srgb(rgb, exposure=0.0):
+    """Linear RGB -> sRGB-encoded values in [0, 1] (colour-science's sRGB CCTF).
+
+    Parameters
+    ----------
+    rgb : array_like
+        Linear values.
+    exposure : float
+        Stops: the values are multiplied by ``2 ** exposure`` before encoding.
+
+    Returns
+    -------
+    ndarray
+        ``cctf_encoding(clip(rgb * 2**exposure, 0, 1), "sRGB")``.
+
+    Examples
+    --------
+    >>> np.round(encode_srgb(np.array([0.0, 0.214041, 1.0, 4.0])), 6).tolist()
+    [0.0, 0.5, 1.0, 1.0]
+    """
+    colour = _colour()
+    exposure = float(exposure)
+    if not np.isfinite(exposure):
+        raise ValueError(f"exposure={exposure} must be a finite number of stops")
+    x = np.asarray(rgb, dtype=np.float64) * 2.0 ** exposure
+    x = np.clip(np.nan_to_num(x, nan=0.0, posinf=1.0), 0.0, 1.0)
+    return np.asarray(colour.cctf_encoding(x, function="sRGB"))
+
+
+def write_png(path, rgb, exposure=0.0):
+    """Write linear RGB as an 8-bit sRGB PNG (values scaled by ``2 ** exposure``, clipped).
+
+    Parameters
+    ----------
+    path : str or Path
+        Output file.
+    rgb : (height, width, 3) array_like
+        Linear radiance.
+    exposure : float
+        Exposure in stops.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    from PIL import Image
+
+    a = _check_rgb(rgb)
+    q = np.round(encode_srgb(a, exposure) * 255.0).astype(np.uint8)
+
+    def write(tmp):
+        Image.fromarray(q).save(tmp, format="PNG")
+
+    return _atomic(path, write)

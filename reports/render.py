@@ -1,0 +1,348 @@
+"""A small NumPy ray tracer for cloth shaded with the microcylinder BRDF.
+
+:func:`render` traces one camera ray per sample (stratified jitter, seeded), finds the first
+hit among the scene's primitives, samples the light directly with a shadow ray, and shades
+cloth with ``fabric.eval(wi_local, wo_local)`` and everything else as Lambertian.  Only
+samples that hit lit cloth reach the BRDF, in batches of one image tile at a time, and tiles
+are spread over the processor cores.  :func:`write_exr` and :func:`write_png` (from
+:mod:`reports.imageio`) save the result.
+
+Shading (one light sample per camera sample, no indirect light):
+
+    L_o = f_r(wi, wo) * E * cos(theta_i) * V
+
+with ``E`` the light's irradiance normal to ``wi`` (point light: ``I / r^2``; disc light:
+``I cos(theta_l) / r^2``; directional light: its irradiance), ``cos(theta_i) = n . wi``,
+and ``V`` the visibility (0 or 1) from the shadow ray.  Diffuse surfaces use
+``f_r = albedo / pi``.  Cloth is two-sided: the normal is turned toward the viewer, keeping
+the warp, and ``wi``, ``wo`` are expressed in (x = warp, y = n x warp, z = n).  A pixel is
+the mean of its samples; rays that hit nothing give 0.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+from concurrent.futures import ProcessPoolExecutor, as_completed
+
+import numpy as np
+
+from reports.imageio import write_exr, write_png
+from reports.scenes import SCENES, Scene, make_scene
+
+__all__ = ["render", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT", "SCENES",
+           "resolve_fabric", "check_size"]
+
+#: Largest image the renderer accepts, pixels.
+MAX_WIDTH, MAX_HEIGHT = 1280, 720
+#: Most samples per pixel accepted.
+MAX_SPP = 4096
+#: Largest number of (wi, wo) pairs passed to one ``fabric.eval`` call.
+BRDF_BATCH = 131072
+
+
+def check_size(width, height, spp=16):
+    """Raise ValueError unless ``0 < width <= 1280``, ``0 < height <= 720`` and
+    ``0 < spp <= 4096`` (all integers).
+
+    Examples
+    --------
+    >>> check_size(1280, 720, 16)
+    >>> check_size(1920, 1080)
+    Traceback (most recent call last):
+    ...
+    ValueError: width=1920 is beyond the limit: images are at most 1280 x 720 pixels
+    """
+    for name, value, top in (("width", width, MAX_WIDTH), ("height", height, MAX_HEIGHT)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise ValueError(f"{name}={value!r} must be an integer number of pixels")
+        if value < 1:
+            raise ValueError(f"{name}={value} must be at least 1 pixel")
+        if value > top:
+            raise ValueError(f"{name}={value} is beyond the limit: images are at most "
+                             f"{MAX_WIDTH} x {MAX_HEIGHT} pixels")
+    if isinstance(spp, bool) or not isinstance(spp, (int, np.integer)) or not 1 <= spp <= MAX_SPP:
+        raise ValueError(f"spp={spp!r} must be an integer from 1 to {MAX_SPP}")
+
+
+def resolve_fabric(fabric, **options):
+    """A BRDF object from a preset name (through ``brdf.fabric``) or any object with ``.eval``.
+
+    Parameters
+    ----------
+    fabric : str or object
+        A name in ``brdf.PRESETS`` or an object whose ``eval(wi, wo)`` returns (..., 3) f_r.
+    **options
+        Passed to ``brdf.fabric`` with a name, or to ``fabric.replace`` with an object.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name or an object without ``eval``.
+    """
+    if isinstance(fabric, str):
+        import brdf
+        presets = tuple(getattr(brdf, "PRESETS", ()))
+        if fabric not in presets:
+            raise ValueError(f"fabric {fabric!r} is unknown; choose one of "
+                             f"{', '.join(presets) if presets else '(no presets available)'}")
+        return brdf.fabric(fabric, **options)
+    if not callable(getattr(fabric, "eval", None)):
+        raise ValueError(f"fabric={fabric!r} must be a preset name or have an eval(wi, wo) method")
+    if options:
+        return fabric.replace(**options)
+    return fabric
+
+
+# --------------------------------------------------------------------------- tracing
+def _intersect(prims, o, d, tmin):
+    """Nearest hit: t (inf on a miss), primitive index and part index."""
+    n = len(o)
+    best = np.full(n, np.inf)
+    pid = np.full(n, -1, np.int16)
+    part = np.zeros(n, np.int8)
+    for k, prim in enumerate(prims):
+        t, pt = prim.intersect(o, d, tmin)
+        closer = t < best
+        best = np.where(closer, t, best)
+        pid[closer] = k
+        part[closer] = pt[closer]
+    return best, pid, part
+
+
+def _occluded(prims, o, d, tmax, tmin):
+    """True where a primitive lies between ``o`` and ``o + tmax d``."""
+    hit = np.zeros(len(o), bool)
+    for prim in prims:
+        rest = np.nonzero(~hit)[0]
+        if rest.size == 0:
+            break
+        t, _ = prim.intersect(o[rest], d[rest], tmin)
+        hit[rest] = t < tmax[rest]
+    return hit
+
+
+def _sample_offsets(rng, npix, spp):
+    """Stratified (n-rooks) offsets in [0, 1)^2, shape (npix, spp) each."""
+    k = np.broadcast_to(np.arange(spp), (npix, spp))
+    jx = (k + rng.random((npix, spp))) / spp
+    jy = (rng.permuted(k, axis=1) + rng.random((npix, spp))) / spp
+    return jx, jy
+
+
+def _shade(scene, fabric, o, d, rng):
+    """Radiance (m, 3) of the rays ``(o, d)``."""
+    prims = scene.primitives
+    eps = 1e-6 * scene.scale
+    t, pid, part = _intersect(prims, o, d, eps)
+    out = np.zeros((len(o), 3))
+    hit = np.nonzero(np.isfinite(t))[0]
+    if hit.size == 0:
+        return out
+    p = o[hit] + t[hit, None] * d[hit]
+    wo = -d[hit]
+    n = np.empty((hit.size, 3))
+    warp = np.empty((hit.size, 3))
+    pid_h = pid[hit]
+    for k, prim in enumerate(prims):
+        sel = pid_h == k
+        if sel.any():
+            n[sel], warp[sel] = prim.frame(p[sel], part[hit][sel])
+    # two-sided: face the viewer
+    cos_o = np.einsum("ij,ij->i", n, wo)
+    flip = cos_o < 0
+    n[flip] *= -1
+    cos_o = np.abs(cos_o)
+    wi, dist, E = scene.light.sample(p, rng)
+    cos_i = np.einsum("ij,ij->i", n, wi)
+    lit = (cos_i > 0) & (cos_o > 0) & np.any(E > 0, axis=1)
+    idx = np.nonzero(lit)[0]
+    if idx.size == 0:
+        return out
+    off = 1e-4 * scene.scale
+    blocked = _occluded(prims, p[idx] + off * n[idx], wi[idx], dist[idx] - 2 * off, eps)
+    idx = idx[~blocked]
+    if idx.size == 0:
+        return out
+    rad = np.zeros((idx.size, 3))
+    is_cloth = np.array([getattr(pr, "material", "diffuse") == "cloth" for pr in prims])
+    cloth = is_cloth[pid_h[idx]]
+    # cloth: BRDF in the local frame (x = warp, y = n x warp, z = n)
+    c = idx[cloth]
+    if c.size:
+        nn, uu = n[c], warp[c]
+        vv = np.cross(nn, uu)
+        frame = np.stack([uu, vv, nn], axis=1)                  # (m, 3, 3) rows = axes
+        wi_l = np.einsum("mij,mj->mi", frame, wi[c])
+        wo_l = np.einsum("mij,mj->mi", frame, wo[c])
+        f = np.empty((c.size, 3))
+        for s in range(0, c.size, BRDF_BATCH):
+            f[s:s + BRDF_BATCH] = fabric.eval(wi_l[s:s + BRDF_BATCH], wo_l[s:s + BRDF_BATCH])
+        rad[cloth] = f * (E[c] * cos_i[c, None])
+    # diffuse: albedo / pi
+    dsel = ~cloth
+    if dsel.any():
+        di = idx[dsel]
+        alb = np.array([getattr(pr, "albedo", 0.5) for pr in prims])[pid_h[di]]
+        rad[dsel] = (alb / np.pi * cos_i[di])[:, None] * E[di]
+    out[hit[idx]] = rad
+    return out
+
+
+def _tiles(width, height, tile):
+    out = []
+    for y0 in range(0, height, tile):
+        for x0 in range(0, width, tile):
+            out.append((len(out), y0, min(y0 + tile, height), x0, min(x0 + tile, width)))
+    return out
+
+
+_CTX = {}
+
+
+def _init_worker(ctx):
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent handles Ctrl-C
+    _CTX.clear()
+    _CTX.update(ctx, parent=os.getppid())
+
+
+def _render_tile(tile, ctx=None):
+    if ctx is None:
+        ctx = _CTX
+        if os.getppid() != ctx["parent"]:   # the parent was killed: stop, do not linger
+            os._exit(1)
+    index, y0, y1, x0, x1 = tile
+    width, height, spp = ctx["width"], ctx["height"], ctx["spp"]
+    rng = np.random.default_rng([ctx["seed"], index])
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    npix = ys.size
+    jx, jy = _sample_offsets(rng, npix, spp)
+    sx = (xs.reshape(-1, 1) + jx).ravel()
+    sy = (ys.reshape(-1, 1) + jy).ravel()
+    scene = ctx["scene"]
+    o, d = scene.camera.rays(sx, sy, width, height)
+    rad = _shade(scene, ctx["fabric"], np.ascontiguousarray(o), np.ascontiguousarray(d), rng)
+    img = rad.reshape(npix, spp, 3).mean(axis=1)
+    return tile, img.reshape(y1 - y0, x1 - x0, 3).astype(np.float32)
+
+
+def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None,
+           camera=None, seed=0, progress=True, workers=None, tile=64):
+    """Render a scene with cloth shaded by ``fabric``.
+
+    Parameters
+    ----------
+    scene : str or Scene
+        A name in :data:`reports.scenes.SCENES` (``curtain``, ``cylinder``, ``sphere``,
+        ``patch``) or a :class:`reports.scenes.Scene`.
+    fabric : str or object
+        A preset name (``brdf.fabric(name)`` with default options) or any object with
+        ``eval(wi, wo) -> (..., 3)`` f_r in 1/sr (e.g. ``brdf.fabric("velvet",
+        masking=False)``).
+    width, height : int
+        Image size in pixels, at most 1280 x 720.
+    spp : int
+        Samples per pixel (stratified jitter), 1 to 4096.
+    light : PointLight or DirectionalLight, optional
+        Replaces the scene's light.
+    camera : PinholeCamera or OrthographicCamera, optional
+        Replaces the scene's camera.
+    seed : int
+        Seed of the jitter and light samples; the same seed gives the same image, whatever
+        the number of workers.
+    progress : bool
+        Show a tqdm bar over the tiles.
+    workers : int, optional
+        Processes; default the usable cores.  1 renders in this process.
+    tile : int
+        Tile edge, pixels.
+
+    Returns
+    -------
+    (height, width, 3) float32 ndarray
+        Linear RGB radiance (W / (m^2 sr) for intensities in W/sr).
+
+    Raises
+    ------
+    ValueError
+        For an unknown scene or fabric, a size beyond 1280 x 720, or a bad ``spp``,
+        ``tile`` or ``workers``, before any rendering.
+
+    Notes
+    -----
+    Each sample's radiance is ``f_r(wi, wo) * E * cos(theta_i) * V`` (see the module
+    docstring); ``wi`` and ``wo`` go to ``fabric.eval`` in the local frame (x = warp,
+    y = n x warp, z = n), all lit cloth samples of a tile in one call (at most
+    131072 pairs each).  Tiles run in ``workers`` processes (fork where available).
+
+    Examples
+    --------
+    >>> class Lambert:
+    ...     def eval(self, wi, wo):
+    ...         return np.full(np.broadcast_shapes(wi.shape, wo.shape), 0.5 / np.pi)
+    >>> img = render("patch", Lambert(), width=4, height=3, spp=1, progress=False)
+    >>> img.shape, img.dtype
+    ((3, 4, 3), dtype('float32'))
+    >>> bool(np.allclose(img, 0.5 / np.pi))   # f_r * E * cos(theta_i), E = 1, theta_i = 0
+    True
+    """
+    check_size(width, height, spp)
+    if not isinstance(scene, Scene):
+        if not isinstance(scene, str):
+            raise ValueError(f"scene={scene!r} must be a scene name or a Scene")
+        scene = make_scene(scene)
+    fabric = resolve_fabric(fabric)
+    if isinstance(tile, bool) or not isinstance(tile, (int, np.integer)) or tile < 1:
+        raise ValueError(f"tile={tile!r} must be a positive integer")
+    if workers is None:
+        try:
+            workers = len(os.sched_getaffinity(0))
+        except AttributeError:  # pragma: no cover
+            workers = os.cpu_count() or 1
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise ValueError(f"workers={workers!r} must be a positive integer")
+    if light is not None:
+        scene = scene.replace(light=light)
+    if camera is not None:
+        scene = scene.replace(camera=camera)
+    # one tiny evaluation: a broken BRDF fails now, not after the pool starts
+    z = np.array([[0.0, 0.0, 1.0]])
+    probe = np.asarray(fabric.eval(z, z))
+    if probe.shape != (1, 3):
+        raise ValueError(f"fabric.eval returned shape {probe.shape} for one pair; (1, 3) expected")
+
+    from tqdm.auto import tqdm
+
+    ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
+           "spp": int(spp), "seed": int(seed)}
+    tiles = _tiles(width, height, tile)
+    image = np.zeros((height, width, 3), np.float32)
+    workers = min(workers, len(tiles))
+    def new_bar():
+        return tqdm(total=len(tiles), unit="tile", desc=f"render {scene.name or 'scene'}",
+                    disable=not progress, leave=False)
+
+    if workers == 1:
+        with new_bar() as bar:
+            for t in tiles:
+                (_, y0, y1, x0, x1), img = _render_tile(t, ctx)
+                image[y0:y1, x0:x1] = img
+                bar.update()
+        return image
+    # fork (where available) shares the scene and fabric without pickling; the workers are
+    # started by the first submit, before this process starts any thread of its own (tqdm)
+    methods = multiprocessing.get_all_start_methods()
+    mp = multiprocessing.get_context("fork" if "fork" in methods else None)
+    pool = ProcessPoolExecutor(workers, mp_context=mp, initializer=_init_worker,
+                               initargs=(ctx,))
+    try:
+        futures = [pool.submit(_render_tile, t) for t in tiles]
+        with new_bar() as bar:
+            for fut in as_completed(futures):
+                (_, y0, y1, x0, x1), img = fut.result()
+                image[y0:y1, x0:x1] = img
+                bar.update()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+    return image

@@ -1,0 +1,284 @@
+"""Fabric.eval: hand-computed values, the spec transliteration, and physical properties."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+import brdf
+from brdf import Fabric, Thread
+from spec_reference import SIGMA_U, random_pairs, reference_eval, thread_sample
+
+VARIANTS = [
+    {},
+    {"masking": False},
+    {"reweighting": False},
+    {"masking": False, "reweighting": False},
+    {"transmission": "longitudinal"},
+    {"gap": "outgoing"},
+    {"tangent_sampling": "control_points"},
+    {"tangent_samples": 5},
+    {"rotation": 0.7},
+]
+CASES = list(itertools.product(brdf.PRESETS, VARIANTS))
+IDS = [f"{p}-{'-'.join(f'{k}={v}' for k, v in o.items()) or 'default'}" for p, o in CASES]
+
+
+@pytest.fixture(scope="module")
+def pairs():
+    return random_pairs(300, np.random.default_rng(7))
+
+
+# -- one thread, one tangent sample, worked by hand -------------------------------------------
+def one_thread_fabric(**options):
+    t1 = Thread(1.46, (0.5, 0.3, 0.1), 0.3, 12, 24, 0.7, (0, 0), (1,))
+    t2 = Thread(1.5, (1, 1, 1), 0.5, 10, 20, 0.0, (0, 0), (1,))  # area 0: contributes nothing
+    return Fabric((t1, t2), tangent_samples=1, **options)
+
+
+def fresnel_snell(eta, c):
+    ti = math.acos(c)
+    tt = math.asin(math.sin(ti) / eta)
+    return 0.5 * ((math.sin(ti - tt) / math.sin(ti + tt)) ** 2
+                  + (math.tan(ti - tt) / math.tan(ti + tt)) ** 2)
+
+
+def test_hand_values_one_thread_one_sample():
+    # Thread along x, offset 0: t = x, b = y, n_t = z.
+    wi = np.array([0.48, 0.36, 0.8])
+    wo = np.array([-0.6, 0.0, 0.8])
+    th_i, th_r = math.asin(0.48), math.asin(-0.6)
+    phi_i, phi_r = math.atan2(0.36, 0.8), 0.0
+    psi_i, psi_r = math.atan2(0.48, 0.8), math.atan2(-0.6, 0.8)
+    th_h, th_d = (th_i + th_r) / 2, (th_i - th_r) / 2
+    phi_d, psi_d = phi_i - phi_r, psi_i - psi_r
+    # each term
+    cos_g = math.cos(th_d) * math.cos(phi_d / 2)
+    F = fresnel_snell(1.46, cos_g)
+    assert brdf.terms.fresnel(1.46, cos_g) == pytest.approx(F, rel=1e-13)
+    g_s = math.exp(-th_h**2 / (2 * math.radians(12) ** 2)) / (math.radians(12) * math.sqrt(2 * math.pi))
+    g_v = math.exp(-th_h**2 / (2 * math.radians(24) ** 2)) / (math.radians(24) * math.sqrt(2 * math.pi))
+    assert brdf.terms.gaussian(math.radians(12), th_h) == pytest.approx(g_s, rel=1e-14)
+    u = lambda x: math.exp(-x * x / (2 * math.radians(20) ** 2))  # noqa: E731
+    M = (1 - u(phi_d)) * math.cos(phi_i) * 1.0 + u(phi_d) * min(math.cos(phi_i), 1.0)
+    P = (1 - u(psi_d)) * math.cos(psi_i) * math.cos(psi_r) + u(psi_d) * min(math.cos(psi_i), math.cos(psi_r))
+    assert brdf.terms.pair_weight(math.cos(phi_i), 1.0, phi_d) == pytest.approx(M, rel=1e-14)
+    f_rs = F * math.cos(phi_d / 2) * g_s
+    ci, cr = math.cos(th_i), math.cos(th_r)
+    A = np.array([0.5, 0.3, 0.1])
+    f_rv = (1 - F) ** 2 * ((1 - 0.3) * g_v + 0.3) / (ci + cr) * A
+    f_s = (f_rs + f_rv) / math.cos(th_d) ** 2
+    S = f_s * M * P * ci
+    Q = 0.7 * P + (1 - 0.7) * 0.8
+    expect = 0.7 * S / (Q * 0.8)
+    np.testing.assert_allclose(one_thread_fabric().eval(wi, wo), expect, rtol=1e-13)
+    # the terms of the "outgoing" gap and longitudinal transmission change just what they should
+    Qo = 0.7 * P + 0.3 * 0.8      # n.wo = 0.8 too: the same Q here
+    np.testing.assert_allclose(one_thread_fabric(gap="outgoing").eval(wi, wo),
+                               0.7 * S / (Qo * 0.8), rtol=1e-13)
+    ft_long = (1 - fresnel_snell(1.46, ci)) * (1 - fresnel_snell(1.46, cr))
+    S_long = (f_rs + ft_long / (1 - F) ** 2 * f_rv) / math.cos(th_d) ** 2 * M * P * ci
+    np.testing.assert_allclose(one_thread_fabric(transmission="longitudinal").eval(wi, wo),
+                               0.7 * S_long / (Q * 0.8), rtol=1e-13)
+    # masking and reweighting off: M = P = Q = 1
+    np.testing.assert_allclose(
+        one_thread_fabric(masking=False, reweighting=False).eval(wi, wo),
+        0.7 * f_s * ci / 0.8, rtol=1e-13)
+
+
+def test_simplified_equation_against_direct_evaluation(pairs):
+    """Masking and reweighting off: f_r = sum_j a_j (1/N) sum_t f_s cos(theta_i) / (n . wi)."""
+    wi, wo = pairs
+    for name in brdf.PRESETS:
+        fab = brdf.fabric(name, masking=False, reweighting=False, tangent_samples=16)
+        direct = np.zeros((len(wi), 3))
+        for j, th in enumerate(fab.threads):
+            t0 = np.array([1.0, 0.0, 0.0]) if j == 0 else np.array([0.0, 1.0, 0.0])
+            s = np.zeros((len(wi), 3))
+            total = sum(th.lengths)
+            for m in range(16):
+                a = math.radians(float(th.curve.offset_at((m + 0.5) / 16 * total)))
+                fs_cos, _ = thread_sample(wi, wo, t0, a, th, False, False, "half_angle")
+                s += fs_cos / 16
+            direct += th.area * s
+        direct /= wi[:, 2:3]
+        np.testing.assert_allclose(fab.eval(wi, wo), direct, rtol=1e-11, atol=0)
+
+
+@pytest.mark.parametrize("preset, options", CASES, ids=IDS)
+def test_matches_spec_transliteration(pairs, preset, options):
+    wi, wo = pairs
+    fab = brdf.fabric(preset, **options)
+    np.testing.assert_allclose(fab.eval(wi, wo), reference_eval(fab, wi, wo), rtol=1e-11,
+                               atol=1e-13)
+
+
+# -- properties ------------------------------------------------------------------------------
+@pytest.mark.parametrize("preset, options", CASES, ids=IDS)
+def test_finite_nonnegative_and_broadcasting(pairs, preset, options):
+    wi, wo = pairs
+    fab = brdf.fabric(preset, **options)
+    f = fab.eval(wi, wo)
+    assert f.shape == (len(wi), 3)
+    assert np.all(np.isfinite(f)) and np.all(f >= 0)
+    assert np.any(f > 0)
+    six = fab.eval(wi[:6], wo[:6])
+    np.testing.assert_array_equal(fab.eval(wi[:6].reshape(2, 3, 3), wo[:6].reshape(2, 3, 3)),
+                                  six.reshape(2, 3, 3))
+    # one wi against many wo
+    np.testing.assert_allclose(fab.eval(wi[0], wo[:5]), fab.eval(np.tile(wi[0], (5, 1)), wo[:5]),
+                               rtol=1e-15)
+
+
+def rotate_z(w, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    return w @ R.T
+
+
+@pytest.mark.parametrize("preset", brdf.PRESETS)
+def test_rotating_fabric_and_directions_together_changes_nothing(pairs, preset):
+    wi, wo = pairs
+    for rho in (0.3, 2.0, -1.2):
+        fab = brdf.fabric(preset)
+        rot = brdf.fabric(preset, rotation=rho)
+        np.testing.assert_allclose(rot.eval(rotate_z(wi, rho), rotate_z(wo, rho)),
+                                   fab.eval(wi, wo), rtol=1e-10, atol=1e-13)
+
+
+@pytest.mark.parametrize("preset", brdf.PRESETS)
+def test_rotation_by_90_degrees_equals_swapping_threads(pairs, preset):
+    # Turned by 90 degrees the weft runs along -x: the same thread as along +x with its tangent
+    # offsets negated. Every preset's weft curve is symmetric under that, so this is a swap.
+    wi, wo = pairs
+    fab = brdf.fabric(preset)
+    t1, t2 = fab.threads
+    swapped = Fabric((t2, t1))
+    np.testing.assert_allclose(fab.replace(rotation=math.pi / 2).eval(wi, wo),
+                               swapped.eval(wi, wo), rtol=1e-10, atol=1e-13)
+
+
+def test_rotation_by_90_degrees_with_asymmetric_weft(pairs):
+    wi, wo = pairs
+    t1 = Thread(1.46, 0.2, 0.3, 8, 16, 0.4, (-10, 40), (1,))
+    t2 = Thread(1.5, 0.3, 0.2, 6, 12, 0.5, (-60, -20), (1,))
+    mirrored = t2.replace(offsets=(60, 20))
+    turned = Fabric((t1, t2), rotation=math.pi / 2)
+    assert not np.allclose(turned.eval(wi, wo), Fabric((t2, t1)).eval(wi, wo))
+    np.testing.assert_allclose(turned.eval(wi, wo), Fabric((mirrored, t1)).eval(wi, wo),
+                               rtol=1e-10, atol=1e-13)
+
+
+@pytest.mark.parametrize("preset", ["linen_plain", "velvet", "polyester_satin_charmeuse"])
+def test_converges_as_tangent_samples_grow(pairs, preset):
+    wi, wo = pairs
+    ref = brdf.fabric(preset, tangent_samples=2048).eval(wi, wo)
+    errs = [np.max(np.abs(brdf.fabric(preset, tangent_samples=n).eval(wi, wo) - ref))
+            for n in (8, 32, 128)]
+    assert errs[0] > errs[1] > errs[2]
+    assert errs[2] < 0.05 * errs[0]
+
+
+def test_zero_below_horizon_and_nan_for_bad_vectors():
+    fab = brdf.fabric("silk_shot")
+    up = np.array([0.3, 0.2, 0.9])
+    wi = np.array([up, [0.3, 0.2, -0.1], [1.0, 0.0, 0.0], [0, 0, 0], [np.nan, 0, 1], up])
+    wo = np.array([up, up, up, up, up, [0.1, 0.0, -1.0]])
+    f = fab.eval(wi, wo)
+    assert np.all(f[0] > 0)
+    np.testing.assert_array_equal(f[[1, 2, 5]], 0.0)
+    assert np.all(np.isnan(f[[3, 4]]))
+    # NaN stays in its own entries
+    np.testing.assert_array_equal(f[0], fab.eval(up, up))
+
+
+def test_non_unit_vectors_are_normalized(pairs):
+    wi, wo = pairs
+    fab = brdf.fabric("velvet")
+    np.testing.assert_allclose(fab.eval(3.0 * wi, 1e-3 * wo), fab.eval(wi, wo), rtol=1e-13)
+    np.testing.assert_allclose(fab.eval(1e200 * wi[:3], wo[:3]), fab.eval(wi[:3], wo[:3]),
+                               rtol=1e-13)
+
+
+def test_eval_threads_sum_to_eval(pairs):
+    wi, wo = pairs
+    fab = brdf.fabric("silk_crepe_de_chine")
+    parts = fab.eval_threads(wi, wo)
+    assert parts.shape == (len(wi), 2, 3)
+    np.testing.assert_allclose(parts.sum(axis=-2), fab.eval(wi, wo), rtol=1e-14)
+
+
+def test_prepare_matches_eval_for_other_parameters(pairs):
+    wi, wo = pairs
+    fab = brdf.fabric("velvet")
+    prep = fab.prepare(wi, wo)
+    changed = [t.replace(eta=1.6, kd=0.5, gamma_s=9, gamma_v=11, area=0.3 + 0.1 * j,
+                         albedo=(0.2, 0.4, 0.6)) for j, t in enumerate(fab.threads)]
+    direct = fab.replace(threads=changed).eval(wi, wo)
+    batch = prep.eval(eta=[[1.46, 1.46], [1.6, 1.6]], kd=[[0.1, 0.1], [0.5, 0.5]],
+                      gamma_s=[[6, 6], [9, 9]], gamma_v=[[12, 12], [11, 11]],
+                      area=[[0.5, 0.5], [0.3, 0.4]],
+                      albedo=[[fab.threads[0].albedo, fab.threads[1].albedo],
+                              [[0.2, 0.4, 0.6]] * 2])
+    assert batch.shape == (2, len(wi), 3)
+    np.testing.assert_allclose(batch[0], fab.eval(wi, wo), rtol=1e-12)
+    np.testing.assert_allclose(batch[1], direct, rtol=1e-12)
+    with pytest.raises(ValueError, match=r"eta must have shape \(\.\.\., 2\)"):
+        prep.eval(eta=[1.4, 1.4, 1.4])
+
+
+# -- bad input -------------------------------------------------------------------------------
+GOOD = dict(eta=1.46, albedo=(0.1, 0.2, 0.3), kd=0.3, gamma_s=12, gamma_v=24, area=0.33,
+            offsets=(-25, 25), lengths=(1,))
+
+
+@pytest.mark.parametrize("field, value, match", [
+    ("eta", 1.0, r"eta must be a finite number with 1.0 < eta; got 1.0"),
+    ("eta", 0.5, "eta must be"),
+    ("kd", 1.2, r"kd must be a finite number with 0.0 <= kd <= 1.0; got 1.2"),
+    ("kd", -0.1, "kd must be"),
+    ("gamma_s", 0.0, r"gamma_s must be a finite angle > 0 degrees; got 0.0"),
+    ("gamma_v", -3, "gamma_v must be a finite angle > 0 degrees"),
+    ("area", -0.1, "area must be"),
+    ("albedo", (0.1, -0.2, 0.3), "albedo must be one or three finite numbers >= 0"),
+    ("albedo", (0.1, 0.2), "albedo must be one or three"),
+    ("offsets", (-25, 95), r"offsets must lie in \[-90, 90\] degrees; got 95.0"),
+    ("lengths", (-1,), "lengths must be finite and >= 0"),
+    ("lengths", (0,), "lengths must sum to more than 0"),
+    ("offsets", (-25, 0, 25), "offsets must have exactly one more entry than lengths"),
+    ("eta", "glass", "eta must be a real number; got 'glass'"),
+])
+def test_bad_thread_parameters(field, value, match):
+    with pytest.raises(ValueError, match=match):
+        Thread(**dict(GOOD, **{field: value}))
+
+
+def test_bad_fabric_input():
+    t = Thread(**GOOD)
+    with pytest.raises(ValueError, match=r"areas must sum to at most 1; got 0.6 \+ 0.6"):
+        Fabric((t.replace(area=0.6), t.replace(area=0.6)))
+    with pytest.raises(ValueError, match="threads must be two brdf.Thread"):
+        Fabric((t,))
+    for opt, val, match in [
+        ("transmission", "fresnel", "transmission must be one of 'half_angle', 'longitudinal'"),
+        ("gap", "none", "gap must be one of 'incident', 'outgoing'"),
+        ("tangent_sampling", "random", "tangent_sampling must be one of"),
+        ("tangent_samples", 0, "tangent_samples must be an integer >= 1; got 0"),
+        ("tangent_samples", 2.5, "tangent_samples must be an integer"),
+        ("masking", "maybe", "masking must be True or False"),
+        ("rotation", float("inf"), "rotation must be a finite angle in radians"),
+        ("colour", 1, "unknown option\\(s\\) 'colour'; valid options are masking"),
+    ]:
+        with pytest.raises(ValueError, match=match):
+            brdf.fabric("linen_plain", **{opt: val})
+
+
+def test_bad_directions():
+    fab = brdf.fabric("linen_plain")
+    with pytest.raises(ValueError, match=r"wi must have shape \(\.\.\., 3\).*got shape \(4, 2\)"):
+        fab.eval(np.ones((4, 2)), np.ones((4, 3)))
+    with pytest.raises(ValueError, match=r"wi and wo must broadcast; got shapes \(4, 3\) and \(5, 3\)"):
+        fab.eval(np.ones((4, 3)), np.ones((5, 3)))
+    with pytest.raises(ValueError, match="wo must"):
+        fab.eval(np.ones(3), 1.0)

@@ -1,0 +1,143 @@
+"""Tests of the ``microcyl measure`` verb (reports/cmd_measure.py)."""
+
+import math
+
+import numpy as np
+import pytest
+
+import brdf
+import gonio
+from reports.cli import main
+
+
+@pytest.fixture
+def written(monkeypatch):
+    """Replace gonio.write by a recorder, to check what would be written without writing."""
+    calls = []
+    monkeypatch.setattr(gonio, "write", lambda table, path: calls.append((table, path)),
+                        raising=False)
+    return calls
+
+
+@pytest.fixture
+def made(monkeypatch):
+    """Record the keyword arguments brdf.fabric receives."""
+    calls = []
+    real = brdf.fabric
+
+    def fabric(name, **kw):
+        calls.append((name, kw))
+        return real(name, **kw)
+
+    monkeypatch.setattr(brdf, "fabric", fabric)
+    return calls
+
+
+def test_measure_good(tmp_path, written, made, capsys):
+    out = tmp_path / "t.exr"
+    status = main(["measure", "velvet", "--geometry", "plane:warp:30", "--snr", "50",
+                   "--floor", "0.001", "--cone-source", "1", "--cone-detector", "2",
+                   "--seed", "1", "--tangent-samples", "4", "--masking", "off",
+                   "--reweighting", "on", "--tangent-sampling", "control_points",
+                   "--transmission", "longitudinal", "--gap", "outgoing",
+                   "--rotation", "30", "-o", str(out)])
+    assert status == 0
+    assert made == [("velvet", {"masking": False, "reweighting": True, "tangent_samples": 4,
+                                "tangent_sampling": "control_points",
+                                "transmission": "longitudinal", "gap": "outgoing"})]
+    (table, path), = written
+    assert path == out and len(table) == 6 * 5
+    m = table.meta
+    assert m["seed"] == 1 and m["units"] == "1/sr" and m["source"]["name"] == "velvet"
+    assert m["instrument"]["snr"] == 50 and m["instrument"]["cone_detector"] == 2
+    assert m["geometry"]["kind"] == "plane" and math.isclose(m["geometry"]["rotation_deg"], 30)
+    assert table.sigma is not None
+    # the rotation turns the sample: the table's directions are in the sample frame
+    assert math.isclose(math.degrees(table.angles[5, 1]), -30, abs_tol=1e-9)  # theta_i 15
+    # same as the Python API with the same settings
+    fab = brdf.fabric("velvet", masking=False, tangent_samples=4,
+                      tangent_sampling="control_points", transmission="longitudinal",
+                      gap="outgoing")
+    ref = gonio.measure(fab, gonio.Geometry.from_spec("plane:warp:30",
+                                                      rotation=math.radians(30)),
+                        gonio.Instrument(cone_source=1, cone_detector=2, snr=50, floor=0.001),
+                        seed=1)
+    assert np.array_equal(ref.values, table.values)
+    assert "velvet: 30 pairs" in capsys.readouterr().out
+
+
+def test_measure_defaults_pass_no_options(tmp_path, written, made):
+    assert main(["measure", "linen_plain", "--geometry", "plane:weft:45:0",
+                 "-o", str(tmp_path / "a.csv")]) == 0
+    assert made == [("linen_plain", {})]
+    (table, _), = written
+    assert table.sigma is None and table.meta["seed"] is None
+
+
+def test_unknown_fabric(tmp_path, written, capsys):
+    status = main(["measure", "tweed", "-o", str(tmp_path / "t.exr")])
+    err = capsys.readouterr().err.strip()
+    assert status == 1 and "\n" not in err
+    assert "unknown fabric 'tweed'" in err
+    for name in brdf.PRESETS:
+        assert name in err
+    assert not written
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--geometry", "sphere:3"], "unknown kind 'sphere'"),
+    (["--geometry", "full:0"], "theta_step"),
+    (["--snr", "-5"], "snr"),
+    (["--floor", "-1"], "floor"),
+    (["--cone-detector", "95"], "cone_detector"),
+    (["--seed", "-3"], "--seed"),
+    (["--tangent-samples", "0"], "--tangent-samples"),
+    (["--rotation", "nan"], "--rotation"),
+])
+def test_bad_values_exit_1(tmp_path, written, capsys, args, match):
+    status = main(["measure", "velvet", *args, "-o", str(tmp_path / "t.exr")])
+    err = capsys.readouterr().err.strip()
+    assert status == 1 and match in err and "\n" not in err
+    assert err.startswith("microcyl measure: error:")
+    assert not written
+
+
+@pytest.mark.parametrize("args", [
+    ["--masking", "maybe"],
+    ["--gap", "sideways"],
+    ["--snr", "lots"],
+    [],                                    # no -o
+])
+def test_usage_errors_exit_2(capsys, args):
+    with pytest.raises(SystemExit) as exc:
+        main(["measure", "velvet", *args])
+    assert exc.value.code == 2
+    assert "\n" not in capsys.readouterr().err.strip()
+
+
+def test_missing_writer_is_a_clear_error(tmp_path, monkeypatch, capsys):
+    monkeypatch.delattr(gonio, "write", raising=False)
+    import sys
+    monkeypatch.setitem(sys.modules, "gonio.io", None)       # as if gonio/io.py were absent
+    status = main(["measure", "velvet", "--geometry", "plane:warp:45:0",
+                   "-o", str(tmp_path / "t.exr")])
+    err = capsys.readouterr().err
+    assert status == 1 and "needs gonio.write" in err
+    assert not (tmp_path / "t.exr").exists()
+
+
+def test_missing_output_folder(tmp_path, written, capsys):
+    status = main(["measure", "velvet", "-o", str(tmp_path / "nope" / "t.exr")])
+    assert status == 1 and "output folder does not exist" in capsys.readouterr().err
+    assert not written
+
+
+def test_measure_writes_a_readable_table(tmp_path):
+    out = tmp_path / "t.exr"
+    assert main(["measure", "silk_shot", "--geometry", "plane:warp:30", "--snr", "40",
+                 "--seed", "2", "--tangent-samples", "4", "-o", str(out)]) == 0
+    table = gonio.read(out)
+    fab = brdf.fabric("silk_shot", tangent_samples=4)
+    ref = gonio.measure(fab, "plane:warp:30", gonio.Instrument(snr=40), seed=2)
+    assert len(table) == len(ref)
+    assert np.allclose(table.values, ref.values, rtol=1e-6, atol=1e-7)   # float32 on disk

@@ -1,0 +1,64 @@
+"""Atomic writes leave nothing behind when the writer fails midway, even on Ctrl-C."""
+
+import numpy as np
+import pytest
+
+import gonio
+from gonio.atomic import atomic_write
+from tests._gonio_helpers import random_table
+
+
+@pytest.mark.parametrize("exc", [RuntimeError, KeyboardInterrupt])
+def test_nothing_left_behind(tmp_path, exc):
+    with pytest.raises(exc):
+        with atomic_write(tmp_path / "x.bin") as f:
+            f.write(b"half of it")
+            raise exc()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_old_file_kept_when_writer_fails(tmp_path, monkeypatch):
+    p = tmp_path / "t.csv"
+    gonio.write(random_table(0), p)
+    before = p.read_bytes()
+
+    calls = {"n": 0}
+    real = np.isfinite
+
+    def boom(x, *a, **k):  # fails after some rows were written
+        calls["n"] += 1
+        if calls["n"] > 200:
+            raise KeyboardInterrupt
+        return real(x, *a, **k)
+
+    monkeypatch.setattr("gonio.csvtable.np.isfinite", boom)
+    with pytest.raises(KeyboardInterrupt):
+        gonio.write(random_table(1, n=500), p)
+    monkeypatch.undo()
+    assert p.read_bytes() == before
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["t.csv"]
+
+
+def test_exr_and_merl_writers_clean_up(tmp_path, monkeypatch):
+    class Broken:
+        def __init__(self):
+            self.n = 0
+
+        def eval(self, wi, wo):
+            self.n += 1
+            if self.n > 3:
+                raise RuntimeError("model failed midway")
+            return np.full(np.shape(wi), 0.1)
+
+    with pytest.raises(RuntimeError, match="midway"):
+        gonio.write(Broken(), tmp_path / "m.binary", rotations=1)
+    import OpenEXR
+
+    def failing_write(self, name):
+        open(name, "wb").write(b"partial")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(OpenEXR.File, "write", failing_write)
+    with pytest.raises(RuntimeError, match="disk full"):
+        gonio.write(random_table(2), tmp_path / "t.exr")
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,51 @@
+"""CUReT: all 61 samples load with 205 rows and the angles of table.txt."""
+
+import numpy as np
+import pytest
+
+import gonio
+
+
+def test_all_samples(shared_data):
+    folder = shared_data / "curet"
+    # independent parse of the two files
+    geo = np.loadtxt(folder / "table.txt")
+    raw = np.loadtxt(folder / "abrdf.dat")
+    assert geo.shape == (205, 5) and raw.shape == (61, 206)
+    for sample in range(1, 62):
+        t = gonio.load_curet(folder, sample)
+        assert len(t) == 205
+        np.testing.assert_allclose(t.values, np.repeat(raw[sample - 1, 1:, None], 3, 1))
+        assert t.meta["units"] == "relative" and t.meta["curet_sample"] == sample
+    ang = t.angles
+    # table.txt: theta_v, phi_v (viewer = wo), theta_i, phi_i (light = wi)
+    np.testing.assert_allclose(ang[:, 2], geo[:, 1], atol=1e-9)
+    np.testing.assert_allclose(ang[:, 0], geo[:, 3], atol=1e-9)
+    wrap = lambda a: np.angle(np.exp(1j * a))  # noqa: E731
+    sin_o, sin_i = np.sin(geo[:, 1]) > 1e-9, np.sin(geo[:, 3]) > 1e-9
+    np.testing.assert_allclose(wrap(ang[sin_o, 3] - geo[sin_o, 2]), 0, atol=1e-9)
+    np.testing.assert_allclose(wrap(ang[sin_i, 1] - geo[sin_i, 4]), 0, atol=1e-9)
+    # row 2 by hand: viewer at 0.981748 rad, light at 1.374447 rad, both at phi = 0
+    np.testing.assert_allclose(t.wo[1], [np.sin(0.981748), 0, np.cos(0.981748)], atol=1e-12)
+    np.testing.assert_allclose(t.wi[1], [np.sin(1.374447), 0, np.cos(1.374447)], atol=1e-12)
+    assert np.all(t.wi[:, 2] > 0) and np.all(t.wo[:, 2] > 0)
+
+
+def test_read_dispatch_and_bad_sample(shared_data, tmp_path):
+    t = gonio.read(shared_data / "curet" / "abrdf.dat", sample=44)
+    assert t.meta["curet_sample"] == 44
+    with pytest.raises(ValueError, match="sample"):
+        gonio.read(shared_data / "curet" / "abrdf.dat")
+    for bad in (0, 62, 1.5):
+        with pytest.raises(ValueError, match="1..61"):
+            gonio.load_curet(shared_data / "curet", bad)
+    # a truncated abrdf.dat
+    (tmp_path / "table.txt").write_text((shared_data / "curet" / "table.txt").read_text())
+    lines = (shared_data / "curet" / "abrdf.dat").read_text().splitlines()
+    (tmp_path / "abrdf.dat").write_text("\n".join(lines[:30]) + "\n")
+    with pytest.raises(gonio.FormatError, match=r"abrdf.dat: wrong size: 30 rows"):
+        gonio.load_curet(tmp_path, 1)
+    lines[4] = lines[4][: len(lines[4]) // 2]
+    (tmp_path / "abrdf.dat").write_text("\n".join(lines) + "\n")
+    with pytest.raises(gonio.FormatError, match=r"abrdf.dat: line 5: expected 206"):
+        gonio.load_curet(tmp_path, 1)

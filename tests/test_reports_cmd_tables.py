@@ -1,0 +1,39 @@
+"""`microcyl convert` and `microcyl info`."""
+
+import numpy as np
+
+import gonio
+from reports.cli import main
+from tests._gonio_helpers import random_table
+
+
+def test_convert_and_info(tmp_path, capsys):
+    src = tmp_path / "t.exr"
+    gonio.write(random_table(0), src)
+    assert main(["convert", str(src), str(tmp_path / "t.csv")]) == 0
+    back = gonio.read(tmp_path / "t.csv")
+    assert len(back) == 50
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "t.csv")]) == 0
+    out = capsys.readouterr().out
+    assert "source: test" in out and "rows: 50" in out
+    assert "missing values: 2 of 150 (NaN 1, negative 1" in out
+    theta_i = np.degrees(back.angles[:, 0])
+    assert f"theta_i: {theta_i.min():.4g} .. {theta_i.max():.4g} deg" in out
+
+
+def test_curet_info(shared_data, capsys):
+    assert main(["info", str(shared_data / "curet" / "abrdf.dat"), "--sample", "44"]) == 0
+    out = capsys.readouterr().out
+    assert "CUReT sample 44" in out and "rows: 205" in out and "relative" in out
+
+
+def test_errors_are_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("theta_i,phi_i,theta_o,phi_o,value\n0,0,0,0,1\n1,2,3\n")
+    assert main(["convert", str(bad), str(tmp_path / "out.exr")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "bad.csv: line 3" in err
+    assert not (tmp_path / "out.exr").exists()
+    assert main(["info", str(tmp_path / "x.unknown")]) == 1
+    assert "known: .exr" in capsys.readouterr().err

@@ -127,7 +127,7 @@ def _white(threads):
 
 def white_furnace(presets=None, *, scan=None, variant: str = "default", theta_deg=SCAN_THETA,
                   phi_deg=SCAN_PHI, modes=("furnace", "reflectance"), tol: float = 2e-3,
-                  workers=None, progress=None) -> list[dict[str, Any]]:
+                  min_level: int = -1, workers=None, progress=None) -> list[dict[str, Any]]:
     """White-furnace scan: A = 1 on both threads, one parameter varied at a time.
 
     Parameters
@@ -147,6 +147,8 @@ def white_furnace(presets=None, *, scan=None, variant: str = "default", theta_de
         Keys of :data:`MODES`.
     tol : float, default 2e-3
         Albedo tolerance (deciding "above 1" does not need 1e-3).
+    min_level : int, default -1
+        Coarsest level of :func:`analysis.albedo` (-1: start with the cheap pair of levels).
     workers : int, optional
         Processes.
     progress : callable, optional
@@ -185,7 +187,8 @@ def white_furnace(presets=None, *, scan=None, variant: str = "default", theta_de
             configs.append({"curves": name, "parameter": param, "value": val,
                             "variant": variant})
             for mode in modes:
-                tasks.append((fab, dirs, {"swap": MODES[mode], "tol": tol}))
+                tasks.append((fab, dirs, {"swap": MODES[mode], "tol": tol,
+                                          "min_level": min_level}))
     res = run_tasks(tasks, workers, progress=progress)
     out, k = [], 0
     for cfg in configs:
@@ -260,7 +263,7 @@ def _statements(curves, furnace, modes) -> list[str]:
 
 
 def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_deg=(0.0, 90.0),
-                  modes=("furnace", "reflectance"), tol: float = 1e-3,
+                  modes=("furnace", "reflectance"), tol: float = 1e-3, min_level: int = -1,
                   hemispherical: bool = True, furnace: bool = True, scan=None,
                   scan_theta_deg=SCAN_THETA, scan_phi_deg=SCAN_PHI, workers=None,
                   progress: bool = False) -> EnergyReport:
@@ -277,7 +280,9 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
     modes : sequence of {"furnace", "reflectance"}
         Which albedos to compute.
     tol : float, default 1e-3
-        Absolute albedo tolerance.
+        Absolute albedo tolerance (relative 1e-3 for albedos above 1).
+    min_level : int, default -1
+        Coarsest quadrature level (see :func:`analysis.albedo`).
     hemispherical : bool, default True
         Also compute the hemispherical-hemispherical albedo of each preset (default variant).
     furnace : bool, default True
@@ -332,7 +337,7 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
         for p, v, m in itertools.product(presets, variants, modes):
             fab = brdf.fabric(p, **VARIANTS[v])
             keys.append((p, v, m))
-            tasks.append((fab, dirs, {"swap": MODES[m], "tol": tol}))
+            tasks.append((fab, dirs, {"swap": MODES[m], "tol": tol, "min_level": min_level}))
         res = run_tasks(tasks, workers, progress=tick)
         curves = []
         for (p, v, m), (val, err, _) in zip(keys, res):
@@ -350,7 +355,7 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
         if hemispherical:
             for p in presets:
                 h = albedo_hemispherical(brdf.fabric(p), n_theta=6, n_phi=4, tol=tol,
-                                         workers=workers)
+                                         min_level=min_level, workers=workers)
                 hemi.append({"preset": p, "variant": "default", **h.to_dict()})
                 if tick:
                     tick(30)
@@ -358,7 +363,7 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
         if furnace:
             scan_rows = white_furnace(presets, scan=scan, theta_deg=scan_theta_deg,
                                       phi_deg=scan_phi_deg, modes=modes, workers=workers,
-                                      progress=tick)
+                                      min_level=min_level, progress=tick)
     finally:
         if bar is not None:
             bar.close()

@@ -49,13 +49,13 @@ MODES = {"furnace": False, "reflectance": True}
 #: White-furnace scan, one parameter at a time from each preset with A = 1 on both threads
 #: (gamma in degrees; gamma_v follows as 2 gamma_s, the ratio of most presets).
 FURNACE_SCAN = {
-    "eta": (1.1, 1.345, 1.46, 1.6, 2.0, 2.5),
-    "kd": (0.0, 0.25, 0.5, 0.75, 1.0),
-    "gamma_s": (1.0, 2.5, 5.0, 10.0, 20.0, 40.0),
+    "eta": (1.1, 1.46, 2.0, 2.5),
+    "kd": (0.0, 0.5, 1.0),
+    "gamma_s": (1.0, 2.5, 10.0, 40.0),
 }
 
 DEFAULT_THETA = tuple(range(0, 90, 5)) + (89,)
-SCAN_THETA = (0.0, 45.0, 70.0, 85.0, 89.0)
+SCAN_THETA = (0.0, 60.0, 85.0, 89.0)
 SCAN_PHI = (0.0, 90.0)
 
 

@@ -75,7 +75,7 @@ def edge_pairs(offsets_deg=(-90.0, -45.0, 0.0, 45.0, 90.0)) -> dict[str, tuple]:
     --------
     >>> sets = edge_pairs()
     >>> sorted(sets)[:3]
-    ['below_horizon', 'both_grazing', 'grazing_i']
+    ['along_tangent_i', 'along_tangent_o', 'below_horizon']
     """
     out = {}
     grazing = np.array([89.0, 89.9, 89.99, 89.999, 90.0 - 1e-7, 90.0])

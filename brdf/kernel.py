@@ -83,7 +83,9 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, masking=True,
     :math:`P` likewise with :math:`P_i = \max(x_i, 0)/\rho_i` and :math:`\psi_d`.
     Where a direction lies along the tangent (cos theta = 0) its azimuth phi is taken as 0,
     as atan2(0, 0) = 0 in MODEL.md's definition; there the thread's term carries the factor
-    cos(theta_i) = 0 (wi side) or is finite (wo side).
+    cos(theta_i) = 0 (wi side) or is finite (wo side). Where cos^2(theta_d) rounds to 0
+    (wi and wo both grazing along the tangent, opposite), the sample's term is 0: the spec's
+    f_s diverges there while P vanishes, and no finite-precision value is meaningful.
     """
     # Longitudinal sines s = w.t and normal components x = w.n_t of every (pair, sample).
     si = ti * ca
@@ -122,15 +124,22 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, masking=True,
         yi_p, yr_p = np.where(zi_, 0.0, bi), np.where(zr_, 0.0, bo)
         cphi = xi_p * xr_p + yi_p * yr_p
         cphi /= ci_p * cr_p
-        np.copyto(c2d, 1.0, where=c2d == 0.0)   # only where cos(theta_i) = 0: the term is 0
     else:
         xi_p, ci_p, xr_p, cr_p = xi, ci, xr, cr
         cphi = bi * bo
         cphi = cphi + xx
         cphi /= cc
     np.clip(cphi, -1.0, 1.0, out=cphi)
+    if c2d.min() == 0.0:
+        # cos^2(theta_d) = 0 only with theta_i = -theta_r = +-pi/2, where cos(theta_i) is 0 or
+        # round-off: the term is taken as 0 there (see Notes).
+        zero = c2d == 0.0
+        np.copyto(c2d, 1.0, where=zero)
+        np.copyto(ci_k := ci.copy(), 0.0, where=zero)
+    else:
+        ci_k = ci
     # K = 2 cos(theta_i) / (2 cos^2 theta_d), the factor 2 applied with ks and kv below.
-    k = ci / c2d
+    k = ci_k / c2d
     pmean = None
     if masking or reweighting:
         mxi = np.maximum(xi, 0.0)

@@ -2,24 +2,13 @@
 
 from __future__ import annotations
 
-import argparse
-import math
 from pathlib import Path
 
 import numpy as np
 
 import brdf
 from reports import cliutil
-
-#: Standard geometries of the summary: (label, theta_i, phi_i, theta_o, phi_o), degrees.
-STANDARD_GEOMETRIES = (
-    ("normal", 0.0, 0.0, 0.0, 0.0),
-    ("specular 30 warp", 30.0, 0.0, 30.0, 180.0),
-    ("specular 30 weft", 30.0, 90.0, 30.0, 270.0),
-    ("specular 60 warp", 60.0, 0.0, 60.0, 180.0),
-    ("retro 45 warp", 45.0, 0.0, 45.0, 0.0),
-    ("oblique 60/30 at 45", 60.0, 45.0, 30.0, 225.0),
-)
+from reports.standard import STANDARD_GEOMETRIES, standard_values
 
 
 def register(sub):
@@ -41,13 +30,21 @@ def register(sub):
     cliutil.add_fabric_options(p)
     p.set_defaults(func=run_eval)
 
-    p = sub.add_parser("report", help="write the report (summary.json and printed table)",
-                       description="The main job: evaluate every preset at standard "
-                                   "geometries and write DIR/summary.json.")
+    p = sub.add_parser("report", help="write the HTML report on the presets (the main job)",
+                       description="The main job: a self-contained HTML report on every "
+                                   "preset (parameters, lobes, slices, masking, energy, "
+                                   "reciprocity, renders, fits) in DIR/index.html, with its "
+                                   "data in DIR/summary.json; prints f_r at standard "
+                                   "geometries.")
     p.add_argument("--fabric", action="append", metavar="NAME", choices=brdf.PRESETS,
                    help="limit to these presets (repeatable; default all)")
     p.add_argument("-o", "--output", default="report", metavar="DIR",
-                   help="output folder (default ./report)")
+                   help="output folder (default ./report); replaced whole by the next run")
+    p.add_argument("--quality", choices=("default", "fast"), default="default",
+                   help="figure and render resolution (default: default)")
+    p.add_argument("--fit", action="append", metavar="FABRIC=RESULTS",
+                   help="show a fit's results.json in FABRIC's page (repeatable)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run_report)
 
 
@@ -87,36 +84,26 @@ def run_eval(args):
     return 0
 
 
-def summary(names=brdf.PRESETS) -> dict:
-    """f_r of each preset at the standard geometries, with the parameters used."""
-    out = {"units": {"f_r": "1/sr", "angles": "degrees"}, "geometries": [], "fabrics": {}}
-    for label, ti, pi_, to, po in STANDARD_GEOMETRIES:
-        out["geometries"].append({"label": label, "theta_i": ti, "phi_i": pi_,
-                                  "theta_o": to, "phi_o": po})
-    angles = np.radians([g[1:] for g in STANDARD_GEOMETRIES])
-    wi = brdf.directions.from_angles(angles[:, 0], angles[:, 1])
-    wo = brdf.directions.from_angles(angles[:, 2], angles[:, 3])
-    for name in names:
-        fab = brdf.fabric(name)
-        f = fab.eval(wi, wo)
-        out["fabrics"][name] = {
-            "parameters": fab.as_dict(),
-            "f_r": {g[0]: [float(v) for v in row] for g, row in zip(STANDARD_GEOMETRIES, f)},
-        }
-    return out
-
-
 def run_report(args):
+    from reports.report import build_report
+
     names = tuple(dict.fromkeys(args.fabric)) if args.fabric else brdf.PRESETS
-    out_dir = cliutil.check_writable_dir(Path(args.output))
-    data = summary(names)
-    cliutil.atomic_write_json(out_dir / "summary.json", data)
+    fits = {}
+    for item in args.fit or ():
+        name, sep, path = item.partition("=")
+        if not sep or name not in brdf.PRESETS:
+            raise ValueError(f"--fit must be FABRIC=PATH/results.json with FABRIC one of "
+                             f"{', '.join(brdf.PRESETS)}; got {item!r}")
+        if not Path(path).is_file():
+            raise ValueError(f"--fit {item!r}: no such file {path!r}")
+        fits[name] = path
+    index = build_report(names, args.output, progress=not args.quiet, quality=args.quality,
+                         fit_results=fits)
     labels = [g[0] for g in STANDARD_GEOMETRIES]
-    print(f"{'fabric':31s} " + " ".join(f"{lab:>20s}" for lab in labels))
-    print(" " * 32 + " ".join(f"{'f_r luminance 1/sr':>20s}" for _ in labels))
+    print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name in names:
-        vals = data["fabrics"][name]["f_r"]
+        vals = standard_values(brdf.fabric(name))
         lum = [0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2] for v in vals.values()]
-        print(f"{name:31s} " + " ".join(f"{x:20.6g}" for x in lum))
-    print(f"wrote {out_dir / 'summary.json'}")
+        print(f"{name:31s} " + " ".join(f"{x:19.6g}" for x in lum))
+    print(f"wrote {index} (data: {index.parent / 'summary.json'})")
     return 0

@@ -8,7 +8,7 @@ import pytest
 
 import brdf
 from brdf import Fabric, Thread
-from spec_reference import SIGMA_U, random_pairs, reference_eval, thread_sample
+from spec_reference import random_pairs, reference_eval, thread_sample
 
 VARIANTS = [
     {},
@@ -282,3 +282,23 @@ def test_bad_directions():
         fab.eval(np.ones((4, 3)), np.ones((5, 3)))
     with pytest.raises(ValueError, match="wo must"):
         fab.eval(np.ones(3), 1.0)
+
+
+@pytest.mark.parametrize("options", [{}, {"masking": False}, {"reweighting": False},
+                                     {"masking": False, "reweighting": False}])
+def test_grazing_pairs_finite_without_warnings(options):
+    """Near the horizon, incl. opposite grazing pairs where cos^2(theta_d) rounds to 0."""
+    z = np.array([6e-17, 1e-12, 1e-6])
+    phi = np.radians(np.arange(0, 360, 7.5))
+    P, Z = np.meshgrid(phi, z)
+    r = np.sqrt(1 - Z**2)
+    w = np.stack([r * np.cos(P), r * np.sin(P), Z], -1).reshape(-1, 3)
+    wi, wo = w[:, None, :], w[None, :, :]
+    opposite = w * [-1, -1, 1]
+    for name in brdf.PRESETS:
+        fab = brdf.fabric(name, **options)
+        with np.errstate(divide="raise", invalid="raise", over="raise", under="ignore"):
+            f = fab.eval(wi, wo)
+            g = fab.eval(w, opposite)
+        assert np.all(np.isfinite(f)) and np.all(f >= 0)
+        assert np.all(np.isfinite(g)) and np.all(g >= 0)

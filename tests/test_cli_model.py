@@ -51,25 +51,34 @@ def test_bad_input_is_one_line_and_nonzero(argv, message, capsys):
     assert len(err.splitlines()) <= 2   # argparse may print its usage line first
 
 
-def test_report_writes_summary(tmp_path, capsys):
+def test_report_writes_html_and_summary(tmp_path, capsys):
     out = tmp_path / "rep"
-    assert main(["report", "--fabric", "silk_shot", "--fabric", "velvet", "-o", str(out)]) == 0
+    assert main(["report", "--fabric", "silk_shot", "--fabric", "velvet", "-o", str(out),
+                 "--quality", "fast", "--quiet"]) == 0
+    assert (out / "index.html").is_file() and (out / "velvet.html").is_file()
     data = json.loads((out / "summary.json").read_text())
     assert list(data["fabrics"]) == ["silk_shot", "velvet"]
-    g = data["geometries"][1]
-    wi = brdf.directions.from_angles(math.radians(g["theta_i"]), math.radians(g["phi_i"]))
-    wo = brdf.directions.from_angles(math.radians(g["theta_o"]), math.radians(g["phi_o"]))
-    np.testing.assert_allclose(data["fabrics"]["velvet"]["f_r"][g["label"]],
-                               brdf.fabric("velvet").eval(wi, wo), rtol=1e-12)
+    std = data["fabrics"]["velvet"]["standard_geometries"]
+    wi = brdf.directions.from_angles(math.radians(30), 0.0)
+    wo = brdf.directions.from_angles(math.radians(30), math.pi)
+    np.testing.assert_allclose(std["specular 30 warp"], brdf.fabric("velvet").eval(wi, wo),
+                               rtol=1e-12)
     assert data["fabrics"]["velvet"]["parameters"]["threads"][1]["offsets"] == [-90, -55, 55, 90]
-    assert "velvet" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "velvet" in printed and "index.html" in printed
+
+
+def test_report_bad_fit_argument(tmp_path, capsys):
+    assert main(["report", "-o", str(tmp_path / "r"), "--fit", "velvet=/nonexistent.json"]) == 1
+    assert "no such file" in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
 
 
 def test_report_unwritable_folder(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("x")
     assert main(["report", "-o", str(blocker / "sub")]) == 1
-    assert "is not writable" in capsys.readouterr().err
+    assert "cannot create output folder" in capsys.readouterr().err
 
 
 def test_help_everywhere(capsys):

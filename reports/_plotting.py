@@ -1,0 +1,169 @@
+"""Shared helpers of the plot modules: axes, atomic saving, BRDF evaluation, quantities.
+
+Private to :mod:`reports`; the public plot functions live in ``reports/plot_*.py`` and are
+gathered in :mod:`reports.plots`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gonio.atomic import atomic_write
+from reports.colour import CHANNEL_COLOURS, luminance
+
+__all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
+           "quantity_styles", "QUANTITIES", "check_quantity", "from_angles", "to_angles",
+           "half_diff_to_io", "check_angle"]
+
+#: What a plot can show of an RGB f_r: its Rec. 709 luminance, each channel, or one channel.
+QUANTITIES = ("luminance", "rgb", "r", "g", "b")
+
+
+def _pyplot():
+    import matplotlib.pyplot as plt  # imported lazily: the backend is the caller's choice
+    return plt
+
+
+def new_axes(ax=None, *, projection=None, figsize=(5.0, 4.0)):
+    """Return ``(fig, ax)``: ``ax`` and its figure, or a new figure with one axes.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes, optional
+        Axes to draw into. Its projection must match ``projection``.
+    projection : str, optional
+        "polar", "3d" or None (cartesian) for a new axes.
+    figsize : tuple of float
+        Size in inches of a new figure.
+    """
+    if ax is not None:
+        name = getattr(ax, "name", "rectilinear")
+        want = projection or "rectilinear"
+        if name != want:
+            raise ValueError(f"ax must have projection {want!r}; got {name!r}")
+        return ax.figure, ax
+    from matplotlib.figure import Figure
+    fig = _pyplot().figure(figsize=figsize) if _use_pyplot() else Figure(figsize=figsize)
+    ax = fig.add_subplot(1, 1, 1, projection=projection)
+    return fig, ax
+
+
+def _use_pyplot() -> bool:
+    # Figures made through pyplot show up in notebooks; under a non-interactive backend a
+    # bare Figure avoids pyplot's global figure list (no leaks in long reports).
+    import matplotlib
+    backend = matplotlib.get_backend().lower()
+    return not (backend == "agg" or backend.endswith("backend_agg") or backend in ("pdf", "svg"))
+
+
+def save_figure(fig, filename, dpi: int = 110) -> Path:
+    """Save ``fig`` to ``filename`` atomically (temporary file in the same folder, then
+    ``os.replace``); the format comes from the file's suffix.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
+    path = Path(filename)
+    fmt = path.suffix.lstrip(".").lower() or "png"
+    with atomic_write(path, "wb") as fh:
+        fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight")
+    return path
+
+
+def finish(fig, ax, filename=None, *, dpi: int = 110):
+    """Save when ``filename`` is given; return ``(fig, ax)``."""
+    if filename is not None:
+        save_figure(fig, filename, dpi=dpi)
+    return fig, ax
+
+
+def check_quantity(quantity: str) -> str:
+    if quantity not in QUANTITIES:
+        raise ValueError(f"quantity must be one of {', '.join(QUANTITIES)}; got {quantity!r}")
+    return quantity
+
+
+def check_angle(name: str, value, lo: float, hi: float) -> np.ndarray:
+    arr = np.asarray(value, dtype=np.float64)
+    if not np.all(np.isfinite(arr)) or np.any(arr < lo) or np.any(arr > hi):
+        raise ValueError(f"{name} must be in [{lo:g}, {hi:g}] degrees; got {value!r}")
+    return arr
+
+
+def eval_brdf(brdf, wi, wo) -> np.ndarray:
+    """``brdf.eval(wi, wo)`` broadcast to a common shape, as float64 (..., 3) in 1/sr."""
+    wi = np.asarray(wi, dtype=np.float64)
+    wo = np.asarray(wo, dtype=np.float64)
+    shape = np.broadcast_shapes(wi.shape, wo.shape)
+    wi = np.broadcast_to(wi, shape)
+    wo = np.broadcast_to(wo, shape)
+    flat = np.asarray(brdf.eval(wi.reshape(-1, 3), wo.reshape(-1, 3)), dtype=np.float64)
+    return flat.reshape(shape[:-1] + (3,))
+
+
+def reduce_quantity(values: np.ndarray, quantity: str) -> np.ndarray:
+    """(..., 3) RGB -> (...,) luminance or one channel, or (..., 3) unchanged for "rgb"."""
+    check_quantity(quantity)
+    if quantity == "luminance":
+        return luminance(values)
+    if quantity == "rgb":
+        return values
+    return values[..., "rgb".index(quantity)]
+
+
+def quantity_styles(quantity: str, colour=None):
+    """[(channel index or None, colour, label suffix)] for the curves of ``quantity``.
+
+    Per-channel curves ("rgb", "r", "g", "b") are drawn in red, green and blue; luminance
+    in ``colour`` (the fabric's own sRGB colour, or black).
+    """
+    check_quantity(quantity)
+    if quantity == "rgb":
+        return [(k, CHANNEL_COLOURS[k], " " + "RGB"[k]) for k in range(3)]
+    if quantity == "luminance":
+        return [(None, colour or "black", "")]
+    k = "rgb".index(quantity)
+    return [(k, CHANNEL_COLOURS[k], " " + "RGB"[k])]
+
+
+def from_angles(theta, phi) -> np.ndarray:
+    """Unit vectors (..., 3) from polar angle ``theta`` (from +z) and azimuth ``phi`` (from +x
+    toward +y), both in radians."""
+    theta = np.asarray(theta, dtype=np.float64)
+    phi = np.asarray(phi, dtype=np.float64)
+    st = np.sin(theta)
+    return np.stack(np.broadcast_arrays(st * np.cos(phi), st * np.sin(phi), np.cos(theta)), -1)
+
+
+def to_angles(w):
+    """(theta, phi) in radians of unit vectors (..., 3)."""
+    w = np.asarray(w, dtype=np.float64)
+    return np.arccos(np.clip(w[..., 2], -1.0, 1.0)), np.arctan2(w[..., 1], w[..., 0])
+
+
+def half_diff_to_io(theta_h, theta_d, phi_d, phi_h=0.0):
+    """Rusinkiewicz half/difference angles (radians) -> (wi, wo), each (..., 3).
+
+    Notes
+    -----
+    h = from_angles(theta_h, phi_h); the difference vector d = from_angles(theta_d, phi_d) is
+    expressed in the frame that takes +z to h: wi = R_z(phi_h) R_y(theta_h) d, and wo is wi
+    mirrored about h, wo = 2 (wi . h) h - wi (Rusinkiewicz 1998).
+    """
+    theta_h, theta_d, phi_d, phi_h = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (theta_h, theta_d, phi_d, phi_h)))
+    d = from_angles(theta_d, phi_d)
+    ct, st = np.cos(theta_h), np.sin(theta_h)
+    # R_y(theta_h)
+    x1 = ct * d[..., 0] + st * d[..., 2]
+    y1 = d[..., 1]
+    z1 = -st * d[..., 0] + ct * d[..., 2]
+    cp, sp = np.cos(phi_h), np.sin(phi_h)
+    wi = np.stack([cp * x1 - sp * y1, sp * x1 + cp * y1, z1], axis=-1)
+    h = from_angles(theta_h, phi_h)
+    wo = 2.0 * np.sum(wi * h, axis=-1, keepdims=True) * h - wi
+    return wi, wo

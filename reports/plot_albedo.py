@@ -1,0 +1,82 @@
+"""Directional albedo against theta, with error bars."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import check_quantity, finish, new_axes, quantity_styles
+from reports.colour import REC709_WEIGHTS, luminance
+
+__all__ = ["plot_albedo"]
+
+
+def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, label=None,
+                ax=None, filename=None, title=None):
+    """Albedo rho(theta) with error bars, and the line rho = 1.
+
+    Parameters
+    ----------
+    theta_deg : array_like, shape (n,)
+        Polar angles in degrees.
+    albedo : array_like, shape (n,) or (n, 3), or a result object
+        Unitless albedo; an object with ``.value`` (and ``.error``), such as the result of
+        ``analysis.albedo``, is accepted in its place.
+    error : array_like, optional
+        One standard error per value (same shape as ``albedo``); taken from the result's
+        ``.error`` when ``albedo`` is a result.
+    quantity : {"rgb", "luminance", "r", "g", "b"}
+        "rgb" draws red, green and blue curves; "luminance" one curve in ``colour`` (e.g. the
+        fabric's sRGB colour). Grey (n,) input is drawn as given whatever the quantity.
+    label : str, optional
+        Prefix of the legend labels (e.g. a fabric name).
+
+    Returns
+    -------
+    (fig, ax)
+        One errorbar container per curve; its Line2D (gid "albedo <label> <channel>") holds
+        x = theta in degrees, y = albedo.
+
+    Notes
+    -----
+    Luminance error is propagated assuming independent channels:
+    sigma_Y = sqrt(sum_c w_c^2 sigma_c^2) with the Rec. 709 weights w.
+    """
+    check_quantity(quantity)
+    if hasattr(albedo, "value"):
+        if error is None:
+            error = getattr(albedo, "error", None)
+        albedo = albedo.value
+    theta = np.asarray(theta_deg, dtype=np.float64).reshape(-1)
+    val = np.asarray(albedo, dtype=np.float64)
+    err = None if error is None else np.asarray(error, dtype=np.float64)
+    if val.shape[0] != theta.shape[0] or val.ndim not in (1, 2) or (
+            val.ndim == 2 and val.shape[1] != 3):
+        raise ValueError(f"albedo must have shape ({theta.shape[0]},) or ({theta.shape[0]}, 3); "
+                         f"got {val.shape}")
+    if err is not None and err.shape != val.shape:
+        raise ValueError(f"error must have the shape of albedo {val.shape}; got {err.shape}")
+    fig, ax = new_axes(ax)
+    if val.ndim == 1:
+        series = [(val, err, colour or "black", "")]
+    elif quantity == "luminance":
+        e = None if err is None else np.sqrt((err ** 2) @ (REC709_WEIGHTS ** 2))
+        series = [(luminance(val), e, colour or "black", " luminance")]
+    else:
+        series = [(val[:, k], None if err is None else err[:, k], col, suffix)
+                  for k, col, suffix in quantity_styles(quantity)]
+    prefix = label or "albedo"
+    for y, e, col, suffix in series:
+        cont = ax.errorbar(theta, y, yerr=e, color=col, lw=1.3, capsize=2, ms=3,
+                           marker="o" if theta.size <= 30 else None, label=f"{prefix}{suffix}")
+        channel = suffix.strip().lower() if suffix.strip() else "grey"
+        cont.lines[0].set_gid(f"albedo {prefix} {channel if channel in 'rgb' else channel}")
+    if not any(l.get_gid() == "unit" for l in ax.get_lines()):
+        ref = ax.axhline(1.0, color="0.5", ls=":", lw=1.0)
+        ref.set_gid("unit")
+    ax.set_xlabel("θ (degrees)")
+    ax.set_ylabel("directional albedo (unitless)")
+    ax.set_xlim(0, 90)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, frameon=False)
+    ax.set_title(title or "directional albedo", fontsize=9)
+    return finish(fig, ax, filename)

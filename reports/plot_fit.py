@@ -1,0 +1,148 @@
+"""Model curves over measured table points in a plane of incidence, with error bars."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import (check_quantity, eval_brdf, finish, new_axes, quantity_styles,
+                               reduce_quantity)
+from reports.colour import REC709_WEIGHTS
+from reports.plot_lobes import plane_directions
+
+__all__ = ["plane_points", "plot_fit_overlay"]
+
+
+def _signed(theta, phi, phi_plane, tol):
+    """Signed angle (radians) of directions in the plane at phi_plane, NaN off the plane."""
+    d = np.angle(np.exp(1j * (phi - phi_plane)))
+    fwd = np.abs(d) <= tol
+    back = np.abs(np.abs(d) - np.pi) <= tol
+    near_pole = theta <= tol
+    s = np.full(theta.shape, np.nan)
+    s[fwd | near_pole] = theta[fwd | near_pole]
+    s[back & ~near_pole] = -theta[back & ~near_pole]
+    return s
+
+
+def plane_points(table, phi_deg=0.0, tol_deg=2.0):
+    """Rows of a table that lie in the plane of incidence at azimuth ``phi_deg``.
+
+    Parameters
+    ----------
+    table : gonio.Table
+    phi_deg : float
+        Azimuth of the plane in degrees.
+    tol_deg : float
+        Azimuth tolerance in degrees (directions within tol of the pole always count).
+
+    Returns
+    -------
+    index : numpy.ndarray of int
+        Rows in the plane, with the light on the negative side (signed theta_i <= 0).
+    theta_i_deg : numpy.ndarray
+        Incidence angle (unsigned) of each row, degrees.
+    theta_o_deg : numpy.ndarray
+        Signed viewing angle of each row, degrees (positive toward azimuth phi).
+    """
+    ang = np.asarray(table.angles)
+    tol = np.radians(tol_deg)
+    phi = np.radians(phi_deg)
+    si = _signed(ang[:, 0], ang[:, 1], phi, tol)
+    so = _signed(ang[:, 2], ang[:, 3], phi, tol)
+    # Light on the positive side: mirror the pair so the light is on the negative side.
+    flip = si > tol
+    si = np.where(flip, -si, si)
+    so = np.where(flip, -so, so)
+    keep = np.isfinite(si) & np.isfinite(so)
+    idx = np.nonzero(keep)[0]
+    return idx, np.degrees(np.abs(si[idx])), np.degrees(so[idx])
+
+
+def plot_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity="rgb",
+                     tol_deg=2.0, resolution=181, log=False, max_incidences=4, ax=None,
+                     filename=None, title=None):
+    """Measured points (with error bars) and model curves against signed theta_o.
+
+    Parameters
+    ----------
+    table : gonio.Table
+        Measured f_r (1/sr), optional sigma; invalid values (NaN, negative) are skipped.
+    brdf : object with ``.eval``
+        The model drawn as curves through the same wi.
+    phi_deg : float
+        Azimuth of the plane of incidence in degrees.
+    theta_i_deg : sequence of float, optional
+        Incidences to show (degrees, matched within 0.5 degree); default the first
+        ``max_incidences`` distinct incidences found in the plane.
+    quantity : {"rgb", "luminance", "r", "g", "b"}
+        "rgb": each channel in red, green and blue, one marker per incidence; "luminance":
+        Rec. 709 luminance in black.
+    tol_deg : float
+        Azimuth tolerance for points in the plane, degrees.
+
+    Returns
+    -------
+    (fig, ax)
+        Model lines have gid "model theta_i=<deg> <channel>" (x signed theta_o in degrees,
+        y f_r in 1/sr), measured points are errorbar containers whose data line has gid
+        "data theta_i=<deg> <channel>".
+
+    Raises
+    ------
+    ValueError
+        If no valid table point lies in the plane.
+
+    Notes
+    -----
+    Luminance sigma assumes independent channels: sqrt(sum_c w_c^2 sigma_c^2).
+    """
+    check_quantity(quantity)
+    idx, ti, to = plane_points(table, phi_deg, tol_deg)
+    values = np.asarray(table.values, dtype=np.float64)[idx]
+    valid = np.asarray(table.valid)[idx].all(axis=1)
+    idx, ti, to, values = idx[valid], ti[valid], to[valid], values[valid]
+    if idx.size == 0:
+        raise ValueError(f"table has no valid points in the plane phi = {phi_deg:g} degrees "
+                         f"(tolerance {tol_deg:g} degrees)")
+    sigma = None if table.sigma is None else np.asarray(table.sigma, float)[idx]
+    distinct = np.unique(np.round(ti * 2.0) / 2.0)
+    wanted = distinct[:max_incidences] if theta_i_deg is None else np.atleast_1d(theta_i_deg)
+    fig, ax = new_axes(ax, figsize=(6.0, 4.0))
+    styles = quantity_styles(quantity)
+    markers = "osD^v<>"
+    x_model = np.linspace(-90.0, 90.0, int(resolution))
+    for n, t in enumerate(wanted):
+        sel = np.abs(ti - t) <= 0.5
+        if not sel.any():
+            continue
+        wi, wo = plane_directions(float(np.mean(ti[sel])), x_model, phi_deg)
+        model = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
+        meas = reduce_quantity(values[sel], quantity)
+        if sigma is None:
+            err = None
+        elif quantity == "luminance":
+            err = np.sqrt((sigma[sel] ** 2) @ (REC709_WEIGHTS ** 2))
+        else:
+            err = reduce_quantity(sigma[sel], quantity)
+        order = np.argsort(to[sel])
+        for k, col, suffix in styles:
+            channel = "luminance" if k is None else "rgb"[k]
+            y = model[:, k] if model.ndim == 2 else model
+            line, = ax.plot(x_model, y, color=col, lw=1.0, ls=["-", "--", ":", "-."][n % 4],
+                            label=f"model θi = {t:g}°{suffix}")
+            line.set_gid(f"model theta_i={t:g} {channel}")
+            ym = (meas[:, k] if meas.ndim == 2 else meas)[order]
+            em = None if err is None else (err[:, k] if err.ndim == 2 else err)[order]
+            cont = ax.errorbar(to[sel][order], ym, yerr=em, color=col, ls="",
+                               marker=markers[n % len(markers)], ms=3.5, mfc="none",
+                               capsize=1.5, label=f"data θi = {t:g}°{suffix}")
+            cont.lines[0].set_gid(f"data theta_i={t:g} {channel}")
+    if log:
+        ax.set_yscale("log")
+    ax.set_xlabel("signed θo (degrees; light on the negative side)")
+    ax.set_ylabel("f_r (1/sr)")
+    ax.set_xlim(-90, 90)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=6, frameon=False, ncol=2)
+    ax.set_title(title or f"model and measurement, plane φ = {phi_deg:g}°", fontsize=9)
+    return finish(fig, ax, filename)

@@ -1,0 +1,152 @@
+"""Hemisphere heat map of f_r(wo) for a fixed wi, in Lambert's azimuthal equal-area projection.
+
+A viewing direction at polar angle theta and azimuth phi sits at radius
+rho = sqrt(2) sin(theta / 2) (1 at the horizon) and angle phi in the unit disc: equal solid
+angles cover equal areas, so the picture shows where the reflected energy goes. +x (right) is
+the warp, +y (up) the weft.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import check_angle, eval_brdf, finish, from_angles, new_axes
+from reports.colour import luminance, to_srgb
+
+__all__ = ["equal_area_grid", "equal_area_xy", "hemisphere_image", "plot_hemisphere"]
+
+
+def equal_area_xy(w):
+    """Disc coordinates (x, y) of unit directions (..., 3) in the equal-area projection.
+
+    Examples
+    --------
+    >>> [round(float(v), 6) for v in equal_area_xy(np.array([1.0, 0.0, 0.0]))]
+    [1.0, 0.0]
+    """
+    w = np.asarray(w, dtype=np.float64)
+    theta = np.arccos(np.clip(w[..., 2], -1.0, 1.0))
+    phi = np.arctan2(w[..., 1], w[..., 0])
+    rho = np.sqrt(2.0) * np.sin(theta / 2.0)
+    return rho * np.cos(phi), rho * np.sin(phi)
+
+
+def equal_area_grid(resolution=101):
+    """Pixel centres of a square image over [-1, 1]^2 and their directions.
+
+    Parameters
+    ----------
+    resolution : int
+        Pixels per side.
+
+    Returns
+    -------
+    x, y : numpy.ndarray, shape (resolution, resolution)
+        Pixel centres (row index = y, increasing upward when drawn with origin="lower").
+    inside : numpy.ndarray of bool
+        Pixels inside the unit disc (the hemisphere).
+    wo : numpy.ndarray, shape (resolution, resolution, 3)
+        Directions of the pixels (those outside the disc are clamped to the horizon).
+
+    Notes
+    -----
+    Inverse projection: rho = sqrt(x^2 + y^2), theta = 2 asin(rho / sqrt 2), phi = atan2(y, x).
+    """
+    n = int(resolution)
+    if n < 2:
+        raise ValueError(f"resolution must be at least 2; got {resolution}")
+    c = (np.arange(n) + 0.5) / n * 2.0 - 1.0
+    y, x = np.meshgrid(c, c, indexing="ij")
+    rho = np.hypot(x, y)
+    inside = rho <= 1.0
+    theta = 2.0 * np.arcsin(np.clip(rho, 0.0, 1.0) / np.sqrt(2.0))
+    return x, y, inside, from_angles(theta, np.arctan2(y, x))
+
+
+def hemisphere_image(brdf, theta_i_deg=45.0, phi_i_deg=0.0, resolution=101):
+    """RGB f_r (1/sr) over the equal-area disc for the light at (theta_i, phi_i) degrees.
+
+    Returns
+    -------
+    values : numpy.ndarray, shape (resolution, resolution, 3)
+        f_r; NaN outside the disc.
+    """
+    _, _, inside, wo = equal_area_grid(resolution)
+    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
+    values = eval_brdf(brdf, wi, wo)
+    values[~inside] = np.nan
+    return values
+
+
+def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminance", log=True,
+                    decades=4.0, cosine=False, exposure=0.0, resolution=101, ax=None,
+                    filename=None, title=None):
+    """Heat map of f_r(wo) over the viewing hemisphere (equal-area projection).
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    theta_i_deg, phi_i_deg : float
+        Direction of the light in degrees.
+    quantity : {"luminance", "srgb"}
+        "luminance": Rec. 709 luminance in a colour map with a colour bar in 1/sr;
+        "srgb": the RGB value itself, times ``2**exposure`` and encoded as sRGB through
+        colour-science (no colour bar; values above 1 clip).
+    log : bool
+        Logarithmic colour scale over ``decades`` below the peak (luminance only).
+    cosine : bool
+        Show f_r cos(theta_o) instead of f_r.
+    resolution : int
+        Pixels per side.
+
+    Returns
+    -------
+    (fig, ax)
+        ``ax.images[0].get_array()`` is the plotted image: luminance in 1/sr (masked outside
+        the disc) or the sRGB image. The light's direction and its mirror are marked.
+    """
+    if quantity not in ("luminance", "srgb"):
+        raise ValueError(f"quantity must be 'luminance' or 'srgb'; got {quantity!r}")
+    check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
+    import matplotlib
+    import matplotlib.colors as mcolors
+    values = hemisphere_image(brdf, theta_i_deg, phi_i_deg, resolution)
+    if cosine:
+        _, _, _, wo = equal_area_grid(resolution)
+        values = values * wo[..., 2:3]
+    fig, ax = new_axes(ax, figsize=(5.0, 4.2))
+    extent = (-1, 1, -1, 1)
+    if quantity == "luminance":
+        img = np.ma.masked_invalid(luminance(values))
+        peak = float(img.max()) if img.count() and img.max() > 0 else 1.0
+        norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=False) if log
+                else mcolors.Normalize(vmin=0.0, vmax=peak))
+        cmap = matplotlib.colormaps["inferno"].with_extremes(bad="white", under="black")
+        im = ax.imshow(img, origin="lower", extent=extent, norm=norm, cmap=cmap,
+                       interpolation="nearest")
+        label = "luminance f_r cos θo (1/sr)" if cosine else "luminance f_r (1/sr)"
+        fig.colorbar(im, ax=ax, label=label)
+    else:
+        rgb = to_srgb(np.nan_to_num(values), exposure=exposure)
+        alpha = np.isfinite(values[..., 0]).astype(float)[..., None]
+        ax.imshow(np.concatenate([rgb, alpha], axis=-1), origin="lower", extent=extent,
+                  interpolation="nearest")
+    t = np.linspace(0, 2 * np.pi, 361)
+    ax.plot(np.cos(t), np.sin(t), color="0.4", lw=0.8)
+    for deg in (30, 60):
+        r = np.sqrt(2.0) * np.sin(np.radians(deg) / 2.0)
+        ax.plot(r * np.cos(t), r * np.sin(t), color="0.6", lw=0.5, ls=":")
+    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
+    xi, yi = equal_area_xy(wi)
+    xm, ym = equal_area_xy(wi * np.array([-1.0, -1.0, 1.0]))
+    ax.plot([xi], [yi], marker="*", color="cyan", ms=9, ls="", label="wi (light)")
+    ax.plot([xm], [ym], marker="+", color="cyan", ms=9, ls="", label="mirror")
+    ax.set_xlim(-1.05, 1.05)
+    ax.set_ylim(-1.05, 1.05)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (warp)")
+    ax.set_ylabel("y (weft)")
+    ax.legend(fontsize=6, loc="lower right", frameon=False)
+    ax.set_title(title or f"f_r(wo), θi = {theta_i_deg:g}°, φi = {phi_i_deg:g}° "
+                 f"(equal-area)", fontsize=9)
+    return finish(fig, ax, filename)

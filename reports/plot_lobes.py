@@ -1,0 +1,316 @@
+"""Lobe plots: polar lobes in a plane of incidence, a comparison of fabrics, and the 3-D lobe.
+
+A *plane of incidence* is the vertical plane at azimuth ``phi`` (0 = along the warp, 90 = along
+the weft, 45 = the diagonal). The light sits on the negative side, wi at signed angle
+-theta_i (azimuth phi + 180 degrees); the viewer sweeps the signed angle theta_o from -90 to
+90 degrees, positive toward azimuth phi, so the mirror direction is at +theta_i.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import (check_angle, eval_brdf, finish, from_angles, new_axes,
+                               quantity_styles, reduce_quantity)
+from reports.colour import line_colour, luminance
+
+__all__ = ["plane_directions", "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison",
+           "plot_lobe_3d", "log_radius"]
+
+
+def plane_directions(theta_i_deg, theta_o_deg, phi_deg=0.0):
+    """Directions in the plane of incidence at azimuth ``phi_deg``.
+
+    Parameters
+    ----------
+    theta_i_deg : float
+        Polar angle of the light in degrees, [0, 90); wi lies at azimuth phi + 180.
+    theta_o_deg : array_like
+        Signed viewing angles in degrees, [-90, 90]; positive toward azimuth phi.
+    phi_deg : float
+        Azimuth of the plane in degrees (from the warp, +x, toward the weft, +y).
+
+    Returns
+    -------
+    wi : numpy.ndarray, shape (3,)
+    wo : numpy.ndarray, shape (n, 3)
+
+    Examples
+    --------
+    >>> wi, wo = plane_directions(30.0, [30.0], 0.0)
+    >>> np.round(wi, 6).tolist(), np.round(wo, 6).tolist()
+    ([-0.5, 0.0, 0.866025], [[0.5, 0.0, 0.866025]])
+    """
+    phi = np.radians(float(phi_deg))
+    wi = from_angles(np.radians(float(theta_i_deg)), phi + np.pi)
+    s = np.radians(np.atleast_1d(np.asarray(theta_o_deg, dtype=np.float64)))
+    wo = np.stack([np.sin(s) * np.cos(phi), np.sin(s) * np.sin(phi), np.cos(s)], axis=-1)
+    return wi, wo
+
+
+def log_radius(values, floor):
+    """Radius of the log polar plot: log10(max(f, floor) / floor), 0 at the floor.
+
+    Examples
+    --------
+    >>> log_radius(np.array([1.0, 10.0, 1e-9]), 0.1).tolist()
+    [1.0, 2.0, 0.0]
+    """
+    return np.log10(np.maximum(np.asarray(values, dtype=np.float64), floor) / floor)
+
+
+def _log_floor(peak, decades):
+    """The power of 10 at least ``decades`` below ``peak`` (1e-12 for a zero peak)."""
+    if not peak > 0:
+        return 1e-12
+    return 10.0 ** np.floor(np.log10(peak) - decades)
+
+
+def _setup_polar(ax, scale, floor, rmax):
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+    if scale == "log":
+        decades = int(np.ceil(rmax)) if rmax > 0 else 1
+        ticks = np.arange(0, decades + 1)
+        ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
+        ax.set_rticks(ticks[ticks <= rmax * 1.05])
+        shown = ticks[ticks <= rmax * 1.05]
+        base = int(round(np.log10(floor)))
+        every = 1 if len(shown) <= 5 else 2
+        ax.set_yticklabels([f"1e{base + k}" if (len(shown) - 1 - k) % every == 0 else ""
+                            for k in shown], fontsize=6)
+    else:
+        from matplotlib.ticker import MaxNLocator
+        ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(axis="y", labelsize=6)
+
+
+def _check_scale(scale):
+    if scale not in ("linear", "log"):
+        raise ValueError(f"scale must be 'linear' or 'log'; got {scale!r}")
+
+
+def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantity="luminance",
+                    scale="linear", decades=4.0, resolution=181, cosine=False, colour=None,
+                    ax=None, filename=None, title=None):
+    """Polar plot of f_r in a plane of incidence, one curve per incidence angle.
+
+    Parameters
+    ----------
+    brdf : object
+        Anything with ``.eval(wi, wo) -> (..., 3)`` f_r in 1/sr.
+    theta_i_deg : float or sequence of float
+        Incidence angles in degrees, each in [0, 90).
+    phi_deg : float
+        Azimuth of the plane in degrees: 0 along the warp, 90 along the weft.
+    quantity : {"luminance", "rgb", "r", "g", "b"}
+        "luminance" draws Rec. 709 luminance, one curve per theta_i; "rgb" draws the three
+        channels in red, green and blue, one line style per theta_i.
+    scale : {"linear", "log"}
+        Radial scale. "log" plots log10(f / floor), clipped at 0, with floor the power of 10
+        at least ``decades`` below the peak; tick labels are f_r values.
+    decades : float
+        Dynamic range of the log scale.
+    resolution : int
+        Number of theta_o samples over [-90, 90] degrees (at least 3).
+    cosine : bool
+        Plot f_r cos(theta_o) (the visible lobe) instead of f_r.
+    colour : matplotlib colour, optional
+        Colour of all luminance curves (line styles then tell the incidences apart); by
+        default each incidence gets its own colour from the "viridis" colour map.
+    ax : matplotlib PolarAxes, optional
+    filename : str or path, optional
+        Save the figure there (atomically) when given.
+    title : str, optional
+
+    Returns
+    -------
+    (fig, ax)
+        Each curve is a Line2D with x = signed theta_o in radians and y = the plotted value
+        (f_r in 1/sr, or its log radius), and gid "lobe theta_i=<deg> <channel>".
+    """
+    _check_scale(scale)
+    thetas = np.atleast_1d(check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999))
+    check_angle("phi_deg", phi_deg, -360.0, 360.0)
+    if int(resolution) < 3:
+        raise ValueError(f"resolution must be at least 3; got {resolution}")
+    if not decades > 0:
+        raise ValueError(f"decades must be positive; got {decades}")
+    fig, ax = new_axes(ax, projection="polar")
+    import matplotlib
+    styles = quantity_styles(quantity, colour)
+    theta_o = np.linspace(-90.0, 90.0, int(resolution))
+    curves = []
+    for ti in thetas:
+        wi, wo = plane_directions(ti, theta_o, phi_deg)
+        f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
+        if cosine:
+            f = f * (np.cos(np.radians(theta_o))[:, None] if f.ndim == 2
+                     else np.cos(np.radians(theta_o)))
+        curves.append(f)
+    peak = max(float(np.nanmax(c)) if np.any(np.isfinite(c)) else 0.0 for c in curves)
+    floor = _log_floor(peak, decades)
+    rmax = 0.0
+    dashes = ["-", "--", ":", "-."]
+    for n, (ti, f) in enumerate(zip(thetas, curves)):
+        for k, col, suffix in styles:
+            y = f[:, k] if f.ndim == 2 else f
+            r = log_radius(y, floor) if scale == "log" else y
+            rmax = max(rmax, float(np.nanmax(r)))
+            ls = dashes[n % len(dashes)] if (len(styles) > 1 or colour is not None) else "-"
+            if k is None and colour is None:
+                col = matplotlib.colormaps["viridis"](0.85 * n / max(len(thetas) - 1, 1))
+            line, = ax.plot(np.radians(theta_o), r, ls=ls, color=col, lw=1.4,
+                            label=f"θi = {ti:g}°{suffix}")
+            line.set_gid(f"lobe theta_i={ti:g} {'luminance' if k is None else 'rgb'[k]}")
+    _setup_polar(ax, scale, floor, rmax)
+    for ti in thetas:  # incident directions as arrows from the centre
+        ax.annotate("", xy=(np.radians(-ti), rmax * 1.0), xytext=(0, 0),
+                    arrowprops=dict(arrowstyle="<-", color="0.5", lw=0.8))
+    label = "f_r cos θo" if cosine else "f_r"
+    unit = "1/sr"
+    what = "luminance" if quantity == "luminance" else quantity.upper()
+    ax.set_title(title or f"{label} ({unit}, {what}, {scale}) in the plane φ = {float(phi_deg):g}°",
+                 fontsize=9)
+    ax.legend(fontsize=6, loc="lower left", bbox_to_anchor=(-0.1, -0.15), ncol=2, frameon=False)
+    return finish(fig, ax, filename)
+
+
+def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0, 90.0), *,
+                     fig=None, filename=None, **kwargs):
+    """Polar lobes in several planes of incidence side by side (warp, 45 degrees, weft).
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    theta_i_deg : sequence of float
+        Incidence angles in degrees.
+    planes_deg : sequence of float
+        Azimuths of the planes in degrees.
+    fig : matplotlib Figure, optional
+        Figure to draw into (its content is replaced); a new one when None.
+    filename : str or path, optional
+    **kwargs
+        Passed to :func:`plot_polar_lobe` (quantity, scale, decades, resolution, cosine).
+
+    Returns
+    -------
+    (fig, axes)
+        axes is a list of PolarAxes, one per plane.
+    """
+    from matplotlib.figure import Figure
+    planes = list(np.atleast_1d(planes_deg))
+    if fig is None:
+        fig = Figure(figsize=(4.2 * len(planes), 3.6))
+    else:
+        fig.clear()
+    axes = [fig.add_subplot(1, len(planes), n + 1, projection="polar")
+            for n in range(len(planes))]
+    names = {0.0: "warp", 90.0: "weft"}
+    for ax, phi in zip(axes, planes):
+        plot_polar_lobe(brdf, theta_i_deg, phi, ax=ax,
+                        title=f"φ = {float(phi):g}° ({names.get(float(phi) % 180, 'diagonal')})",
+                        **kwargs)
+    return finish(fig, axes, filename)
+
+
+def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", decades=4.0,
+                         resolution=181, ax=None, filename=None, title=None):
+    """Luminance lobes of several BRDFs in one polar plot, each in its own sRGB colour
+    (:func:`reports.colour.line_colour`) and its own line style.
+
+    Parameters
+    ----------
+    brdfs : mapping of str to BRDF
+        Name -> object with ``.eval``; the curve's label is the name.
+    theta_i_deg, phi_deg : float
+        Incidence angle and plane azimuth in degrees.
+    scale, decades, resolution
+        As in :func:`plot_polar_lobe`; the log floor is common to all curves.
+
+    Returns
+    -------
+    (fig, ax)
+        One Line2D per BRDF with gid "lobe <name>".
+    """
+    _check_scale(scale)
+    check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999)
+    fig, ax = new_axes(ax, projection="polar", figsize=(6.0, 4.5))
+    theta_o = np.linspace(-90.0, 90.0, int(resolution))
+    wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
+    data = {name: luminance(eval_brdf(b, wi, wo)) for name, b in dict(brdfs).items()}
+    peak = max((float(np.nanmax(v)) for v in data.values()), default=0.0)
+    floor = _log_floor(peak, decades)
+    rmax = 0.0
+    styles = ["-", "--", "-.", ":"]
+    for n, (name, y) in enumerate(data.items()):
+        r = log_radius(y, floor) if scale == "log" else y
+        rmax = max(rmax, float(np.nanmax(r)))
+        line, = ax.plot(np.radians(theta_o), r, color=line_colour(dict(brdfs)[name]),
+                        ls=styles[n % 4], lw=1.5, label=name)
+        line.set_gid(f"lobe {name}")
+    _setup_polar(ax, scale, floor, rmax)
+    ax.set_title(title or f"luminance f_r (1/sr, {scale}), θi = {float(theta_i_deg):g}°, "
+                 f"φ = {float(phi_deg):g}°", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    return finish(fig, ax, filename)
+
+
+def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resolution=(30, 60),
+                 ax=None, filename=None, title=None):
+    """3-D lobe: the surface r(wo) wo over the upper hemisphere for a fixed wi.
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    theta_i_deg, phi_i_deg : float
+        Direction of the light in degrees.
+    cosine : bool
+        r = luminance(f_r) cos(theta_o) when True (the visible lobe), luminance(f_r) when False;
+        in 1/sr.
+    resolution : (int, int)
+        Samples in theta_o over [0, 90] and in phi_o over [0, 360] degrees.
+    ax : Axes3D, optional
+    filename : str or path, optional
+
+    Returns
+    -------
+    (fig, ax)
+        The surface is ``ax.collections[0]``; its z extent is the largest r cos(theta_o).
+    """
+    check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999)
+    nt, npf = (int(v) for v in resolution)
+    if nt < 2 or npf < 3:
+        raise ValueError(f"resolution must be at least (2, 3); got {resolution}")
+    fig, ax = new_axes(ax, projection="3d", figsize=(5.0, 4.5))
+    t = np.radians(np.linspace(0.0, 90.0, nt))
+    p = np.radians(np.linspace(0.0, 360.0, npf))
+    T, P = np.meshgrid(t, p, indexing="ij")
+    wo = from_angles(T, P)
+    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
+    r = luminance(eval_brdf(brdf, wi, wo))
+    if cosine:
+        r = r * np.cos(T)
+    X, Y, Z = (r * wo[..., k] for k in range(3))
+    import matplotlib
+    norm = matplotlib.colors.Normalize(0.0, max(float(np.nanmax(r)), 1e-12))
+    facecolors = matplotlib.colormaps["viridis"](norm(r))
+    ax.plot_surface(X, Y, Z, facecolors=facecolors, rstride=1, cstride=1, linewidth=0,
+                    antialiased=False, shade=False)
+    ext = max(float(np.nanmax(np.abs([X, Y, Z]))), 1e-12)
+    ax.plot([0, wi[0] * ext], [0, wi[1] * ext], [0, wi[2] * ext], color="orange", lw=1.5,
+            label="wi")
+    ax.set_xlim(-ext, ext)
+    ax.set_ylim(-ext, ext)
+    ax.set_zlim(0, ext)
+    ax.set_xlabel("x (warp)", fontsize=7)
+    ax.set_ylabel("y (weft)", fontsize=7)
+    ax.set_zlabel("z", fontsize=7)
+    ax.tick_params(labelsize=6)
+    what = "luminance f_r cos θo" if cosine else "luminance f_r"
+    ax.set_title(title or f"3-D lobe, {what} (1/sr), θi = {float(theta_i_deg):g}°, "
+                 f"φi = {float(phi_i_deg):g}°", fontsize=9)
+    return finish(fig, ax, filename)

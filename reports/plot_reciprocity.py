@@ -1,0 +1,94 @@
+"""Reciprocity error maps over a (theta_i, theta_o) grid at fixed azimuths."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import eval_brdf, finish, from_angles, new_axes
+
+__all__ = ["reciprocity_map", "plot_reciprocity_map"]
+
+
+def reciprocity_map(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45, quantity="luminance"):
+    """Relative reciprocity error on a grid of incidence and viewing angles.
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    phi_i_deg, phi_o_deg : float
+        Fixed azimuths of wi and wo in degrees (default: the plane of incidence along the warp,
+        light and viewer on opposite sides).
+    resolution : int
+        Cells per axis; cell centres at theta = (k + 1/2) 90 / resolution degrees.
+    quantity : {"luminance", "rgb"}
+        "luminance" compares Rec. 709 luminances; "rgb" takes the largest error over the
+        three channels.
+
+    Returns
+    -------
+    theta_deg : numpy.ndarray, shape (resolution,)
+    error : numpy.ndarray, shape (resolution, resolution)
+        error[i, o] = |f(wi, wo) - f(wo, wi)| / max(f(wi, wo), f(wo, wi)) (unitless, 0 where
+        both are 0), rows theta_i, columns theta_o.
+    """
+    if quantity not in ("luminance", "rgb"):
+        raise ValueError(f"quantity must be 'luminance' or 'rgb'; got {quantity!r}")
+    n = int(resolution)
+    if n < 1:
+        raise ValueError(f"resolution must be at least 1; got {resolution}")
+    theta = (np.arange(n) + 0.5) * 90.0 / n
+    TI, TO = np.meshgrid(np.radians(theta), np.radians(theta), indexing="ij")
+    wi = from_angles(TI, np.radians(phi_i_deg))
+    wo = from_angles(TO, np.radians(phi_o_deg))
+    a = eval_brdf(brdf, wi, wo)
+    b = eval_brdf(brdf, wo, wi)
+    if quantity == "luminance":
+        from reports.colour import luminance
+        a, b = luminance(a), luminance(b)
+    big = np.maximum(np.abs(a), np.abs(b))
+    err = np.divide(np.abs(a - b), big, out=np.zeros_like(big), where=big > 0)
+    if quantity == "rgb":
+        err = err.max(axis=-1)
+    return theta, err
+
+
+def plot_reciprocity_map(brdf=None, phi_i_deg=180.0, phi_o_deg=0.0, *, theta_deg=None,
+                         error=None, resolution=45, quantity="luminance", ax=None,
+                         filename=None, title=None):
+    """Image of the relative reciprocity error over (theta_o, theta_i).
+
+    Either ``brdf`` (the map is computed by :func:`reciprocity_map`) or precomputed
+    ``theta_deg`` and ``error`` (shape (n, n), rows theta_i) are given.
+
+    Returns
+    -------
+    (fig, ax)
+        ``ax.images[0].get_array()`` is the error map (rows theta_i, columns theta_o),
+        unitless in [0, 1]; the colour bar is labelled.
+    """
+    if error is None:
+        if brdf is None:
+            raise ValueError("plot_reciprocity_map needs brdf or theta_deg and error")
+        theta_deg, error = reciprocity_map(brdf, phi_i_deg, phi_o_deg, resolution, quantity)
+    else:
+        error = np.asarray(error, dtype=np.float64)
+        if error.ndim != 2 or error.shape[0] != error.shape[1]:
+            raise ValueError(f"error must be a square (n, n) map; got {error.shape}")
+        if theta_deg is None:
+            n = error.shape[0]
+            theta_deg = (np.arange(n) + 0.5) * 90.0 / n
+    theta_deg = np.asarray(theta_deg, dtype=np.float64)
+    step = theta_deg[1] - theta_deg[0] if theta_deg.size > 1 else 90.0
+    lo, hi = theta_deg[0] - step / 2, theta_deg[-1] + step / 2
+    fig, ax = new_axes(ax, figsize=(5.0, 4.2))
+    im = ax.imshow(error, origin="lower", extent=(lo, hi, lo, hi), vmin=0.0, vmax=1.0,
+                   cmap="viridis", interpolation="nearest")
+    fig.colorbar(im, ax=ax, label="|f(wi,wo) − f(wo,wi)| / max (unitless)")
+    ax.set_xlabel("θo (degrees)")
+    ax.set_ylabel("θi (degrees)")
+    finite = error[np.isfinite(error)]
+    stats = (f"median {np.median(finite):.3g}, max {np.max(finite):.3g}" if finite.size
+             else "no data")
+    ax.set_title(title or f"reciprocity error, φi = {phi_i_deg:g}°, φo = {phi_o_deg:g}°\n"
+                 f"({stats})", fontsize=9)
+    return finish(fig, ax, filename)

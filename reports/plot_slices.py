@@ -1,0 +1,208 @@
+"""The BRDF Explorer's cartesian slices and its theta_h x theta_d image slice.
+
+Half/difference angles follow Rusinkiewicz (1998): theta_h, phi_h locate the half vector h,
+theta_d, phi_d the incident direction in the frame whose pole is h
+(:func:`reports._plotting.half_diff_to_io`). For an anisotropic BRDF such as cloth, phi_h
+matters too: every slice takes it (default 0, the half vector in the warp's plane).
+Pairs with either direction below the horizon evaluate to 0 (the BRDF's own convention). The
+cartesian slices stop at ``theta_max_deg`` (default 89.5 degrees) short of the horizon, where
+wi and wo can both graze and the model's value is a limit it reaches only in round-off.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import (check_angle, eval_brdf, finish, from_angles, half_diff_to_io,
+                               new_axes, quantity_styles, reduce_quantity, check_quantity)
+from reports.colour import line_colour, luminance
+
+__all__ = ["plot_slice_theta_o", "plot_slice_theta_h", "plot_slice_theta_d",
+           "plot_slice_image", "slice_image"]
+
+
+def _check_max(theta_max_deg):
+    v = float(theta_max_deg)
+    if not 0.0 < v <= 90.0:
+        raise ValueError(f"theta_max_deg must be in (0, 90] degrees; got {theta_max_deg!r}")
+    return v
+
+
+def _check_res(resolution, least=2):
+    if int(resolution) < least:
+        raise ValueError(f"resolution must be at least {least}; got {resolution}")
+    return int(resolution)
+
+
+def _draw(ax, x_deg, values, quantity, colour, log, gid):
+    styles = quantity_styles(quantity, colour)
+    for k, col, suffix in styles:
+        y = values[..., k] if values.ndim == 2 else values
+        line, = ax.plot(x_deg, y, color=col, lw=1.4,
+                        label=("luminance" if k is None else "RGB"[k]))
+        line.set_gid(f"{gid} {'luminance' if k is None else 'rgb'[k]}")
+    if log:
+        ax.set_yscale("log")
+    ax.set_ylabel("f_r (1/sr)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, frameon=False)
+
+
+def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *,
+                       quantity="rgb", log=False, resolution=181, theta_max_deg=89.5, ax=None,
+                       filename=None,
+                       title=None):
+    """f_r against theta_o at fixed wi and viewing azimuth phi_o.
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    theta_i_deg, phi_i_deg : float
+        The light's direction in degrees (default: 30 degrees, on the -x side).
+    phi_o_deg : float
+        Azimuth of the viewer in degrees.
+    quantity : {"rgb", "luminance", "r", "g", "b"}
+        "rgb" draws three curves in red, green and blue; "luminance" one curve in the fabric's
+        sRGB colour.
+    log : bool
+        Logarithmic y axis.
+    resolution : int
+        Samples of theta_o over [0, theta_max_deg] degrees.
+    theta_max_deg : float
+        End of the swept angle in degrees (all three cartesian slices take it).
+
+    Returns
+    -------
+    (fig, ax)
+        Lines have x = theta_o in degrees and y = f_r in 1/sr; gid "theta_o <channel>".
+    """
+    check_quantity(quantity)
+    check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
+    n = _check_res(resolution)
+    fig, ax = new_axes(ax)
+    x = np.linspace(0.0, _check_max(theta_max_deg), n)
+    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
+    wo = from_angles(np.radians(x), np.radians(phi_o_deg))
+    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
+    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_o")
+    ax.set_xlabel("θo (degrees)")
+    ax.set_title(title or f"θi = {theta_i_deg:g}°, φi = {phi_i_deg:g}°, φo = {phi_o_deg:g}°",
+                 fontsize=9)
+    return finish(fig, ax, filename)
+
+
+def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
+                       quantity="rgb", log=True, resolution=181, theta_max_deg=89.5, ax=None,
+                       filename=None,
+                       title=None):
+    """f_r against theta_h in [0, theta_max_deg] at fixed theta_d, phi_d and phi_h (degrees).
+
+    Returns
+    -------
+    (fig, ax)
+        Lines have x = theta_h in degrees and y = f_r in 1/sr; gid "theta_h <channel>".
+    """
+    check_quantity(quantity)
+    check_angle("theta_d_deg", theta_d_deg, 0.0, 90.0)
+    n = _check_res(resolution)
+    fig, ax = new_axes(ax)
+    x = np.linspace(0.0, _check_max(theta_max_deg), n)
+    wi, wo = half_diff_to_io(np.radians(x), np.radians(theta_d_deg), np.radians(phi_d_deg),
+                             np.radians(phi_h_deg))
+    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
+    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_h")
+    ax.set_xlabel("θh (degrees)")
+    ax.set_title(title or f"θd = {theta_d_deg:g}°, φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°",
+                 fontsize=9)
+    return finish(fig, ax, filename)
+
+
+def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
+                       quantity="rgb", log=True, resolution=181, theta_max_deg=89.5, ax=None,
+                       filename=None,
+                       title=None):
+    """f_r against theta_d in [0, theta_max_deg] at fixed theta_h, phi_d and phi_h (degrees).
+
+    Returns
+    -------
+    (fig, ax)
+        Lines have x = theta_d in degrees and y = f_r in 1/sr; gid "theta_d <channel>".
+    """
+    check_quantity(quantity)
+    check_angle("theta_h_deg", theta_h_deg, 0.0, 90.0)
+    n = _check_res(resolution)
+    fig, ax = new_axes(ax)
+    x = np.linspace(0.0, _check_max(theta_max_deg), n)
+    wi, wo = half_diff_to_io(np.radians(theta_h_deg), np.radians(x), np.radians(phi_d_deg),
+                             np.radians(phi_h_deg))
+    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
+    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_d")
+    ax.set_xlabel("θd (degrees)")
+    ax.set_title(title or f"θh = {theta_h_deg:g}°, φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°",
+                 fontsize=9)
+    return finish(fig, ax, filename)
+
+
+def slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, resolution=90):
+    """Luminance of f_r on the theta_h x theta_d grid at fixed phi_d, phi_h.
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    phi_d_deg, phi_h_deg : float
+        Difference and half azimuths in degrees.
+    resolution : int
+        Cells per axis; cell centres at (k + 1/2) 90 / resolution degrees.
+
+    Returns
+    -------
+    theta_deg : numpy.ndarray, shape (resolution,)
+        Cell centres in degrees (the same for both axes).
+    image : numpy.ndarray, shape (resolution, resolution)
+        Luminance f_r in 1/sr, rows = theta_d, columns = theta_h.
+    """
+    n = _check_res(resolution, 1)
+    theta = (np.arange(n) + 0.5) * 90.0 / n
+    TD, TH = np.meshgrid(np.radians(theta), np.radians(theta), indexing="ij")
+    wi, wo = half_diff_to_io(TH, TD, np.radians(phi_d_deg), np.radians(phi_h_deg))
+    return theta, luminance(eval_brdf(brdf, wi, wo))
+
+
+def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4.0,
+                     resolution=90, ax=None, filename=None, title=None):
+    """The Explorer's image slice: luminance f_r over theta_h (x) and theta_d (y).
+
+    Parameters
+    ----------
+    brdf : object with ``.eval``
+    phi_d_deg, phi_h_deg : float
+        Fixed azimuths in degrees.
+    log : bool
+        Logarithmic colour scale over ``decades`` below the peak (zeros shown at the floor).
+    resolution : int
+        Cells per axis.
+
+    Returns
+    -------
+    (fig, ax)
+        ``ax.images[0].get_array()`` is the luminance image in 1/sr (rows theta_d from 0 at
+        the bottom, columns theta_h), as :func:`slice_image` returns it.
+    """
+    import matplotlib.colors as mcolors
+    theta, img = slice_image(brdf, phi_d_deg, phi_h_deg, resolution)
+    fig, ax = new_axes(ax, figsize=(5.0, 4.2))
+    peak = float(np.nanmax(img)) if np.any(img > 0) else 1.0
+    norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=True) if log
+            else mcolors.Normalize(vmin=0.0, vmax=peak))
+    im = ax.imshow(img, origin="lower", extent=(0, 90, 0, 90), norm=norm, cmap=_CMAP(),
+                   interpolation="nearest", aspect="equal")
+    fig.colorbar(im, ax=ax, label="luminance f_r (1/sr)")
+    ax.set_xlabel("θh (degrees)")
+    ax.set_ylabel("θd (degrees)")
+    ax.set_title(title or f"φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°", fontsize=9)
+    return finish(fig, ax, filename)
+
+
+def _CMAP():
+    import matplotlib
+    return matplotlib.colormaps["magma"].with_extremes(bad="black", under="black")

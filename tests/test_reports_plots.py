@@ -1,0 +1,300 @@
+"""Tests of the plot modules: every plot returns a figure holding the expected data.
+
+Reference values are computed here from the BRDF directly, with direction formulas written out
+independently of reports._plotting.
+"""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import brdf  # noqa: E402
+from gonio import Table  # noqa: E402
+from reports import plots  # noqa: E402
+from reports_standin import Lambert, Phongish  # noqa: E402
+
+W = np.array([0.2126, 0.7152, 0.0722])
+
+
+def sph(theta_deg, phi_deg):
+    t, p = np.radians(theta_deg), np.radians(phi_deg)
+    t, p = np.broadcast_arrays(t, p)
+    return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
+
+
+def ev(fab, wi, wo):
+    wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+    return fab.eval(wi.reshape(-1, 3), wo.reshape(-1, 3)).reshape(wi.shape)
+
+
+@pytest.fixture(scope="module")
+def velvet():
+    return brdf.fabric("velvet")
+
+
+@pytest.fixture(scope="module")
+def silk():
+    return brdf.fabric("silk_crepe_de_chine")
+
+
+def lines_by_gid(ax):
+    return {l.get_gid(): l for l in ax.get_lines() if l.get_gid()}
+
+
+@pytest.mark.parametrize("phi", [0.0, 45.0, 90.0])
+def test_polar_lobe_values_equal_eval(velvet, phi):
+    fig, ax = plots.plot_polar_lobe(velvet, [20.0, 50.0], phi, resolution=37)
+    lines = lines_by_gid(ax)
+    for ti in (20.0, 50.0):
+        line = lines[f"lobe theta_i={ti:g} luminance"]
+        x = np.degrees(line.get_xdata())
+        assert np.allclose(x, np.linspace(-90, 90, 37))
+        # light on the far side of the plane: azimuth phi + 180
+        wi = sph(ti, phi + 180.0)
+        wo = np.where((x >= 0)[:, None], sph(np.abs(x), phi), sph(np.abs(x), phi + 180.0))
+        expected = ev(velvet, wi, wo) @ W
+        # interior points: at the horizon itself (z ~ 6e-17) the model is sensitive to
+        # round-off in the other components
+        assert np.allclose(line.get_ydata()[1:-1], expected[1:-1], rtol=1e-10, atol=1e-14)
+    assert ax.name == "polar"
+
+
+def test_polar_lobe_rgb_and_log(silk):
+    fig, ax = plots.plot_polar_lobe(silk, 30.0, 0.0, quantity="rgb", resolution=19)
+    lines = lines_by_gid(ax)
+    x = np.linspace(-90, 90, 19)
+    wo = np.where((x >= 0)[:, None], sph(np.abs(x), 0.0), sph(np.abs(x), 180.0))
+    f = ev(silk, sph(30.0, 180.0), wo)
+    for k, c in enumerate("rgb"):
+        line = lines[f"lobe theta_i=30 {c}"]
+        assert np.allclose(line.get_ydata()[1:-1], f[1:-1, k])
+        assert line.get_color() == ("tab:red", "tab:green", "tab:blue")[k]
+    fig, ax = plots.plot_polar_lobe(silk, 30.0, 0.0, scale="log", decades=3, resolution=19)
+    y = lines_by_gid(ax)["lobe theta_i=30 luminance"].get_ydata()
+    lum = f @ W
+    floor = 10.0 ** np.floor(np.log10(lum.max()) - 3)
+    assert np.allclose(y[1:-1], np.log10(np.maximum(lum, floor) / floor)[1:-1])
+
+
+def test_lobe_planes_and_comparison(velvet, silk):
+    fig, axes = plots.plot_lobe_planes(velvet, (30.0,), (0.0, 90.0), resolution=11)
+    assert len(axes) == 2 and all(a.name == "polar" for a in axes)
+    fig, ax = plots.plot_lobe_comparison({"velvet": velvet, "silk": silk}, 40.0, 90.0,
+                                         scale="linear", resolution=13)
+    lines = lines_by_gid(ax)
+    x = np.linspace(-90, 90, 13)
+    wo = np.where((x >= 0)[:, None], sph(np.abs(x), 90.0), sph(np.abs(x), 270.0))
+    assert np.allclose(lines["lobe silk"].get_ydata()[1:-1],
+                       (ev(silk, sph(40.0, 270.0), wo) @ W)[1:-1])
+
+
+def test_saves_only_when_given_a_filename(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    lam = Lambert()
+    plots.plot_polar_lobe(lam, resolution=5)
+    plots.plot_hemisphere(lam, resolution=8)
+    assert list(tmp_path.iterdir()) == []
+    target = tmp_path / "sub" / "lobe.png"
+    target.parent.mkdir()
+    fig, ax = plots.plot_polar_lobe(lam, resolution=5, filename=target)
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in target.parent.iterdir()] == ["lobe.png"]  # no temp file left
+    plots.plot_slice_theta_h(lam, resolution=5, filename=tmp_path / "s.svg")
+    assert (tmp_path / "s.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_given_axes_are_used(velvet):
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots()
+    f2, a2 = plots.plot_slice_theta_o(velvet, ax=ax, resolution=5)
+    assert f2 is fig and a2 is ax
+    with pytest.raises(ValueError, match="projection"):
+        plots.plot_polar_lobe(velvet, ax=ax)
+    plt.close(fig)
+
+
+def test_half_diff_conversion_properties():
+    th, td, pd, ph = np.radians([25.0, 40.0, 70.0, 30.0])
+    wi, wo = plots.half_diff_to_io(th, td, pd, ph)
+    h = (wi + wo) / np.linalg.norm(wi + wo)
+    assert np.allclose(h, sph(25.0, 30.0))
+    assert np.degrees(np.arccos(wi @ h)) == pytest.approx(40.0)
+    assert np.linalg.norm(wi) == pytest.approx(1.0) and np.linalg.norm(wo) == pytest.approx(1.0)
+    # theta_h = 0: h = n, wi at (theta_d, phi_d), wo its mirror about n
+    wi, wo = plots.half_diff_to_io(0.0, td, pd, 0.0)
+    assert np.allclose(wi, sph(40.0, 70.0))
+    assert np.allclose(wo, sph(40.0, 250.0))
+
+
+def test_cartesian_slices_equal_eval(silk):
+    x = np.linspace(0, 89.5, 7)
+    fig, ax = plots.plot_slice_theta_o(silk, 30.0, 180.0, 45.0, resolution=7)
+    f = ev(silk, sph(30.0, 180.0), sph(x, 45.0))
+    for k, c in enumerate("rgb"):
+        assert np.allclose(lines_by_gid(ax)[f"theta_o {c}"].get_ydata(), f[:, k])
+    # theta_d slice at theta_h = 0: wi = (theta_d, phi_d), wo = (theta_d, phi_d + 180)
+    fig, ax = plots.plot_slice_theta_d(silk, 0.0, 60.0, resolution=7, quantity="luminance")
+    x = lines_by_gid(ax)["theta_d luminance"].get_xdata()
+    assert x[-1] == pytest.approx(89.5)
+    inside = x < 90
+    expected = ev(silk, sph(x, 60.0), sph(x, 240.0)) @ W
+    assert np.allclose(lines_by_gid(ax)["theta_d luminance"].get_ydata()[inside],
+                       expected[inside])
+    fig, ax = plots.plot_slice_theta_h(silk, 10.0, 90.0, 0.0, resolution=7, quantity="g")
+    wi, wo = plots.half_diff_to_io(np.radians(np.linspace(0, 89.5, 7)), np.radians(10.0),
+                                   np.radians(90.0))
+    assert np.allclose(lines_by_gid(ax)["theta_h g"].get_ydata(), ev(silk, wi, wo)[:, 1])
+
+
+def test_slice_image_equals_eval(velvet):
+    fig, ax = plots.plot_slice_image(velvet, 90.0, resolution=6)
+    img = np.asarray(ax.images[0].get_array())
+    assert img.shape == (6, 6)
+    centres = (np.arange(6) + 0.5) * 15.0
+    r, c = 4, 1   # theta_d = 67.5, theta_h = 22.5
+    wi, wo = plots.half_diff_to_io(np.radians(centres[c]), np.radians(centres[r]),
+                                   np.radians(90.0))
+    assert img[r, c] == pytest.approx(float(ev(velvet, wi, wo) @ W))
+
+
+def test_hemisphere_is_equal_area_and_equals_eval(silk):
+    n = 40
+    fig, ax = plots.plot_hemisphere(silk, 45.0, 30.0, resolution=n)
+    img = ax.images[0].get_array()
+    assert img.shape == (n, n)
+    c = (np.arange(n) + 0.5) / n * 2 - 1
+    y, x = np.meshgrid(c, c, indexing="ij")
+    rho = np.hypot(x, y)
+    assert np.array_equal(np.ma.getmaskarray(img), rho > 1)
+    theta = np.degrees(2 * np.arcsin(np.clip(rho, 0, 1) / np.sqrt(2)))
+    phi = np.degrees(np.arctan2(y, x))
+    expected = ev(silk, sph(45.0, 30.0), sph(theta, phi)) @ W
+    inside = rho <= 1
+    assert np.allclose(img[inside], expected[inside])
+    # equal area: the cap theta < 60 degrees has half the hemisphere's solid angle
+    assert np.mean(theta[inside] < 60.0) == pytest.approx(0.5, abs=0.03)
+    assert "1/sr" in fig.axes[-1].get_ylabel()   # the colour bar
+    fig, ax = plots.plot_hemisphere(silk, 45.0, 30.0, quantity="srgb", resolution=8)
+    assert ax.images[0].get_array().shape == (8, 8, 4)
+
+
+def test_lobe_3d(velvet):
+    fig, ax = plots.plot_lobe_3d(velvet, 40.0, 0.0, resolution=(7, 9))
+    assert ax.name == "3d"
+    t, p = np.meshgrid(np.linspace(0, 90, 7), np.linspace(0, 360, 9), indexing="ij")
+    r = ev(velvet, sph(40.0, 0.0), sph(t, p)) @ W * np.cos(np.radians(t))
+    zmax = float(np.max(r * np.cos(np.radians(t))))
+    surf = ax.collections[0]
+    assert len(surf.get_facecolors()) == 6 * 8
+    assert ax.zz_dataLim.intervalx[1] >= zmax * (1 - 1e-9)
+
+
+def test_masking_views(velvet):
+    fig, ax = plots.plot_masking_lobes(velvet, 70.0, 0.0, resolution=13)
+    lines = lines_by_gid(ax)
+    x = np.linspace(-90, 90, 13)
+    wo = np.where((x >= 0)[:, None], sph(np.abs(x), 0.0), sph(np.abs(x), 180.0))
+    off = brdf.fabric("velvet", masking=False)
+    inner = slice(1, -1)  # away from the horizon (see test_polar_lobe_values_equal_eval)
+    assert np.allclose(lines["masking off"].get_ydata()[inner],
+                       (ev(off, sph(70.0, 180.0), wo) @ W)[inner])
+    assert np.allclose(lines["masking on"].get_ydata()[inner],
+                       (ev(velvet, sph(70.0, 180.0), wo) @ W)[inner])
+    assert not np.allclose(lines["masking on"].get_ydata(), lines["masking off"].get_ydata())
+    fig, ax = plots.plot_masking_terms((30.0,), resolution=13)
+    lines = lines_by_gid(ax)
+    x = np.linspace(-180, 180, 13)
+    assert np.allclose(lines["M"].get_ydata(), np.maximum(np.cos(np.radians(x)), 0))
+    assert np.allclose(lines["u"].get_ydata(), np.exp(-x ** 2 / (2 * 20.0 ** 2)))
+    # pair weight at phi_o = 0 against phi_i = 30: delta = -30 degrees
+    ud = np.exp(-30.0 ** 2 / (2 * 20.0 ** 2))
+    mi, mo = np.cos(np.radians(30.0)), 1.0
+    expected = (1 - ud) * mi * mo + ud * min(mi, mo)
+    assert lines["pair phi_i=30"].get_ydata()[6] == pytest.approx(expected)
+    with pytest.raises(ValueError, match="replace"):
+        plots.plot_masking_lobes(Lambert())
+
+
+def test_albedo_from_arrays_and_results():
+    theta = np.array([0.0, 30.0, 60.0])
+    val = np.array([[0.5, 0.6, 0.7], [0.4, 0.5, 0.6], [0.3, 0.2, 1.1]])
+    err = np.full((3, 3), 0.01)
+
+    class Result:
+        value, error = val, err
+
+    fig, ax = plots.plot_albedo(theta, Result())
+    lines = lines_by_gid(ax)
+    for k, c in enumerate("rgb"):
+        assert np.allclose(lines[f"albedo albedo {c}"].get_ydata(), val[:, k])
+    fig, ax = plots.plot_albedo(theta, val, err, quantity="luminance", label="x")
+    assert np.allclose(lines_by_gid(ax)["albedo x luminance"].get_ydata(), val @ W)
+    fig, ax = plots.plot_albedo(theta, val[:, 0])
+    assert np.allclose(lines_by_gid(ax)["albedo albedo grey"].get_ydata(), val[:, 0])
+    with pytest.raises(ValueError, match="albedo must have shape"):
+        plots.plot_albedo(theta, val[:2])
+    with pytest.raises(ValueError, match="error"):
+        plots.plot_albedo(theta, val, err[:, :2])
+
+
+def test_reciprocity_map():
+    b = Phongish()
+    theta, err = plots.reciprocity_map(b, 180.0, 0.0, resolution=5)
+    assert np.allclose(theta, [9, 27, 45, 63, 81])
+    i, o = 1, 3
+    wi, wo = sph(theta[i], 180.0), sph(theta[o], 0.0)
+    a, c = ev(b, wi, wo) @ W, ev(b, wo, wi) @ W
+    assert err[i, o] == pytest.approx(abs(a - c) / max(a, c))
+    assert err.max() > 0.01
+    theta, err0 = plots.reciprocity_map(Lambert(), resolution=4)
+    assert np.all(err0 == 0)
+    fig, ax = plots.plot_reciprocity_map(b, resolution=5)
+    assert np.allclose(ax.images[0].get_array(), err)
+    fig, ax = plots.plot_reciprocity_map(theta_deg=theta, error=err0)
+    with pytest.raises(ValueError, match="square"):
+        plots.plot_reciprocity_map(error=np.zeros((2, 3)))
+
+
+def test_fit_overlay(silk):
+    x = np.linspace(-80, 80, 17)
+    rows_wi, rows_wo = [], []
+    for ti in (20.0, 50.0):
+        for s in x:
+            rows_wi.append(sph(ti, 180.0))
+            rows_wo.append(sph(abs(s), 0.0 if s >= 0 else 180.0))
+    rows_wi.append(sph(30.0, 60.0))          # off the plane: left out
+    rows_wo.append(sph(30.0, 100.0))
+    wi, wo = np.array(rows_wi), np.array(rows_wo)
+    vals = ev(silk, wi, wo) * 1.1
+    vals[3] = np.nan                                # invalid: left out
+    table = Table(wi.copy(), wo.copy(), vals, sigma=0.05 * np.nan_to_num(vals) + 1e-4)
+    fig, ax = plots.plot_fit_overlay(table, silk, 0.0, resolution=9)
+    lines = lines_by_gid(ax)
+    data = lines["data theta_i=20 r"]
+    keep = np.ones(17, bool)
+    keep[3] = False
+    assert np.allclose(data.get_xdata(), x[keep])
+    assert np.allclose(data.get_ydata(), vals[:17, 0][keep])
+    xm = np.linspace(-90, 90, 9)
+    wom = np.where((xm >= 0)[:, None], sph(np.abs(xm), 0.0), sph(np.abs(xm), 180.0))
+    assert np.allclose(lines["model theta_i=50 b"].get_ydata()[1:-1],
+                       ev(silk, sph(50.0, 180.0), wom)[1:-1, 2])
+    assert "data theta_i=30 r" not in lines
+    with pytest.raises(ValueError, match="no valid points"):
+        plots.plot_fit_overlay(table, silk, 37.0)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda b: plots.plot_polar_lobe(b, 95.0), "theta_i_deg"),
+    (lambda b: plots.plot_polar_lobe(b, quantity="hsv"), "quantity"),
+    (lambda b: plots.plot_polar_lobe(b, scale="sqrt"), "scale"),
+    (lambda b: plots.plot_hemisphere(b, quantity="rgb"), "quantity"),
+    (lambda b: plots.plot_slice_theta_h(b, resolution=1), "resolution"),
+    (lambda b: plots.plot_lobe_3d(b, resolution=(1, 1)), "resolution"),
+])
+def test_bad_input(call, match):
+    with pytest.raises(ValueError, match=match):
+        call(Lambert())

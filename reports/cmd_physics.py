@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from pathlib import Path
 
 import brdf
-from reports import cliutil
+from gonio.atomic import atomic_write
 
 #: ../shared/data beside the repository (override with --data or MICROCYL_DATA).
 DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -45,6 +46,25 @@ def _floats(text: str, what: str) -> tuple[float, ...]:
     if not vals or not all(math.isfinite(v) for v in vals):
         raise ValueError(f"{what} must be comma-separated finite numbers; got {text!r}")
     return vals
+
+
+def _finite(x):
+    """Replace NaN and infinities (not valid JSON) by None, recursively."""
+    if isinstance(x, float):
+        return x if math.isfinite(x) else None
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    return x
+
+
+def write_json(path, data) -> None:
+    """Write ``data`` as indented JSON (NaN and inf as null) through a temporary file
+    renamed into place."""
+    with atomic_write(path, "w") as fh:
+        json.dump(_finite(data), fh, indent=2, allow_nan=False)
+        fh.write("\n")
 
 
 def _check_json_target(path):
@@ -164,7 +184,7 @@ def run_energy(args) -> int:
                         workers=args.workers, progress=not args.quiet)
     print(format_energy(rep))
     if target is not None:
-        cliutil.atomic_write_json(target, rep.to_dict())
+        write_json(target, rep.to_dict())
         print(f"wrote {target}")
     return 0
 
@@ -232,6 +252,6 @@ def run_reciprocity(args) -> int:
     rep["notes"] = notes
     print(format_reciprocity(rep))
     if target is not None:
-        cliutil.atomic_write_json(target, rep)
+        write_json(target, rep)
         print(f"wrote {target}")
     return 0

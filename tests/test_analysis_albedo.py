@@ -159,3 +159,13 @@ def test_bad_directions_and_brdf():
         albedo(Lambert(), [0, 0, 1.0], method="threads")
     with pytest.raises(ValueError, match="theta_deg"):
         albedo_curve(Lambert(), [0, 95])
+
+
+def test_rotated_fabric_uses_its_own_thread_axes():
+    """Turning the fabric and the direction together leaves the albedo unchanged."""
+    rot = 0.4
+    w0 = dirs(np.array([30.0, 75.0]), np.array([0.0, 90.0]))
+    w1 = dirs(np.array([30.0, 75.0]), np.degrees(rot) + np.array([0.0, 90.0]))
+    a = albedo(brdf.fabric("polyester_satin_charmeuse"), w0)
+    b = albedo(brdf.fabric("polyester_satin_charmeuse", rotation=rot), w1)
+    np.testing.assert_allclose(a.value, b.value, atol=1e-9)

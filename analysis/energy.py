@@ -84,8 +84,8 @@ class EnergyReport:
         Directions, tolerance, modes, variants and scan grid used.
     curves : list of dict
         One per (preset, variant, mode): ``theta_deg``, ``phi_deg``, ``value`` and ``error``
-        (T, P, 3), ``max`` (value, error, theta_deg, phi_deg, channel), ``exceeds_one`` and
-        ``possibly_exceeds_one``.
+        (T, P, 3), ``max`` (value, error, theta_deg, phi_deg, channel), ``exceeds_one``,
+        ``possibly_exceeds_one`` and ``first_theta_above_one`` (degrees, or None).
     hemispherical : list of dict
         Hemispherical-hemispherical albedo per preset (default variant): value, error (3,).
     furnace : list of dict
@@ -225,6 +225,28 @@ def _statements(curves, furnace, modes) -> list[str]:
             + f". Largest: {top['preset']}/{top['variant']} {_fmt(m['value'], m['error'])} at "
             f"theta = {m['theta_deg']:g} deg, phi = {m['phi_deg']:g} deg "
             f"({'RGB'[m['channel']]}).")
+    for mode in modes:
+        per_variant = {}
+        for c in curves:
+            if c["mode"] == mode:
+                per_variant.setdefault(c["variant"], []).append(c)
+        parts = [f"{v}: {sum(c['max']['exceeds_one'] for c in cs)}/{len(cs)} presets above 1"
+                 for v, cs in per_variant.items()]
+        if parts:
+            lines.append(f"  {mode} by variant: " + "; ".join(parts) + ".")
+    refl = [c for c in curves if c["mode"] == "reflectance" and c["variant"] == "default"]
+    if refl:
+        grazing = sum(c["max"]["theta_deg"] >= 80 for c in refl)
+        firsts = [f"{c['preset']} {c['first_theta_above_one']:g}" for c in refl
+                  if c["first_theta_above_one"] is not None]
+        if firsts:
+            lines.append("  reflectance of the default variant first exceeds 1 at theta_i "
+                         "(degrees, smallest on the grid): " + ", ".join(firsts) + ".")
+        lines.append(
+            f"  reflectance maxima of the default variant sit at grazing incidence in {grazing} "
+            f"of {len(refl)} presets: f_r = (a1 S1 + a2 S2) / (Q n.wi) keeps the 1/(n.wi) "
+            "while S_j carries only the longitudinal cosine, so rho'(wi) grows like "
+            "1/cos(theta_i) toward the horizon.")
     if furnace:
         for mode in modes:
             rows = [f for f in furnace if mode in f]
@@ -326,7 +348,7 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
     n_scan = (len(presets) * (1 + sum(len(v) for v in scan.values())) * len(modes)
               * len(scan_theta_deg) * len(scan_phi_deg)) if furnace else 0
     total = len(presets) * len(variants) * len(modes) * dirs.shape[0] + n_scan \
-        + (len(presets) * 30 if hemispherical else 0)
+        + (len(presets) * 60 if hemispherical else 0)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -350,15 +372,17 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
                 "error": err.tolist(), "max": info,
                 "exceeds_one": info["exceeds_one"],
                 "possibly_exceeds_one": info["possibly_exceeds_one"],
+                "first_theta_above_one": (float(th[np.any(val - err > 1, axis=(1, 2))][0])
+                                          if info["exceeds_one"] else None),
             })
         hemi = []
         if hemispherical:
             for p in presets:
-                h = albedo_hemispherical(brdf.fabric(p), n_theta=6, n_phi=4, tol=tol,
+                h = albedo_hemispherical(brdf.fabric(p), n_theta=6, n_phi=8, tol=tol,
                                          min_level=min_level, workers=workers)
                 hemi.append({"preset": p, "variant": "default", **h.to_dict()})
                 if tick:
-                    tick(30)
+                    tick(60)
         scan_rows = []
         if furnace:
             scan_rows = white_furnace(presets, scan=scan, theta_deg=scan_theta_deg,

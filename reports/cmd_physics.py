@@ -91,8 +91,9 @@ def register(sub):
     p.add_argument("--variants", metavar="V1,V2",
                    help="variants (default all: default, masking_off, reweighting_off, "
                         "transmission_longitudinal, gap_outgoing)")
-    p.add_argument("--theta-step", type=float, default=5.0, metavar="DEG",
-                   help="step of the theta sweep, degrees (default 5; 89 is always added)")
+    p.add_argument("--theta-step", type=float, default=10.0, metavar="DEG",
+                   help="step of the theta sweep, degrees (default 10; 85 and 89 are always "
+                        "added)")
     p.add_argument("--phi", default="0,90", metavar="DEG,...",
                    help="azimuths of the sweep, degrees from the warp (default 0,90)")
     p.add_argument("--tol", type=float, default=1e-3, help="albedo tolerance (default 1e-3)")
@@ -178,7 +179,8 @@ def run_energy(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be >= 1; got {args.workers}")
     target = _check_json_target(args.json)
-    theta = sorted(set(np.arange(0.0, 89.0 + 1e-9, args.theta_step).round(9).tolist()) | {89.0})
+    theta = sorted(set(np.arange(0.0, 89.0 + 1e-9, args.theta_step).round(9).tolist())
+                   | {85.0, 89.0})
     rep = energy_report(presets, variants, theta_deg=theta, phi_deg=phi, tol=args.tol,
                         hemispherical=not args.no_hemispherical, furnace=not args.no_furnace,
                         workers=args.workers, progress=not args.quiet)

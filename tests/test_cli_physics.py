@@ -28,7 +28,7 @@ def test_energy_small_json(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "silk_shot" in text and "+-" in text
     d = json.loads(out.read_text())
-    assert d["settings"]["theta_deg"] == [0.0, 45.0, 89.0]
+    assert d["settings"]["theta_deg"] == [0.0, 45.0, 85.0, 89.0]
     assert len(d["curves"]) == 2
     assert not list(tmp_path.glob(".*tmp"))
 

@@ -19,10 +19,10 @@ class Lambert:
 
 
 class SeparableLobe:
-    """f = k (n + 2) / (2 pi) cos^n(theta_i) cos^(n - 1)... : here f = k c_n cos^n(i) cos^n(o).
+    """f = k (n + 2) / (2 pi) cos^n(theta_i) cos^n(theta_o), reciprocal.
 
-    With c_n = (n + 2) / (2 pi): integral of f cos(theta_i) dwi = k cos^n(theta_o)
-    (since integral of cos^(n+1) dw = 2 pi / (n + 2)). Reciprocal.
+    Since the integral of cos^(n+1) over the hemisphere is 2 pi / (n + 2), the albedo is
+    integral of f cos(theta_i) dwi = k cos^n(theta_o).
     """
 
     def __init__(self, n=20, k=(0.9, 0.6, 0.3)):

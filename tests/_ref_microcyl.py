@@ -95,7 +95,7 @@ class RefFabric:
         t = np.cos(a)[:, None] * t0 + np.sin(a)[:, None] * nz      # (N, 3)
         nt = np.cos(a)[:, None] * nz - np.sin(a)[:, None] * t0
         def ang(w):
-            wt = w[..., None, :] @ t.T if False else np.einsum("...k,nk->...n", w, t)
+            wt = np.einsum("...k,nk->...n", w, t)
             wn = np.einsum("...k,nk->...n", w, nt)
             wb = (w @ b)[..., None]
             theta = np.arcsin(np.clip(wt, -1, 1))

@@ -12,7 +12,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 import brdf  # noqa: E402
 from _analytic_brdfs import Lambert, Phong, SeparableLobe, TwoLambertThreads  # noqa: E402
-from _ref_microcyl import PRESETS as REF_PRESETS, RefFabric  # noqa: E402
+from spec_reference import ReferenceFabric  # noqa: E402
 
 from analysis import albedo, albedo_curve, albedo_hemispherical  # noqa: E402
 
@@ -77,10 +77,10 @@ def test_thread_rule_on_fake_threads_is_exact_sum():
 
 
 def test_threads_agree_with_independent_transliteration():
-    """brdf's fabric and tests/_ref_microcyl.py (written from MODEL.md) give the same albedo."""
+    """brdf's fabric and tests/spec_reference.py (written from MODEL.md) give the same albedo."""
     w = dirs(np.array([0.0, 70.0]), np.array([0.0, 90.0]))
     ours = albedo(brdf.fabric("polyester_satin_charmeuse"), w)
-    ref = albedo(RefFabric(REF_PRESETS["polyester_satin_charmeuse"]), w, max_level=1)
+    ref = albedo(ReferenceFabric(brdf.fabric("polyester_satin_charmeuse")), w, max_level=1)
     np.testing.assert_allclose(ours.value, ref.value, atol=1e-6)
 
 

@@ -1,12 +1,21 @@
 """analysis package of microcyl: physical checks and Bayesian fitting (emcee)."""
 
+from analysis.albedo import (AlbedoCurve, AlbedoResult, HemisphericalAlbedo, albedo,
+                             albedo_curve, albedo_hemispherical)
+from analysis.energy import VARIANTS, EnergyReport, energy_report, white_furnace
+from analysis.reciprocity import ReciprocityResult, reciprocity, reciprocity_report
+from analysis.sanity import SanityResult, sanity_scan
 from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rhat
 from analysis.fit import FabricModel, FitResult, LogPosterior, fit, write_results
 from analysis.likelihood import Likelihood
-from analysis.params import DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec, defaults_from_fabric
+from analysis.params import (DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec,
+                             defaults_from_fabric)
 
-__all__ = [
-    "ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
-    "Likelihood", "fit", "FitResult", "FabricModel", "LogPosterior", "write_results",
-    "autocorr_time", "split_rhat", "ess", "interval_summary",
-]
+__all__ = []
+__all__ += ["albedo", "albedo_curve", "albedo_hemispherical", "AlbedoResult", "AlbedoCurve",
+            "HemisphericalAlbedo", "energy_report", "white_furnace", "EnergyReport", "VARIANTS",
+            "reciprocity", "reciprocity_report", "ReciprocityResult", "sanity_scan",
+            "SanityResult"]
+__all__ += ["ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
+            "Likelihood", "fit", "FitResult", "FabricModel", "LogPosterior", "write_results",
+            "autocorr_time", "split_rhat", "ess", "interval_summary"]

@@ -6,12 +6,11 @@ gathered in :mod:`reports.plots`.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from gonio.atomic import atomic_write
 from reports.colour import CHANNEL_COLOURS, luminance
 
 __all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
@@ -70,26 +69,9 @@ def save_figure(fig, filename, dpi: int = 110) -> Path:
     """
     path = Path(filename)
     fmt = path.suffix.lstrip(".").lower() or "png"
-    folder = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight")
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    with atomic_write(path, "wb") as fh:
+        fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight")
     return path
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def finish(fig, ax, filename=None, *, dpi: int = 110):

@@ -21,6 +21,7 @@ COMMAND_MODULES = (
     "reports.cmd_measure",
     "reports.cmd_tables",
     "reports.cmd_render",
+    "reports.cmd_physics",
     "reports.cmd_fit",
 )
 

@@ -3,16 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import os
 import tempfile
 from pathlib import Path
 
 import brdf
 
-__all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "atomic_write_text",
-           "check_writable_dir"]
+__all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir"]
 
 
 def _on_off(value: str) -> bool:
@@ -84,26 +81,3 @@ def check_writable_dir(path: Path) -> Path:
         raise OSError(f"output folder {str(path)!r} is not writable: {exc.strerror or exc}") \
             from None
     return path
-
-
-def atomic_write_text(path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file renamed into place."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-
-
-def atomic_write_json(path, data) -> None:
-    """JSON version of :func:`atomic_write_text` (indented, NaN as null is not attempted)."""
-    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=False) + "\n")

@@ -7,10 +7,11 @@ with :func:`os.replace`, so an interrupted write (Ctrl-C included) leaves no par
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from gonio.atomic import atomic_write
 
 __all__ = ["write_exr", "read_exr", "write_png", "encode_srgb", "check_output"]
 
@@ -42,21 +43,11 @@ def check_output(path):
 
 
 def _atomic(path, write):
-    """Call ``write(tmp_path)`` then move the temporary file onto ``path``."""
+    """Call ``write(tmp_path)`` on a temporary file that is moved onto ``path`` on success."""
     path = Path(path)
     check_output(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.resolve().parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+    with atomic_write(path, "wb") as fh:
+        write(fh.tmp_path)
     return path
 
 

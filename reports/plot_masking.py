@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from reports._plotting import finish, new_axes
-from reports.plot_lobes import plot_polar_lobe
 
 __all__ = ["plot_masking_lobes", "plot_masking_terms", "masking_terms"]
 

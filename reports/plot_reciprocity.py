@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import eval_brdf, finish, from_angles, new_axes, check_quantity
+from reports._plotting import eval_brdf, finish, from_angles, new_axes
 
 __all__ = ["reciprocity_map", "plot_reciprocity_map"]
 

@@ -39,7 +39,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from reports._plotting import _umask
+from gonio.atomic import atomic_write, file_mode
 
 __all__ = ["build_report", "SECTIONS", "QUALITIES", "Unavailable", "check_output_dir"]
 
@@ -102,19 +102,8 @@ def check_output_dir(out_dir) -> Path:
 
 
 def _atomic_write(path: Path, data: bytes | str) -> None:
-    mode = "w" if isinstance(data, str) else "wb"
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    try:
-        with os.fdopen(fd, mode, **({"encoding": "utf-8", "newline": ""} if mode == "w" else {})) as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    with atomic_write(path, "w" if isinstance(data, str) else "wb") as fh:
+        fh.write(data)
 
 
 def _jsonable(obj):
@@ -733,7 +722,7 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
             from None
     t_start = time.perf_counter()
     try:
-        os.chmod(tmp, 0o777 & ~_umask())
+        os.chmod(tmp, file_mode(0o777))
         fabs = {n: (f if f is not None else brdf.fabric(n)) for n, f in resolved.items()}
         summaries: dict[str, dict] = {}
         bar = tqdm(total=len(fabs) * len(sections) + 1, disable=not progress, unit="section",

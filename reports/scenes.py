@@ -37,7 +37,7 @@ Named scenes (:data:`SCENES`, built by :func:`make_scene`):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 

@@ -98,15 +98,19 @@ def thread_sample(wi, wo, t0, alpha, th, masking, reweighting, transmission):
     return f_s * (M * P * np.cos(ti))[:, None], P
 
 
-def reference_eval(fabric, wi, wo):
-    """f_r (n, 3) of a brdf.Fabric by MODEL.md, for unit (n, 3) wi, wo above the horizon."""
+def reference_threads(fabric, wi, wo):
+    """Each thread's share a_j S_j / (Q n.wi), shape (n, 2, 3), by MODEL.md.
+
+    ``fabric`` supplies parameters and options only (a brdf.Fabric); wi, wo are unit (n, 3)
+    directions above the horizon.
+    """
     opts = fabric.options
     wi = np.atleast_2d(np.asarray(wi, float))
     wo = np.atleast_2d(np.asarray(wo, float))
     rho = opts["rotation"]
     t0s = [np.array([math.cos(rho), math.sin(rho), 0.0]),
            np.array([math.cos(rho + math.pi / 2), math.sin(rho + math.pi / 2), 0.0])]
-    num = np.zeros((len(wi), 3))
+    parts = []
     Q = np.zeros(len(wi))
     for th, t0 in zip(fabric.threads, t0s):
         alphas = curve_samples(th.offsets, th.lengths, opts["tangent_samples"],
@@ -118,7 +122,7 @@ def reference_eval(fabric, wi, wo):
                                  opts["transmission"])
             S += s / len(alphas)
             Pm += P / len(alphas)
-        num += th.area * S
+        parts.append(th.area * S)
         Q += th.area * Pm
     a1, a2 = fabric.threads[0].area, fabric.threads[1].area
     gap = wi[:, 2] if opts["gap"] == "incident" else wo[:, 2]
@@ -126,9 +130,40 @@ def reference_eval(fabric, wi, wo):
     if not opts["reweighting"]:
         Q = np.ones(len(wi))
     with np.errstate(invalid="ignore", divide="ignore"):
-        out = num / (Q * wi[:, 2])[:, None]
+        out = np.stack(parts, axis=1) / (Q * wi[:, 2])[:, None, None]
     out[Q == 0] = 0
     return out
+
+
+def reference_eval(fabric, wi, wo):
+    """f_r (n, 3) of a brdf.Fabric by MODEL.md, for unit (n, 3) wi, wo above the horizon."""
+    return reference_threads(fabric, wi, wo).sum(axis=1)
+
+
+class ReferenceFabric:
+    """A BRDF object (``eval``, ``eval_threads``) backed by this transliteration.
+
+    Directions may have any leading shape; entries below the horizon give 0.
+    """
+
+    def __init__(self, fabric):
+        self.fabric = fabric
+        self.threads = fabric.threads
+        self.options = fabric.options
+
+    def eval_threads(self, wi, wo):
+        wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        shape = wi.shape[:-1]
+        wi = wi.reshape(-1, 3) / np.linalg.norm(wi.reshape(-1, 3), axis=-1, keepdims=True)
+        wo = wo.reshape(-1, 3) / np.linalg.norm(wo.reshape(-1, 3), axis=-1, keepdims=True)
+        up = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+        out = np.zeros((len(wi), 2, 3))
+        if up.any():
+            out[up] = reference_threads(self.fabric, wi[up], wo[up])
+        return out.reshape(shape + (2, 3))
+
+    def eval(self, wi, wo):
+        return self.eval_threads(wi, wo).sum(axis=-2)
 
 
 def random_pairs(n, rng):

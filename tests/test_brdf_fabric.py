@@ -8,7 +8,7 @@ import pytest
 
 import brdf
 from brdf import Fabric, Thread
-from spec_reference import SIGMA_U, random_pairs, reference_eval, thread_sample
+from spec_reference import random_pairs, reference_eval, thread_sample
 
 VARIANTS = [
     {},

@@ -1,0 +1,322 @@
+"""Reciprocity: how far f_r(wi, wo) is from f_r(wo, wi).
+
+For each direction pair the relative asymmetry is
+
+    r(wi, wo) = |f(wi, wo) - f(wo, wi)| / max(f(wi, wo), f(wo, wi)),
+
+between 0 (reciprocal) and 1 (one of the two is 0), computed on the luminance
+Y = 0.2126 R + 0.7152 G + 0.0722 B of the RGB f_r (Rec. ITU-R BT.709 weights, the Y row of the
+linear-sRGB to XYZ matrix) unless a channel is asked for. Pairs where both values are 0 are
+excluded and counted; so are pairs where either value is not finite.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["ReciprocityResult", "reciprocity", "reciprocity_report", "random_pairs", "LUMINANCE"]
+
+#: Rec. ITU-R BT.709 luminance weights of linear RGB.
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+_CHANNELS = {"luminance": None, "r": 0, "g": 1, "b": 2, 0: 0, 1: 1, 2: 2}
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class ReciprocityResult:
+    """Distribution of the relative reciprocity error over direction pairs.
+
+    Attributes
+    ----------
+    median, p95, max, mean : float
+        Statistics of r over the included pairs (dimensionless, in [0, 1]); NaN if none.
+    n_pairs : int
+        Pairs examined.
+    n_included : int
+        Pairs with at least one non-zero, finite value.
+    n_zero : int
+        Pairs excluded because f(wi, wo) = f(wo, wi) = 0.
+    n_nonfinite : int
+        Pairs excluded because a value was NaN or infinite.
+    channel : str
+        ``"luminance"`` or ``"r"``, ``"g"``, ``"b"``.
+    worst : list of dict
+        The worst pairs: ``theta_i, phi_i, theta_o, phi_o`` in degrees, ``f_io`` = f(wi, wo),
+        ``f_oi`` = f(wo, wi) (1/sr, on the chosen channel) and ``r``.
+    """
+
+    median: float
+    p95: float
+    max: float
+    mean: float
+    n_pairs: int
+    n_included: int
+    n_zero: int
+    n_nonfinite: int
+    channel: str
+    worst: list
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-serializable data (NaN becomes None)."""
+        d = dataclasses.asdict(self)
+        for k in ("median", "p95", "max", "mean"):
+            d[k] = None if not math.isfinite(d[k]) else float(d[k])
+        return d
+
+
+def random_pairs(n: int, seed=0) -> tuple[np.ndarray, np.ndarray]:
+    """n direction pairs drawn uniformly (in solid angle) on the upper hemisphere.
+
+    Parameters
+    ----------
+    n : int
+        Number of pairs.
+    seed : int or numpy.random.Generator
+        The same seed gives the same pairs.
+
+    Returns
+    -------
+    wi, wo : ndarray, shape (n, 3)
+
+    Examples
+    --------
+    >>> wi, wo = random_pairs(4, seed=1)
+    >>> wi.shape, bool(np.all(wi[:, 2] > 0))
+    ((4, 3), True)
+    """
+    if int(n) < 1:
+        raise ValueError(f"n must be >= 1; got {n}")
+    rng = np.random.default_rng(seed)
+    u = rng.random((2, int(n), 2))
+    z = 1.0 - u[..., 0]                      # uniform in (0, 1]: uniform in solid angle
+    phi = 2 * np.pi * u[..., 1]
+    s = np.sqrt(1.0 - z * z)
+    w = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=-1)
+    return w[0], w[1]
+
+
+def _angles_deg(w):
+    theta = np.degrees(np.arccos(np.clip(w[..., 2], -1, 1)))
+    phi = np.degrees(np.arctan2(w[..., 1], w[..., 0])) % 360.0
+    return theta, phi
+
+
+def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance",
+                n_worst: int = 5, weight: str = "none") -> ReciprocityResult:
+    """Relative reciprocity error of a BRDF over random or given direction pairs.
+
+    Parameters
+    ----------
+    brdf : object
+        Anything with ``eval(wi, wo) -> (..., 3)`` in 1/sr.
+    pairs : tuple (wi, wo) of arrays (n, 3), or an object with ``wi`` and ``wo``, optional
+        The pairs to test (a gonio Geometry or Table works). Default: ``n`` random pairs,
+        uniform on the hemisphere, from ``seed``.
+    n : int, default 20000
+        Number of random pairs when ``pairs`` is None.
+    seed : int or numpy.random.Generator, default 0
+        Seed of the random pairs.
+    channel : {"luminance", "r", "g", "b"}, default "luminance"
+        What the error is computed on.
+    n_worst : int, default 5
+        How many of the worst pairs to return.
+    weight : {"none", "cos_i"}, default "none"
+        "cos_i" compares f(wi, wo) cos(theta_i) with f(wo, wi) cos(theta_o) instead: a
+        diagnostic that removes the 1/(n . wi) of the microcylinder model's f_r, to show how
+        much of the asymmetry is left in S_j / Q.
+
+    Returns
+    -------
+    ReciprocityResult
+
+    Raises
+    ------
+    ValueError
+        For a bad channel, pair arrays of different shapes, or a BRDF without ``eval``.
+
+    Notes
+    -----
+    r = |f(wi, wo) - f(wo, wi)| / max(f(wi, wo), f(wo, wi)); pairs with both values 0
+    (or a non-finite value) are excluded and counted.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> class Lambert:
+    ...     def eval(self, wi, wo):
+    ...         return np.full(np.broadcast(wi, wo).shape, 0.5 / np.pi)
+    >>> r = reciprocity(Lambert(), n=100, seed=0)
+    >>> r.max, r.n_included, r.n_zero
+    (0.0, 100, 0)
+    """
+    if channel not in _CHANNELS:
+        raise ValueError(f"channel must be 'luminance', 'r', 'g' or 'b'; got {channel!r}")
+    if not hasattr(brdf, "eval"):
+        raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
+    if weight not in ("none", "cos_i"):
+        raise ValueError(f"weight must be 'none' or 'cos_i'; got {weight!r}")
+    if pairs is None:
+        wi, wo = random_pairs(n, seed)
+    else:
+        if hasattr(pairs, "wi") and hasattr(pairs, "wo"):
+            wi, wo = pairs.wi, pairs.wo
+        else:
+            wi, wo = pairs
+        wi = np.asarray(wi, dtype=np.float64).reshape(-1, 3)
+        wo = np.asarray(wo, dtype=np.float64).reshape(-1, 3)
+        if wi.shape != wo.shape:
+            raise ValueError(f"pairs: wi and wo must have the same shape; got {wi.shape}, "
+                             f"{wo.shape}")
+    with np.errstate(all="ignore"):
+        f_io = np.asarray(brdf.eval(wi, wo), dtype=np.float64)
+        f_oi = np.asarray(brdf.eval(wo, wi), dtype=np.float64)
+        if weight == "cos_i":
+            f_io = f_io * np.clip(wi[..., 2:3], 0, None)
+            f_oi = f_oi * np.clip(wo[..., 2:3], 0, None)
+    ch = _CHANNELS[channel]
+    if ch is None:
+        a, b = f_io @ LUMINANCE, f_oi @ LUMINANCE
+        name = "luminance"
+    else:
+        a, b = f_io[..., ch], f_oi[..., ch]
+        name = "rgb"[ch]
+    finite = np.isfinite(a) & np.isfinite(b)
+    zero = finite & (a == 0) & (b == 0)
+    inc = finite & ~zero
+    with np.errstate(all="ignore"):
+        r = np.abs(a - b) / np.maximum(a, b)
+    # a negative value (invalid BRDF) can make the ratio meaningless: clip into [0, inf)
+    r = np.where(inc, np.abs(r), np.nan)
+    ri = r[inc]
+    if ri.size:
+        med, p95, mx, mean = (float(np.median(ri)), float(np.percentile(ri, 95)),
+                              float(ri.max()), float(ri.mean()))
+    else:
+        med = p95 = mx = mean = float("nan")
+    worst = []
+    if ri.size and n_worst > 0:
+        idx = np.flatnonzero(inc)
+        order = idx[np.argsort(-ri, kind="stable")[:n_worst]]
+        ti, pi_ = _angles_deg(wi[order])
+        to, po = _angles_deg(wo[order])
+        for k, j in enumerate(order):
+            worst.append({"theta_i": float(ti[k]), "phi_i": float(pi_[k]),
+                          "theta_o": float(to[k]), "phi_o": float(po[k]),
+                          "f_io": float(a[j]), "f_oi": float(b[j]), "r": float(r[j])})
+    return ReciprocityResult(median=med, p95=p95, max=mx, mean=mean, n_pairs=int(a.size),
+                             n_included=int(inc.sum()), n_zero=int(zero.sum()),
+                             n_nonfinite=int((~finite).sum()), channel=name, worst=worst)
+
+
+def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
+                       geometry=None, felts=(), channel="luminance",
+                       n_worst: int = 5) -> dict[str, Any]:
+    """Reciprocity statistics per preset and variant, and for measured BRDFs as a contrast.
+
+    Parameters
+    ----------
+    presets : sequence of str, optional
+        Preset names (default: all of ``brdf.PRESETS``).
+    variants : sequence of str, optional
+        Keys of :data:`analysis.energy.VARIANTS` (default: all), so the report shows which
+        term (gap, transmission, masking, reweighting) changes the asymmetry.
+    n : int, default 20000
+        Random pairs (uniform on the hemisphere) per BRDF.
+    seed : int, default 0
+        Seed of the random pairs (the same pairs for every BRDF).
+    geometry : object with ``wi``, ``wo``, optional
+        A gonio geometry examined as well (e.g. ``gonio.full_grid(10)``).
+    felts : sequence of str or os.PathLike, optional
+        RGL tensor files (``gonio.load_rgl``), reported as measured contrasts.
+    channel : str, default "luminance"
+        See :func:`reciprocity`.
+    n_worst : int, default 5
+        Worst pairs kept per entry.
+
+    Returns
+    -------
+    dict
+        ``settings``, ``rows`` (one per BRDF: ``source`` ("model" or "measured"), ``name``,
+        ``variant``, ``random``, ``random_cos_i`` (the ``weight="cos_i"`` diagnostic) and
+        optionally ``geometry``: :meth:`ReciprocityResult.to_dict`),
+        and ``statements`` (plain findings).
+
+    Raises
+    ------
+    ValueError
+        Unknown preset or variant.
+    """
+    import time
+
+    import brdf
+
+    from analysis.energy import VARIANTS
+
+    t0 = time.perf_counter()
+    presets = tuple(brdf.PRESETS if presets is None else presets)
+    variants = tuple(VARIANTS if variants is None else variants)
+    for p in presets:
+        if p not in brdf.PRESETS:
+            raise ValueError(f"unknown fabric {p!r}; presets: {', '.join(brdf.PRESETS)}")
+    for v in variants:
+        if v not in VARIANTS:
+            raise ValueError(f"unknown variant {v!r}; variants: {', '.join(VARIANTS)}")
+    pairs = random_pairs(n, seed)
+    rows = []
+
+    def one(name, variant, source, b):
+        row = {"source": source, "name": name, "variant": variant,
+               "random": reciprocity(b, pairs, channel=channel, n_worst=n_worst).to_dict(),
+               "random_cos_i": reciprocity(b, pairs, channel=channel, n_worst=n_worst,
+                                           weight="cos_i").to_dict()}
+        if geometry is not None:
+            row["geometry"] = reciprocity(b, geometry, channel=channel,
+                                          n_worst=n_worst).to_dict()
+        rows.append(row)
+
+    for p in presets:
+        for v in variants:
+            one(p, v, "model", brdf.fabric(p, **VARIANTS[v]))
+    for path in felts:
+        import gonio
+
+        from pathlib import Path
+
+        one(Path(path).stem, None, "measured", gonio.load_rgl(path))
+    statements = []
+    for p in presets:
+        mine = {r["variant"]: r["random"] for r in rows if r["name"] == p}
+        if "default" in mine and mine["default"]["median"] is not None:
+            d = mine["default"]
+            parts = [f"{p}: median {d['median']:.3f}, p95 {d['p95']:.3f}, max {d['max']:.3f} "
+                     "(default)"]
+            for v, s in mine.items():
+                if v != "default" and s["median"] is not None:
+                    parts.append(f"{v} median {s['median']:.3f} "
+                                 f"({'lower' if s['median'] < d['median'] else 'not lower'})")
+            c = next(r["random_cos_i"] for r in rows if r["name"] == p
+                     and r["variant"] == "default")
+            if c["median"] is not None:
+                parts.append(f"without the 1/(n.wi) factor (f cos theta_i) median "
+                             f"{c['median']:.3f}, p95 {c['p95']:.3f}")
+            statements.append("; ".join(parts) + ".")
+    meas = [r for r in rows if r["source"] == "measured" and r["random"]["median"] is not None]
+    for r in meas:
+        s = r["random"]
+        statements.append(f"measured {r['name']}: median {s['median']:.3f}, p95 {s['p95']:.3f},"
+                          f" max {s['max']:.3f} (interpolated table; a contrast, not a model)")
+    return {
+        "settings": {"n": int(n), "seed": seed if isinstance(seed, int) else None,
+                     "channel": channel, "presets": list(presets),
+                     "variants": {v: VARIANTS[v] for v in variants},
+                     "geometry": getattr(geometry, "kind", None) if geometry is not None
+                     else None,
+                     "felts": [str(f) for f in felts],
+                     "metric": "|f(wi,wo) - f(wo,wi)| / max(f(wi,wo), f(wo,wi)); pairs with "
+                               "both 0 excluded and counted (n_zero)"},
+        "rows": rows, "statements": statements, "seconds": time.perf_counter() - t0,
+    }

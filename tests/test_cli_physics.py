@@ -1,0 +1,52 @@
+"""Tests of the ``microcyl energy`` and ``microcyl reciprocity`` verbs."""
+
+import json
+
+import brdf
+from reports.cli import main
+
+
+def test_bad_fabric_one_line_listing_presets(capsys):
+    assert main(["energy", "bogus"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bogus" in err[0] and all(p in err[0] for p in brdf.PRESETS)
+    assert main(["reciprocity", "bogus"]) == 1
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_bad_variant(capsys):
+    assert main(["energy", "linen_plain", "--variants", "nope"]) == 1
+    assert "nope" in capsys.readouterr().err
+
+
+def test_energy_small_json(tmp_path, capsys):
+    out = tmp_path / "e.json"
+    rc = main(["energy", "silk_shot", "--variants", "default", "--theta-step", "45",
+               "--phi", "0", "--no-furnace", "--no-hemispherical", "--workers", "1",
+               "--quiet", "--json", str(out)])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "silk_shot" in text and "+-" in text
+    d = json.loads(out.read_text())
+    assert d["settings"]["theta_deg"] == [0.0, 45.0, 85.0, 89.0]
+    assert len(d["curves"]) == 2
+    assert not list(tmp_path.glob(".*tmp"))
+
+
+def test_reciprocity_small_json(tmp_path, capsys):
+    out = tmp_path / "r.json"
+    rc = main(["reciprocity", "velvet", "-n", "300", "--grid-step", "45", "--no-felts",
+               "--variants", "default,gap_outgoing", "--json", str(out)])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "velvet" in text and "median" in text
+    d = json.loads(out.read_text())
+    assert [r["variant"] for r in d["rows"]] == ["default", "gap_outgoing"]
+    assert "geometry" in d["rows"][0]
+
+
+def test_json_folder_missing(tmp_path, capsys):
+    rc = main(["reciprocity", "velvet", "-n", "10", "--no-felts", "--grid-step", "0",
+               "--json", str(tmp_path / "no" / "r.json")])
+    assert rc == 1
+    assert "does not exist" in capsys.readouterr().err

@@ -110,7 +110,9 @@ def run(args) -> int:
         extra = write_fit_plots(result, table, lambda wi, wo: FabricModel(fab, wi, wo), out)
         doc = json.loads(jpath.read_text())
         doc["_fit"]["report"] = extra
-        cliutil.atomic_write_text(jpath, json.dumps(doc, indent=2) + "\n")
+        from gonio import atomic_write
+        with atomic_write(jpath, "w") as fh:
+            fh.write(json.dumps(doc, indent=2) + "\n")
     print(format_summary(result))
     if not args.no_plots:
         print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "

@@ -281,8 +281,7 @@ def point_estimate(logpost: LogPosterior, starts: np.ndarray, maxiter: int = 300
     """
     spec = logpost.spec
     lower, upper = spec.lower, spec.upper
-    width = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
-    h = 1e-6 * width
+    h = 1e-6 * spec.width
     big = 1e30
 
     def fun_grad(x):
@@ -314,7 +313,7 @@ def _laplace_cov(logpost: LogPosterior, x: np.ndarray) -> np.ndarray | None:
     deviations from the first pass.
     """
     spec = logpost.spec
-    width = np.where(np.isfinite(spec.upper - spec.lower), spec.upper - spec.lower, 1.0)
+    width = spec.width
     cov = _hessian_cov(logpost, x, 1e-4 * width)
     if cov is None:
         return None
@@ -352,7 +351,7 @@ def _hessian_cov(logpost: LogPosterior, x: np.ndarray, h: np.ndarray):
     # Not positive definite (a parameter against a bound, a flat or rough direction): keep
     # the curvature where it is positive and cap every standard deviation at a tenth of the
     # parameter's range, so the proposal and the starting ball stay usable.
-    width = np.where(np.isfinite(spec.upper - spec.lower), spec.upper - spec.lower, 1.0)
+    width = spec.width
     Hs = H * np.outer(width, width)                       # in units of each range
     w, v = np.linalg.eigh(0.5 * (Hs + Hs.T))
     w = np.maximum(w, 100.0)                              # sd <= 0.1 range
@@ -377,8 +376,19 @@ def _proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256) -> float:
     return float(w.sum() ** 2 / (n * (w * w).sum()))
 
 
+def _laplace_share(logpost, move: "LaplaceMove", laplace_move: float, rng):
+    """Share of the independence move: ``laplace_move`` scaled by its importance-sampling ESS
+    fraction (full share from 0.2 up, at least 0.05), and that fraction.
+
+    A poor approximation (non-Gaussian posterior, parameters at bounds) would waste the move's
+    evaluations, so it gets little."""
+    frac = _proposal_quality(logpost, move, rng)
+    share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
+    return max(share, 0.05), frac
+
+
 def _initial_walkers(logpost, best, cov, nwalkers, rng, spec):
-    width = spec.upper - spec.lower
+    width = spec.width
     d = best.size
     if cov is None:
         cov = np.diag((1e-3 * width) ** 2)
@@ -453,6 +463,28 @@ class FitResult:
         """Natural-unit samples, (N, ndim) when flat."""
         return self.chains.reshape(-1, len(self.names)) if flat else self.chains
 
+    def residuals(self) -> dict:
+        """How well the posterior median explains the table.
+
+        Returns
+        -------
+        dict
+            ``residual`` (n_used,): data minus model in the likelihood's space (log(1 + f_r
+            cos theta_i) by default; log f_r for "relative") at the posterior median,
+            ``normalized``: the same over the noise scale (the table's sigma propagated, with
+            the fitted extra noise), and their root mean squares ``rms`` and
+            ``rms_normalized`` (near 1 when the model explains the data to within its noise).
+        """
+        med = np.median(self.chains_internal.reshape(-1, len(self.names)), axis=0)
+        lik = self.logpost.lik
+        r = lik.y - lik.transform(self.logpost.predict(med[None]))[0]
+        s2 = np.zeros_like(r) if lik.sigma_y2 is None else lik.sigma_y2
+        if "log_noise" in self.names:
+            s2 = s2 + np.exp(2 * self.spec.to_natural(med)[self.names.index("log_noise")])
+        z = r / np.sqrt(s2)
+        return {"residual": r, "normalized": z, "rms": float(np.sqrt(np.mean(r * r))),
+                "rms_normalized": float(np.sqrt(np.mean(z * z)))}
+
 
 def _atomic_write(path: Path, text: str):
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
@@ -517,7 +549,8 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         nu: float = 4.0, ensembles: int = 4, walkers: int | None = None, seed: int = 0,
         max_steps: int = 20000, check_every: int = 50, min_ratio: float = 50.0,
         tau_tol: float = 0.05, rhat_max: float = 1.01, burn_fraction: float = 0.2,
-        n_starts: int = 4, laplace_move: float = 0.75, threads: int | None = None, out_dir=None,
+        n_starts: int = 4, laplace_move: float = 0.75, adapt: int | None = None,
+        threads: int | None = None, out_dir=None,
         time_limit: float | None = None, progress: bool = True,
         config_extra: Mapping | None = None) -> FitResult:
     """Fit the free parameters of ``spec`` to ``table``; see the module notes.
@@ -540,6 +573,15 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         Seeds the optimizer starts and every ensemble (via SeedSequence).
     max_steps : int
         Step limit per ensemble.
+    laplace_move : float
+        Largest share of the independence move (0 turns it off).
+    adapt : int, optional
+        First of the steps ``adapt``, ``2 adapt``, ``4 adapt`` at which each ensemble may refit
+        its independence proposal to the second half of its own chain so far (default
+        ``2 * check_every``; 0 for never). A refit is kept only when it raises the proposal's
+        importance-sampling ESS by more than 10%; the first refit not kept ends the
+        adaptation of that ensemble. The chain before the last refit is discarded (the
+        burn-in is at least that long), so the kept samples come from one fixed kernel.
     out_dir : path, optional
         Folder for ``fit_config.json`` and the checkpoints ``chains_<k>.h5``; resumes there.
     time_limit : float, optional
@@ -586,13 +628,18 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     if max_steps < 1 or check_every < 1:
         raise ValueError(f"max_steps and check_every must be >= 1; got {max_steps}, "
                          f"{check_every}")
+    if adapt is None:
+        adapt = 2 * check_every if laplace_move > 0 else 0
+    if adapt < 0 or (adapt and laplace_move <= 0):
+        raise ValueError(f"adapt must be >= 0, and 0 when laplace_move is 0; got {adapt}")
     threads = threads or min(2, os.cpu_count() or 1)
     logpost = LogPosterior(spec, lik, model)
 
     config = {
-        "version": 1, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
+        "version": 2, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
         "ensembles": ensembles, "walkers": walkers, "seed": seed,
         "table": _table_digest(table), "n_used": lik.n_used,
+        "laplace_move": laplace_move, "adapt": adapt,
         **({"extra": dict(config_extra)} if config_extra else {}),
     }
     out = Path(out_dir) if out_dir is not None else None
@@ -638,7 +685,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
             raise ValueError(f"the log-posterior is not finite at the start "
                              f"{dict(zip(spec.free, spec.to_natural(start).tolist()))}; "
                              f"check the bounds, ties and the table")
-        width = spec.upper - spec.lower
+        width = spec.width
         starts = [start]
         for _ in range(max(0, n_starts - 1)):
             s = start + rng_opt.normal(scale=0.05 * width)
@@ -653,29 +700,71 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     t_opt = time.perf_counter() - t0
 
     laplace_info = {"share": 0.0, "importance_ess_fraction": None}
-    lm, share = None, 0.0
+    share = 0.0
     if cov is not None and laplace_move > 0:
-        lm = LaplaceMove(best, cov)
-        frac = _proposal_quality(logpost, lm, np.random.default_rng(seed))
-        # a poor approximation (non-Gaussian posterior, parameters at bounds) would waste the
-        # move's evaluations: give it a share in proportion to its importance-sampling ESS
-        share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
-        share = max(share, 0.05)
+        share, frac = _laplace_share(logpost, LaplaceMove(best, cov), laplace_move,
+                                     np.random.default_rng(seed))
         laplace_info = {"share": share, "importance_ess_fraction": frac}
+    schedule = [a for a in (adapt, 2 * adapt, 4 * adapt) if 0 < a < max_steps]
+    laplace_info["adapt_schedule"] = schedule
+    last_adapt = [0] * ensembles          # step of each ensemble's last kept refit
+    adapt_done = [not schedule] * ensembles
+    laplace_moves = [None] * ensembles
 
-    def make_moves():
+    def make_moves(k):
         # one set per ensemble: emcee's DE moves set attributes in setup(), not thread-safe
         g0 = 2.38 / np.sqrt(2 * ndim)
         moves = [(emcee.moves.DEMove(gamma0=g0), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
-        if lm is None:
+        if laplace_move <= 0:
             return moves
-        return [(m, w * (1 - share)) for m, w in moves] + [(LaplaceMove(best, cov), share)]
+        # present even without a usable Laplace covariance (weight 0) so that it can adapt
+        lm = LaplaceMove(best, cov if cov is not None else
+                         np.diag((1e-2 * spec.width) ** 2))
+        laplace_moves[k] = lm
+        return [(m, w * (1 - share)) for m, w in moves] + [(lm, share)]
+
+    def adapt_moves(k, a):
+        """Refit ensemble k's independence proposal at step ``a`` to its own chain over steps
+        a/2 to a; kept only if it is clearly better than the current one. Deterministic given
+        the stored chain, so a resumed fit repeats every decision exactly."""
+        s = samplers[k]
+        x = s.get_chain()[a // 2:a].reshape(-1, ndim)
+        c = np.cov(x.T).reshape(ndim, ndim) if x.shape[0] >= 5 * ndim else None
+        move = None
+        if c is not None:
+            c += np.diag((1e-9 * spec.width) ** 2)
+            try:
+                move = LaplaceMove(x.mean(axis=0), c)
+            except np.linalg.LinAlgError:
+                move = None
+        lm = laplace_moves[k]
+        if move is None:
+            adapt_done[k] = True
+            return {"step": a, "kept": False}
+        sh, frac = _laplace_share(logpost, move, laplace_move,
+                                  np.random.default_rng([seed, k, a]))
+        _, frac_now = _laplace_share(logpost, lm, laplace_move,
+                                     np.random.default_rng([seed, k, a]))
+        s_weights = np.array(s._weights, dtype=np.float64)
+        if not (np.isfinite(frac) and (not np.isfinite(frac_now) or frac > 1.1 * frac_now
+                                       or s_weights[-1] == 0)):
+            adapt_done[k] = True
+            return {"step": a, "kept": False, "importance_ess_fraction": frac,
+                    "current": frac_now}
+        lm.mean, lm.chol = move.mean, move.chol
+        w = s_weights
+        w[:-1] = w[:-1] / max(w[:-1].sum(), 1e-300) * (1 - sh)
+        w[-1] = sh
+        s._weights = w / w.sum()
+        last_adapt[k] = a
+        return {"step": a, "kept": True, "share": sh, "importance_ess_fraction": frac,
+                "previous": frac_now}
 
     lock = LockStep(logpost, ensembles, threads=threads)
     samplers = []
     for k in range(ensembles):
         s = emcee.EnsembleSampler(walkers, ndim, (lambda x, k=k: lock.call(k, x)),
-                                  moves=make_moves(), vectorize=True, backend=backends[k])
+                                  moves=make_moves(k), vectorize=True, backend=backends[k])
         # emcee's wrapper prints a traceback for any exception (interrupts included); the
         # errors are reported by fit's caller instead
         s.log_prob_fn = (lambda x, k=k: lock.call(k, x))
@@ -718,6 +807,28 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                 if exc is not None and not isinstance(exc, _Aborted):
                     raise exc
 
+    laplace_info["adaptations"] = []
+    adapt_evals = [0]
+
+    def maybe_adapt():
+        e0 = logpost.n_evals
+        try:
+            _maybe_adapt()
+        finally:
+            adapt_evals[0] += logpost.n_evals - e0
+
+    def _maybe_adapt():
+        n = min(s.iteration for s in samplers)
+        for a in schedule:
+            if a > n:
+                break
+            for k in range(ensembles):
+                if not adapt_done[k] and last_adapt[k] < a and \
+                        all(d["step"] != a for d in laplace_info["adaptations"]
+                            if d.get("ensemble") == k):
+                    info = adapt_moves(k, a)
+                    laplace_info["adaptations"].append(dict(info, ensemble=k))
+
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -743,12 +854,16 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                     recheck = True
             except (ValueError, KeyError):
                 pass
+        maybe_adapt()
         while True:
             if not recheck:
-                target = min(max_steps, (target // check_every + 1) * check_every)
+                nxt = (target // check_every + 1) * check_every
+                nxt = min([nxt] + [a for a in schedule if a > target])
+                target = min(max_steps, nxt)
                 run_to(target)
+                maybe_adapt()
             recheck = False
-            diag = _diagnose(samplers, burn_fraction)
+            diag = _diagnose(samplers, burn_fraction, max(last_adapt))
             tau = diag["tau"]
             if ppath is not None:   # lets a resumed run repeat this check's verdict
                 _atomic_write(ppath, json.dumps(
@@ -786,7 +901,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
             bar.close()
         lock.close()
     t_sample = time.perf_counter() - t_s0
-    n_evals = logpost.n_evals - evals0
+    n_evals = logpost.n_evals - evals0 - adapt_evals[0]
 
     internal = diag["chains"]
     natural = spec.to_natural(internal)
@@ -804,7 +919,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
               "log_prob_evals": int(n_evals),
               "evals_per_s": n_evals / t_sample if t_sample > 0 else float("nan"),
               "ess_per_s": float(np.min(ess) / t_sample) if t_sample > 0 else float("nan"),
-              "laplace_move": laplace_info}
+              "laplace_move": laplace_info, "adapt_evals": int(adapt_evals[0])}
     return FitResult(
         names=spec.free, units=spec.units, chains=natural, chains_internal=internal,
         log_prob=diag["log_prob"], summary=summary, converged=converged, reason=reason,
@@ -815,9 +930,9 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         counts=dict(lik.counts), timing=timing, spec=spec, logpost=logpost)
 
 
-def _diagnose(samplers, burn_fraction):
+def _diagnose(samplers, burn_fraction, last_adapt=0):
     n = min(s.iteration for s in samplers)
-    burn = int(burn_fraction * n)
+    burn = max(int(burn_fraction * n), min(last_adapt, n // 2))
     chains = np.stack([s.get_chain()[burn:n] for s in samplers])   # (m, steps, w, d)
     logp = np.stack([s.get_log_prob()[burn:n] for s in samplers])
     taus = np.stack([diagnostics.autocorr_time(c) for c in chains])

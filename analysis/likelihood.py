@@ -19,6 +19,10 @@ freedom and scale s (robust to outliers): log t_nu(r / s) - log s.
 
 Points with NaN or negative values, with non-finite or non-positive sigma, or with either
 direction at or below the horizon are masked; every mask is counted in :attr:`Likelihood.counts`.
+
+A grey table (R = G = B, and the same sigma, at every point: CUReT, a CSV with one ``value``
+column) holds one measurement per point, not three: it enters once, against the mean of the
+model's R, G and B (CUReT's grey value is that mean), so that it is not counted three times.
 """
 
 from __future__ import annotations
@@ -32,6 +36,11 @@ __all__ = ["Likelihood", "KINDS", "is_relative"]
 
 KINDS = ("gaussian", "relative", "student-t")
 _LOG_2PI = math.log(2.0 * math.pi)
+
+
+def _is_grey(a) -> bool:
+    return bool(np.array_equal(a[:, 0], a[:, 1], equal_nan=True)
+                and np.array_equal(a[:, 0], a[:, 2], equal_nan=True))
 
 
 def is_relative(meta) -> bool:
@@ -66,7 +75,7 @@ class Likelihood:
     Attributes
     ----------
     counts : dict
-        ``total`` (n x 3 values), ``used``, ``invalid_value`` (NaN or negative),
+        ``total`` (n x 3 values, n for a grey table), ``used``, ``invalid_value`` (NaN or negative),
         ``bad_sigma``, ``below_horizon``, ``zero_value`` (relative only).
     has_sigma : bool
         Whether the table gave sigma (otherwise a ``log_noise`` parameter is needed).
@@ -103,8 +112,12 @@ class Likelihood:
         sigma = None if table.sigma is None else np.asarray(table.sigma, dtype=np.float64)
         good_sigma = np.ones((n, 3), bool) if sigma is None else np.isfinite(sigma) & (sigma > 0)
         mask = good_value & above & good_sigma
+        self.grey = _is_grey(values) and (sigma is None or _is_grey(sigma))
+        if self.grey:
+            mask[:, 1:] = False
+            good_value, above, good_sigma = (a[:, :1] for a in (good_value, above, good_sigma))
         counts = {
-            "total": int(values.size),
+            "total": int(good_value.size),
             "invalid_value": int((~good_value).sum()),
             "below_horizon": int((good_value & ~above).sum()),
             "bad_sigma": int((good_value & above & ~good_sigma).sum()),
@@ -134,6 +147,13 @@ class Likelihood:
             nu = self.nu
             self._t_const = gammaln((nu + 1) / 2) - gammaln(nu / 2) - 0.5 * math.log(nu * math.pi)
 
+    def _at(self, model_values) -> np.ndarray:
+        """Model values (B..., n, 3) at the used entries (B..., n_used); grey: channel mean."""
+        m = np.asarray(model_values, dtype=np.float64)
+        if self.grey:
+            return m[..., self.pt, :].mean(axis=-1)
+        return m[..., self.pt, self.ch]
+
     @property
     def n_used(self) -> int:
         """Number of (point, channel) values that enter the likelihood."""
@@ -141,7 +161,7 @@ class Likelihood:
 
     def transform(self, model_values) -> np.ndarray:
         """Model f_r (B..., n, 3) -> the residual space at the used entries (B..., n_used)."""
-        m = np.asarray(model_values, dtype=np.float64)[..., self.pt, self.ch]
+        m = self._at(model_values)
         if self.kind == "relative":
             return np.log(np.maximum(m, 1e-300))
         return np.log1p(np.maximum(m, 0.0) * self.cos_i)
@@ -168,7 +188,7 @@ class Likelihood:
         ValueError
             When the table has no sigma and no ``log_noise`` is given.
         """
-        m = np.asarray(model_values, dtype=np.float64)[..., self.pt, self.ch]
+        m = self._at(model_values)
         if scale is not None:
             m = m * np.asarray(scale, dtype=np.float64)[..., None]
         if self.kind == "relative":

@@ -10,9 +10,14 @@ without sigma).
 Each parameter is free (sampled), fixed (at its default, normally the preset's value) or tied to
 another one (``eta2=eta1``: eta2 takes eta1's value; ``area2=1-area1``: the complement).
 
-The sampler works in *internal* coordinates: the value itself for a uniform prior, its natural
-log for a log-uniform prior. Both priors are then flat in internal coordinates between the
-bounds, so the log-prior is 0 inside and -inf outside (plus area1 + area2 <= 1).
+The sampler works in unbounded *internal* coordinates: with g the identity for a uniform prior
+and the natural log for a log-uniform one, p = (g(x) - g(lo)) / (g(hi) - g(lo)) is the position
+of x within its bounds and u = logit(p) = log(p / (1 - p)). The prior, flat in g(x), has the
+density p (1 - p) in u (the Jacobian), so the log-prior is sum of log p + log(1 - p) over the
+free parameters (minus infinity where area1 + area2 > 1 or a tied value leaves its bounds).
+A posterior piled against a bound (an albedo near 1, a k_d near 0) is then a smooth bump in u
+rather than a wall, which the samplers and the Laplace approximation handle far better.
+Internal values are limited to +-:data:`INTERNAL_LIMIT` (p within 4e-18 of a bound).
 """
 
 from __future__ import annotations
@@ -24,9 +29,16 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
+import scipy.special
 
-__all__ = ["Param", "ParamSpec", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
+__all__ = ["Param", "ParamSpec", "INTERNAL_LIMIT", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
            "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric", "parse_free", "parse_ties"]
+
+
+#: Internal (logit) coordinates are limited to [-INTERNAL_LIMIT, INTERNAL_LIMIT].
+INTERNAL_LIMIT = 40.0
+#: A typical internal scale: a logit range of 4 spans p from 0.12 to 0.88.
+INTERNAL_WIDTH = 4.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,22 +80,40 @@ class Param:
     def is_log(self) -> bool:
         return self.prior == "log-uniform"
 
-    def to_internal(self, x):
-        """Natural value -> internal coordinate (log for log-uniform)."""
-        x = np.asarray(x, dtype=np.float64)
+    def _g(self, x):
         if self.is_log:
             with np.errstate(divide="ignore", invalid="ignore"):
                 return np.log(x)
         return x
 
+    def to_internal(self, x):
+        """Natural value -> internal coordinate logit(p), p the position within the bounds
+        (on a log scale for log-uniform); +-inf at the bounds, NaN outside.
+
+        Examples
+        --------
+        >>> p = Param("kd1", 0.0, 1.0, "uniform", "1", 0.5)
+        >>> float(p.to_internal(0.5)), round(float(p.to_natural(p.to_internal(0.9))), 12)
+        (0.0, 0.9)
+        """
+        x = np.asarray(x, dtype=np.float64)
+        g0, g1 = self._g(self.lo), self._g(self.hi)
+        q = (self._g(x) - g0) / (g1 - g0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where((q >= 0) & (q <= 1), np.log(q) - np.log1p(-q), np.nan)
+
     def to_natural(self, u):
-        """Internal coordinate -> natural value."""
+        """Internal coordinate -> natural value (within the bounds)."""
         u = np.asarray(u, dtype=np.float64)
-        return np.exp(u) if self.is_log else u
+        q = scipy.special.expit(u)
+        g0, g1 = self._g(self.lo), self._g(self.hi)
+        v = g0 + q * (g1 - g0)
+        x = np.exp(v) if self.is_log else v
+        return np.clip(x, self.lo, self.hi)
 
     @property
     def internal_bounds(self) -> tuple[float, float]:
-        return (float(self.to_internal(self.lo)), float(self.to_internal(self.hi)))
+        return (-INTERNAL_LIMIT, INTERNAL_LIMIT)
 
 
 #: Base quantities: (lo, hi, prior, unit, fallback default), per thread.
@@ -251,8 +281,8 @@ class ParamSpec:
     ...                  ties="eta2=eta1")
     >>> spec.free, spec.ndim
     (('eta1', 'gamma_s1'), 2)
-    >>> v = spec.values(np.array([[1.6, np.log(4.0)]]))
-    >>> float(v["eta2"][0]), round(float(v["gamma_s1"][0]), 6)
+    >>> v = spec.values(spec.to_internal(np.array([[1.6, 4.0]])))
+    >>> round(float(v["eta2"][0]), 12), round(float(v["gamma_s1"][0]), 12)
     (1.6, 4.0)
     """
 
@@ -300,6 +330,8 @@ class ParamSpec:
         self._index = {n: i for i, n in enumerate(self.free)}
         self.lower = np.array([self.params[n].internal_bounds[0] for n in self.free])
         self.upper = np.array([self.params[n].internal_bounds[1] for n in self.free])
+        #: A typical scale of each internal coordinate (for step sizes and starting balls).
+        self.width = np.full(len(self.free), INTERNAL_WIDTH)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -349,9 +381,11 @@ class ParamSpec:
         return tuple(self.params[n].unit for n in self.free)
 
     def start(self) -> np.ndarray:
-        """Internal coordinates of the free parameters' defaults, shape (ndim,)."""
-        return np.array([float(self.params[n].to_internal(self.params[n].default))
-                         for n in self.free])
+        """Internal coordinates of the free parameters' defaults, shape (ndim,); a default on
+        a bound starts just inside it (internal values are clipped to +-10: p = 4.5e-5)."""
+        u = np.array([float(self.params[n].to_internal(self.params[n].default))
+                      for n in self.free])
+        return np.clip(u, -10.0, 10.0)
 
     def with_defaults(self, **values: float) -> "ParamSpec":
         """A copy whose defaults (start values) are changed."""
@@ -401,18 +435,21 @@ class ParamSpec:
     def log_prior(self, theta) -> np.ndarray:
         """Log prior (up to a constant) for internal ``theta`` (B..., ndim) -> (B...,).
 
-        Flat in internal coordinates within the bounds, -inf outside or where
+        Flat in each natural value (or its log) within the bounds: in the internal logit
+        coordinates the sum of log p + log(1 - p); -inf beyond +-INTERNAL_LIMIT, or where
         area1 + area2 > 1 or a tied value leaves its own bounds.
         """
         theta = np.asarray(theta, dtype=np.float64)
         ok = np.all((theta >= self.lower) & (theta <= self.upper) & np.isfinite(theta), axis=-1)
+        with np.errstate(invalid="ignore"):
+            jac = -(np.logaddexp(0.0, theta) + np.logaddexp(0.0, -theta)).sum(axis=-1)
         if self.ties or any(n.startswith("area") for n in self.free):
             v = self.values(theta)
             ok &= v["area1"] + v["area2"] <= 1.0 + 1e-12
             for target in self.ties:
                 p = self.params[target]
                 ok &= (v[target] >= p.lo) & (v[target] <= p.hi)
-        return np.where(ok, 0.0, -np.inf)
+        return np.where(ok, jac, -np.inf)
 
     def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Keyword arguments of ``prepare(...).eval``: each (B..., 2), albedo (B..., 2, 3)."""

@@ -111,54 +111,33 @@ def calibration(args):
     return 0 if ok else 1
 
 
-#: Real tables and the preset each fit starts from.
-REAL = [("rgl", "acrylic_felt_white_rgb", "linen_plain"),
-        ("rgl", "acrylic_felt_pink_rgb", "linen_plain"),
-        ("rgl", "acrylic_felt_purple_rgb", "linen_plain"),
-        ("curet", 1, "linen_plain"), ("curet", 7, "velvet"), ("curet", 44, "linen_plain"),
-        ("curet", 46, "linen_plain"), ("curet", 2, "polyester_satin_charmeuse"),
-        ("curet", 42, "velvet")]
-
-
 def real(args):
+    """Fits of the measured datasets (analysis.measured): verdict, residuals, time."""
+    from analysis.measured import MEASURED, load_measured, measured_spec
     if not SHARED.is_dir():
         print(f"measured data not found at {SHARED}")
         return 1
     out_root = Path(args.out or tempfile.mkdtemp(prefix="microcyl-real-"))
-    for kind, what, preset in REAL:
-        if args.only and kind != args.only:
+    bad = 0
+    for name, d in MEASURED.items():
+        if args.only and d.kind != args.only:
             continue
-        if kind == "rgl":
-            table = gonio.read(SHARED / "rgl" / f"{what}.bsdf", step=10.0)
-            free = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1", "albedo1")
-            ties = ("eta2=eta1", "area2=1-area1", "albedo2_r=albedo1_r",
-                    "albedo2_g=albedo1_g", "albedo2_b=albedo1_b", "kd2=kd1",
-                    "gamma_s2=gamma_s1", "gamma_v2=gamma_v1")
-        else:
-            table = gonio.load_curet(SHARED / "curet", what)
-            free = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1")
-            ties = ("eta2=eta1", "area2=1-area1", "kd2=kd1", "gamma_s2=gamma_s1",
-                    "gamma_v2=gamma_v1")
-        fab = brdf.fabric(preset)
-        label = f"{kind} {what} (from {preset})"
-        try:
-            r = run_fit(table, fab, free=free, ties=ties, seed=0, progress=False,
-                        likelihood="gaussian", max_steps=args.max_steps,
-                        time_limit=args.time_limit,
-                        out=out_root / f"{kind}_{what}")
-        except ValueError as exc:
-            print(f"{label}: {exc}")
-            continue
+        table = load_measured(name, SHARED)
+        spec, fab = measured_spec(name)
+        r = fit(table, spec, FabricModel(fab, table.wi, table.wo), seed=0, progress=False,
+                max_steps=args.max_steps, time_limit=args.time_limit, out_dir=out_root / name)
         lik = r.logpost.lik
         med = np.median(r.chains_internal.reshape(-1, len(r.names)), axis=0)
-        pred = r.logpost.predict(med[None])[0]
-        res = lik.y - lik.transform(pred[None])[0]
-        print(f"{label}: {len(table)} pairs, {r.counts['used']} values; "
+        res = lik.y - lik.transform(r.logpost.predict(med[None]))[0]
+        kept = [a["step"] for a in r.timing["laplace_move"]["adaptations"] if a.get("kept")]
+        print(f"{name} (from {d.preset}): {len(table)} pairs, {r.counts['used']} values; "
               f"rms residual (log space) {np.sqrt(np.mean(res ** 2)):.3f}; "
-              f"{r.timing['wall_s']:.0f} s; {r.reason}")
+              f"{r.timing['wall_s']:.0f} s, {r.timing['evals_per_s']:.0f} evals/s; proposal "
+              f"refits kept at {kept}; {r.reason}", flush=True)
         print("   " + ", ".join(f"{n}={r.summary[n]['median']:.4g}" for n in r.names))
-    print(f"chains and configs in {out_root}")
-    return 0
+        bad += not r.converged
+    print(f"chains and configs in {out_root}; {bad} not converged")
+    return 1 if bad else 0
 
 
 def main():

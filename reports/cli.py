@@ -23,6 +23,7 @@ COMMAND_MODULES = (
     "reports.cmd_render",
     "reports.cmd_physics",
     "reports.cmd_fit",
+    "reports.cmd_measured",
 )
 
 

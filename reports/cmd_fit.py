@@ -15,7 +15,7 @@ from pathlib import Path
 import brdf
 from reports import cliutil
 
-__all__ = ["register", "run", "read_table"]
+__all__ = ["register", "run", "read_table", "fit_and_write", "format_summary"]
 
 
 def read_table(path, sample=None):
@@ -89,7 +89,7 @@ def _spec_from_args(args, fab):
 
 
 def run(args) -> int:
-    from analysis.fit import FabricModel, fit, write_results
+    from analysis.fit import FabricModel
     if args.fabric not in brdf.PRESETS:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")
@@ -97,28 +97,66 @@ def run(args) -> int:
     spec = _spec_from_args(args, fab)
     out = cliutil.check_writable_dir(Path(args.output))
     table = read_table(args.table, args.sample)
-    model = FabricModel(fab, table.wi, table.wo)
-    result = fit(table, spec, model, likelihood=args.likelihood, nu=args.nu,
-                 ensembles=args.ensembles, walkers=args.walkers, seed=args.seed,
-                 max_steps=args.max_steps, check_every=args.check_every, out_dir=out,
-                 time_limit=args.time_limit, progress=not args.no_progress,
-                 config_extra={"fabric": args.fabric, "options": fab.options,
-                               "sample": args.sample})
-    jpath, _ = write_results(result, out)
-    if not args.no_plots:
-        from reports.fitplots import write_fit_plots
-        extra = write_fit_plots(result, table, lambda wi, wo: FabricModel(fab, wi, wo), out)
-        doc = json.loads(jpath.read_text())
-        doc["_fit"]["report"] = extra
-        from gonio import atomic_write
-        with atomic_write(jpath, "w") as fh:
-            fh.write(json.dumps(doc, indent=2) + "\n")
+    result, doc = fit_and_write(
+        table, fab, spec, out, plots=not args.no_plots,
+        likelihood=args.likelihood, nu=args.nu, ensembles=args.ensembles,
+        walkers=args.walkers, seed=args.seed, max_steps=args.max_steps,
+        check_every=args.check_every, time_limit=args.time_limit,
+        progress=not args.no_progress,
+        config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
     print(format_summary(result))
+    q = doc["_fit"]["quality"]
+    print(f"residuals at the posterior median: rms {q['rms_residual']:.4f} in the "
+          f"likelihood's space, {q['rms_normalized']:.2f} in units of the noise")
     if not args.no_plots:
         print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "
-              f"{extra['albedo_delta_e2000']:.2f}; plots in {out}")
-    print(f"results: {jpath}")
+              f"{doc['_fit']['report']['albedo_delta_e2000']:.2f}; plots in {out}")
+    print(f"results: {out / 'results.json'}")
     return 0
+
+
+def fit_and_write(table, fab, spec, out, *, plots: bool = True, **fit_kw):
+    """Fit ``table`` (:func:`analysis.fit.fit`), write ``results.json``/``.csv`` and the plots.
+
+    Parameters
+    ----------
+    table : gonio.Table
+    fab : brdf.Fabric
+        The fabric whose parameters the spec fixes (and whose geometry is evaluated).
+    spec : analysis.params.ParamSpec
+    out : path
+        Output folder (checkpoints, results, plots); a rerun resumes there.
+    plots : bool
+        Write corner, trace, lobe and residual plots (and the albedo colour difference).
+    **fit_kw
+        Passed to :func:`analysis.fit.fit`.
+
+    Returns
+    -------
+    result : FitResult
+    doc : dict
+        The ``results.json`` document; ``doc["_fit"]["quality"]`` holds the residual rms
+        (likelihood space and normalized), ``doc["_fit"]["report"]`` the plots and the
+        CIEDE2000 albedo difference.
+    """
+    from analysis.fit import FabricModel, fit, write_results
+    from gonio import atomic_write
+    out = Path(out)
+    model = FabricModel(fab, table.wi, table.wo)
+    result = fit(table, spec, model, out_dir=out, **fit_kw)
+    jpath, _ = write_results(result, out)
+    doc = json.loads(jpath.read_text())
+    q = result.residuals()
+    doc["_fit"]["quality"] = {"rms_residual": q["rms"], "rms_normalized": q["rms_normalized"],
+                              "values": int(q["residual"].size)}
+    if plots:
+        from reports.fitplots import write_fit_plots
+        extra = write_fit_plots(result, table, lambda wi, wo: FabricModel(fab, wi, wo), out)
+        extra["plots"] = {k: Path(v).name for k, v in extra["plots"].items()}
+        doc["_fit"]["report"] = extra
+    with atomic_write(jpath, "w") as fh:
+        fh.write(json.dumps(doc, indent=2) + "\n")
+    return result, doc
 
 
 def format_summary(result) -> str:

@@ -44,6 +44,8 @@ def register(sub):
                    help="figure and render resolution (default: default)")
     p.add_argument("--fit", action="append", metavar="FABRIC=RESULTS",
                    help="show a fit's results.json in FABRIC's page (repeatable)")
+    p.add_argument("--measured", default=None, metavar="DIR",
+                   help="add the fits of `microcyl fit-measured -o DIR` (page measured.html)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run_report)
 
@@ -98,7 +100,7 @@ def run_report(args):
             raise ValueError(f"--fit {item!r}: no such file {path!r}")
         fits[name] = path
     index = build_report(names, args.output, progress=not args.quiet, quality=args.quality,
-                         fit_results=fits)
+                         fit_results=fits, measured=args.measured)
     labels = [g[0] for g in STANDARD_GEOMETRIES]
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name in names:

@@ -207,10 +207,18 @@ def albedo_colours(table, prediction):
     estimate of the directional albedo averaged over the table's incidences; the prediction uses
     the same points and mask, so the two are comparable whatever the sampling.
 
+    A grey table (R = G = B everywhere: CUReT) is compared with the grey of the prediction,
+    the mean of its channels, as the grey value was measured.
+
     Returns
     -------
     measured, predicted : ndarray (3,)
     """
+    prediction = np.asarray(prediction, dtype=np.float64)
+    v = np.asarray(table.values, dtype=np.float64)
+    if np.array_equal(v[:, 0], v[:, 1], equal_nan=True) and \
+            np.array_equal(v[:, 0], v[:, 2], equal_nan=True):
+        prediction = np.repeat(prediction.mean(axis=-1, keepdims=True), 3, axis=-1)
     valid = table.valid & np.isfinite(prediction)
     cos_o = np.clip(table.wo[:, 2], 0, None)[:, None]
     meas = np.where(valid, table.values, 0.0) * cos_o

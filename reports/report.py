@@ -542,11 +542,14 @@ def _swatch(fab) -> str:
     return f'<span class="swatch" style="background:rgb({r},{g},{b})"></span>'
 
 
-def _nav(names, current=None) -> str:
+def _nav(names, current=None, measured=False) -> str:
     links = ['<a href="index.html">overview</a>']
     for n in names:
         label = f"<b>{html.escape(n)}</b>" if n == current else html.escape(n)
         links.append(f'<a href="{html.escape(n)}.html">{label}</a>')
+    if measured:
+        label = "<b>measured fits</b>" if current == "measured" else "measured fits"
+        links.append(f'<a href="measured.html">{label}</a>')
     return "".join(links)
 
 
@@ -657,7 +660,8 @@ def _resolve_fabrics(fabrics) -> dict:
 
 
 def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True,
-                 quality="default", fit_results=None, title="microcyl report") -> Path:
+                 quality="default", fit_results=None, measured=None,
+                 title="microcyl report") -> Path:
     """Write the HTML report on ``fabrics`` to ``out_dir``; return the path of index.html.
 
     Parameters
@@ -677,6 +681,9 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
         Resolutions of plots and renders (:data:`QUALITIES`).
     fit_results : mapping of str to path, optional
         Fabric name -> ``results.json`` of a fit, shown in the "fit" section.
+    measured : path, optional
+        Output folder of ``microcyl fit-measured``: adds the page ``measured.html`` (fits to
+        the measured felts and CUReT fabrics) and its table on the overview.
     title : str
         Title of the overview page.
 
@@ -708,6 +715,11 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
         raise ValueError(f"unknown section {bad[0]!r}; valid: {', '.join(SECTIONS)}")
     sections = [s for s in SECTIONS if s in sections]
     resolved = _resolve_fabrics(fabrics)
+    measured_fits = None
+    if measured is not None:
+        from reports.report_measured import read_measured
+        measured_fits = read_measured(measured)
+    has_measured = measured_fits is not None
     out = check_output_dir(out_dir)
     q = dict(QUALITIES[quality])
     q["fit_results"] = {str(k): v for k, v in dict(fit_results or {}).items()}
@@ -749,20 +761,32 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
                 bar.update(1)
             summaries[name] = summary
             _atomic_write(tmp / f"{name}.html",
-                          _page(f"{title}: {name}", _nav(names, name), "".join(body)))
+                          _page(f"{title}: {name}", _nav(names, name, has_measured), "".join(body)))
         bar.set_description("overview")
         overview = _overview(tmp, fabs, summaries, sections, q)
+        measured_summary = None
+        if has_measured:
+            from reports.report_measured import measured_page, overview_table
+            mbody, measured_summary = measured_page(tmp, measured_fits)
+            _atomic_write(tmp / "measured.html", _page(f"{title}: fits to measured data",
+                                                       _nav(names, "measured", True), mbody))
+            overview += ('<section id="measured-fits"><h2>Fits to measured data</h2>'
+                         + overview_table(measured_fits)
+                         + '<p>Details: <a href="measured.html">measured.html</a>.</p></section>')
         fabric_sections = "".join(
             f'<section class="fabric" id="fabric-{html.escape(n)}"><h2>{_swatch(fabs[n])}'
             f'<a href="{html.escape(n)}.html">{html.escape(n)}</a></h2><ul>'
             + "".join(f"<li>{html.escape(_TITLES[s])}: {html.escape(v['status'])}</li>"
                       for s, v in summaries[n]["sections"].items())
             + "</ul></section>" for n in names)
-        _atomic_write(tmp / "index.html", _page(title, _nav(names), overview + fabric_sections))
+        _atomic_write(tmp / "index.html", _page(title, _nav(names, None, has_measured),
+                                                  overview + fabric_sections))
         bar.update(1)
         bar.close()
         doc = {"title": title, "generated": _now(), "quality": quality, "sections": sections,
                "fabrics": summaries, "seconds": round(time.perf_counter() - t_start, 2)}
+        if measured_summary is not None:
+            doc["measured"] = measured_summary
         _atomic_write(tmp / "summary.json", json.dumps(_jsonable(doc), indent=1))
         _atomic_write(tmp / _MARKER, "microcyl report folder: replaced whole by the next run\n")
         _swap_into_place(tmp, out)

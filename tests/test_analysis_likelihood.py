@@ -92,3 +92,22 @@ def test_bad_options_and_relative_meta():
         Likelihood(_table(), "student-t", nu=0)
     assert is_relative({"units": "relative"}) and Likelihood(
         _table(meta={"units": "relative"})).relative_data
+
+
+def test_grey_table_enters_once_per_point_against_the_channel_mean():
+    t = _table()
+    grey = t.values[:, :1] * np.ones(3)
+    g = t.replace(values=grey, sigma=0.1 * grey)
+    lik = Likelihood(g)
+    assert lik.grey and lik.counts["used"] == len(t) and lik.counts["total"] == len(t)
+    m = t.values * 1.3                                  # a coloured model
+    c = t.wi[:, 2]
+    y = np.log1p(grey[:, 0] * c)
+    mu = np.log1p(m.mean(axis=1) * c)
+    s = c * 0.1 * grey[:, 0] / (1 + grey[:, 0] * c)
+    expect = stats.norm.logpdf(y, mu, s).sum()
+    assert lik(m[None])[0] == pytest.approx(expect, rel=1e-12)
+    # one channel different at one point: an RGB table, every channel counted
+    v = grey.copy()
+    v[0, 2] *= 1.01
+    assert Likelihood(t.replace(values=v, sigma=0.1 * v)).counts["used"] == 3 * len(t)

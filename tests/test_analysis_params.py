@@ -30,32 +30,53 @@ def test_ties_equal_complement_and_swap():
         parse_ties("foo=eta1")
     spec = ParamSpec(DEFAULT_FREE, defaults=D, ties=DEFAULT_TIES)
     assert spec.ndim == 8 and "eta2" not in spec.free and "area2" not in spec.free
-    theta = spec.start()[None].repeat(2, 0)
-    theta[1, spec.free.index("eta1")] = 1.7
-    theta[1, spec.free.index("area1")] = 0.6
-    v = spec.values(theta)
-    assert v["eta2"][1] == 1.7 and v["eta1"][1] == 1.7
-    assert v["area2"][1] == pytest.approx(0.4)
+    x = spec.to_natural(spec.start()[None].repeat(2, 0))
+    x[1, spec.free.index("eta1")] = 1.7
+    x[1, spec.free.index("area1")] = 0.6
+    v = spec.values(spec.to_internal(x))
+    assert v["eta2"][1] == v["eta1"][1] == pytest.approx(1.7, rel=1e-12)
+    assert v["area2"][1] == pytest.approx(0.4, rel=1e-12)
     # --free eta2 --tie eta2=eta1: only eta2 is free, so eta1 follows eta2 (swapped)
     s2 = ParamSpec("eta2", defaults=D, ties="eta2=eta1")
     assert s2.free == ("eta2",) and s2.ties == {"eta1": ("eta2", "equal")}
-    assert s2.values(np.array([1.33]))["eta1"] == 1.33
+    assert s2.values(s2.to_internal(np.array([1.33])))["eta1"] == pytest.approx(1.33, rel=1e-12)
 
 
-def test_log_uniform_internal_coordinates_and_prior():
-    spec = ParamSpec("gamma_s1,kd1", defaults=D)
+def test_internal_coordinates_are_logits_of_the_position_within_the_bounds():
+    spec = ParamSpec("gamma_s1,kd1", defaults=D)      # gamma_s log-uniform [0.3, 60] deg
     u = spec.start()
-    assert u[0] == pytest.approx(np.log(5.0)) and u[1] == 0.2
-    assert spec.values(np.array([np.log(7.0), 0.5]))["gamma_s1"] == pytest.approx(7.0)
-    lp = spec.log_prior(np.array([[np.log(7.0), 0.5], [np.log(7.0), 1.2],
-                                  [np.log(100.0), 0.5]]))
-    assert lp[0] == 0.0 and np.isneginf(lp[1]) and np.isneginf(lp[2])
+    q = (np.log(5.0) - np.log(0.3)) / (np.log(60.0) - np.log(0.3))
+    assert u[0] == pytest.approx(np.log(q / (1 - q)), rel=1e-12)
+    assert u[1] == pytest.approx(np.log(0.2 / 0.8), rel=1e-12)
+    x = np.array([[7.0, 0.5], [0.31, 0.999], [59.0, 1e-6]])
+    np.testing.assert_allclose(spec.to_natural(spec.to_internal(x)), x, rtol=1e-9)
+    assert spec.values(spec.to_internal(x))["gamma_s1"][0] == pytest.approx(7.0, rel=1e-12)
+    # outside the bounds there is no internal value
+    assert np.isnan(spec.to_internal(np.array([100.0, 0.5]))[0])
+
+
+def test_log_prior_is_flat_in_the_natural_value():
+    """Prior mass of an interval of kd (uniform) and of gamma_s (log-uniform), integrated in
+    the internal coordinate, equals its share of the range."""
+    spec = ParamSpec("gamma_s1,kd1", defaults=D)
+    u = np.linspace(-40, 40, 400001)
+    th = np.stack([np.zeros_like(u), u], -1)
+    w = np.exp(spec.log_prior(th))                    # gamma_s at its mid-point, kd varies
+    kd = spec.to_natural(th)[:, 1]
+    share = np.trapezoid(w * ((kd > 0.2) & (kd < 0.5)), u) / np.trapezoid(w, u)
+    assert share == pytest.approx(0.3, abs=1e-4)
+    th = np.stack([u, np.zeros_like(u)], -1)
+    w = np.exp(spec.log_prior(th))
+    g = spec.to_natural(th)[:, 0]
+    share = np.trapezoid(w * ((g > 1.0) & (g < 10.0)), u) / np.trapezoid(w, u)
+    assert share == pytest.approx(np.log(10) / np.log(200), abs=1e-4)
+    assert np.isneginf(spec.log_prior(np.array([[0.0, 41.0]]))[0])
 
 
 def test_area_sum_constraint():
     spec = ParamSpec("area1,area2", defaults=D)
-    lp = spec.log_prior(np.array([[0.5, 0.4], [0.7, 0.4]]))
-    assert lp[0] == 0.0 and np.isneginf(lp[1])
+    lp = spec.log_prior(spec.to_internal(np.array([[0.5, 0.4], [0.7, 0.4]])))
+    assert np.isfinite(lp[0]) and np.isneginf(lp[1])
 
 
 def test_start_outside_bounds_is_an_error():
@@ -70,9 +91,9 @@ def test_start_outside_bounds_is_an_error():
 
 def test_model_kwargs_layout():
     spec = ParamSpec("kd1", defaults=D)
-    kw = spec.model_kwargs(spec.values(np.array([[0.9], [0.1]])))
+    kw = spec.model_kwargs(spec.values(spec.to_internal(np.array([[0.9], [0.1]]))))
     assert kw["kd"].shape == (2, 2) and kw["albedo"].shape == (2, 2, 3)
-    assert kw["kd"][0].tolist() == [0.9, 0.3]
+    np.testing.assert_allclose(kw["kd"][0], [0.9, 0.3], rtol=1e-12)
     assert kw["albedo"][1].tolist() == [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]]
     assert kw["gamma_s"][0].tolist() == [5.0, 18.0]
 
@@ -85,7 +106,8 @@ def test_from_toml(tmp_path):
     spec = ParamSpec.from_toml(p, defaults=D, free="kd2")
     assert spec.free == ("eta1", "gamma_s1", "kd2")
     assert spec.params["eta1"].lo == 1.2 and spec.params["eta1"].default == 1.6
-    assert spec.start()[1] == 5.0          # uniform prior now: internal = natural
+    q = (5.0 - 0.3) / (60.0 - 0.3)           # uniform prior now: linear position in [0.3, 60]
+    assert spec.start()[1] == pytest.approx(np.log(q / (1 - q)), rel=1e-12)
     bad = tmp_path / "bad.toml"
     bad.write_text("free = [\n")
     with pytest.raises(ValueError, match="bad.toml: not valid TOML"):

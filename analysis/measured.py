@@ -1,0 +1,176 @@
+r"""Fits of the model to the measured fabrics of ``../shared/data``: which tables, which preset
+each starts from, which parameters are free.
+
+Nine datasets: the three RGL acrylic felts (absolute f_r in 1/sr, RGB) and six CUReT fabric
+samples (relative reflectance, grey: a free ``scale``). Neither kind has per-value sigma, so a
+``log_noise`` parameter is added by :func:`analysis.fit.fit`.
+
+Choices, all physically motivated and stated in the report:
+
+- **Start preset.** The closest fabric of the paper: ``linen_plain`` (a matte staple-fibre
+  weave) for felt, linen and cotton; ``velvet`` for velvet and corduroy (both cut piles);
+  ``polyester_satin_charmeuse`` for polyester. The preset fixes the tangent curves and the
+  values of the parameters that are not free.
+- **Free parameters.** One set of optical parameters shared by both threads (the two threads
+  of a felt or of a grey measurement cannot be told apart): ``eta1``, ``kd1``, ``gamma_s1``,
+  ``gamma_v1``, ``area1`` (``area2 = 1 - area1``), and for the RGB felts the albedo
+  ``albedo1_r/g/b``; thread 2 is tied to thread 1. CUReT is grey and relative, so its albedo
+  cannot be separated from the free scale and stays at the preset's.
+- **Tables.** RGL: the tensor file evaluated (:func:`gonio.load_rgl`) at its own incidence
+  nodes below 90 degrees and outgoing directions every ``rgl_step`` degrees (default 15: the
+  felts are smooth, and the finer 10-degree grid changes no interval by more than its
+  sampling noise while costing twice the time). CUReT: the 205 configurations as measured.
+
+Examples
+--------
+>>> sorted(MEASURED)[:3]
+['curet_01_felt', 'curet_02_polyester', 'curet_07_velvet']
+>>> MEASURED["rgl_white_felt"].preset
+'linen_plain'
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+
+__all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir"]
+
+_SHARED_FREE = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1")
+_SHARED_TIES = ("eta2=eta1", "kd2=kd1", "gamma_s2=gamma_s1", "gamma_v2=gamma_v1",
+                "area2=1-area1")
+_ALBEDO_TIES = ("albedo2_r=albedo1_r", "albedo2_g=albedo1_g", "albedo2_b=albedo1_b")
+
+
+@dataclasses.dataclass(frozen=True)
+class MeasuredDataset:
+    """One measured table and how it is fitted.
+
+    Attributes
+    ----------
+    name : str
+        Key, also the name of its output folder.
+    title : str
+        Human-readable description (material and source).
+    kind : {"rgl", "curet"}
+        Reader.
+    path : str
+        Path relative to the data folder (``../shared/data``).
+    sample : int or None
+        CUReT sample number.
+    preset : str
+        Preset giving the tangent curves, fixed values and start.
+    free, ties : tuple of str
+        Free parameters and ties (:class:`analysis.params.ParamSpec` syntax).
+    """
+
+    name: str
+    title: str
+    kind: str
+    path: str
+    sample: int | None
+    preset: str
+    free: tuple[str, ...]
+    ties: tuple[str, ...]
+
+
+def _rgl(colour: str) -> MeasuredDataset:
+    return MeasuredDataset(
+        f"rgl_{colour}_felt", f"RGL acrylic felt, {colour} (Dupuy and Jakob 2018)", "rgl",
+        f"rgl/acrylic_felt_{colour}_rgb.bsdf", None, "linen_plain",
+        _SHARED_FREE + ("albedo1_r", "albedo1_g", "albedo1_b"), _SHARED_TIES + _ALBEDO_TIES)
+
+
+def _curet(sample: int, what: str, preset: str) -> MeasuredDataset:
+    return MeasuredDataset(
+        f"curet_{sample:02d}_{what}", f"CUReT sample {sample}, {what} (Dana et al. 1999)",
+        "curet", "curet/abrdf.dat", sample, preset, _SHARED_FREE, _SHARED_TIES)
+
+
+#: The measured datasets by name.
+MEASURED: dict[str, MeasuredDataset] = {d.name: d for d in (
+    _rgl("white"), _rgl("pink"), _rgl("purple"),
+    _curet(1, "felt", "linen_plain"), _curet(2, "polyester", "polyester_satin_charmeuse"),
+    _curet(7, "velvet", "velvet"), _curet(42, "corduroy", "velvet"),
+    _curet(44, "linen", "linen_plain"), _curet(46, "cotton", "linen_plain"),
+)}
+
+
+def default_data_dir() -> Path:
+    """The measured-data folder: ``$MICROCYL_DATA``, else ``../shared/data`` from the current
+    folder, else the same beside this source tree's parent."""
+    env = os.environ.get("MICROCYL_DATA")
+    if env:
+        return Path(env)
+    here = Path.cwd() / ".." / "shared" / "data"
+    if here.is_dir():
+        return here.resolve()
+    return (Path(__file__).resolve().parents[2] / "shared" / "data")
+
+
+def _dataset(name) -> MeasuredDataset:
+    if isinstance(name, MeasuredDataset):
+        return name
+    if name not in MEASURED:
+        raise ValueError(f"unknown measured dataset {name!r}; valid: {', '.join(MEASURED)}")
+    return MEASURED[name]
+
+
+def load_measured(name, data_dir=None, rgl_step: float = 15.0):
+    """The table of a measured dataset.
+
+    Parameters
+    ----------
+    name : str or MeasuredDataset
+        A key of :data:`MEASURED`.
+    data_dir : path, optional
+        The data folder (default :func:`default_data_dir`).
+    rgl_step : float
+        Outgoing-direction step for sampling an RGL file, degrees (> 0).
+
+    Returns
+    -------
+    gonio.Table
+
+    Raises
+    ------
+    ValueError
+        Unknown name or bad step.
+    FileNotFoundError
+        The data file is missing.
+    """
+    import gonio
+    d = _dataset(name)
+    if not (rgl_step > 0):
+        raise ValueError(f"rgl_step must be > 0 degrees; got {rgl_step}")
+    root = Path(data_dir) if data_dir is not None else default_data_dir()
+    path = root / d.path
+    if not path.exists():
+        raise FileNotFoundError(2, f"measured data for {d.name} not found (set --data or "
+                                   f"MICROCYL_DATA)", str(path))
+    if d.kind == "rgl":
+        return gonio.read(path, step=float(rgl_step))
+    return gonio.load_curet(path.parent, d.sample)
+
+
+def measured_spec(name, fab=None):
+    """The :class:`~analysis.params.ParamSpec` and start fabric of a measured dataset.
+
+    Returns
+    -------
+    spec : ParamSpec
+    fabric : brdf.Fabric
+        The start preset (defaults for every fixed parameter).
+
+    Examples
+    --------
+    >>> spec, fab = measured_spec("curet_07_velvet")
+    >>> spec.free, fab.name
+    (('eta1', 'kd1', 'gamma_s1', 'gamma_v1', 'area1'), 'velvet')
+    """
+    import brdf
+    from analysis.params import ParamSpec, defaults_from_fabric
+    d = _dataset(name)
+    fab = fab if fab is not None else brdf.fabric(d.preset)
+    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties), fab

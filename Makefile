@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test report bench clean
+.PHONY: test report fits bench clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "microcyl needs Python >= 3.11, found " + sys.version.split()[0])'
@@ -16,8 +16,13 @@ $(STAMP): pyproject.toml
 test: $(STAMP)
 	$(PY) -m pytest
 
+# the report includes the measured-data fits when `make fits` has made them
 report: $(STAMP)
-	$(VENV)/bin/microcyl report
+	$(VENV)/bin/microcyl report $(if $(wildcard fits/measured.json),--measured fits)
+
+# fits of the RGL felts and CUReT fabrics (about 1.5 h on 2 cores; resumable: run it again)
+fits: $(STAMP)
+	$(VENV)/bin/microcyl fit-measured -o fits
 
 bench: $(STAMP)
 	for f in bench/bench_*.py; do echo "== $$f"; $(PY) $$f || exit 1; done

@@ -8,6 +8,7 @@ from analysis.sanity import SanityResult, sanity_scan
 from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rhat
 from analysis.fit import FabricModel, FitResult, LogPosterior, fit, write_results
 from analysis.likelihood import Likelihood
+from analysis.measured import MEASURED, MeasuredDataset, load_measured, measured_spec
 from analysis.params import (DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec,
                              defaults_from_fabric)
 
@@ -18,4 +19,5 @@ __all__ += ["albedo", "albedo_curve", "albedo_hemispherical", "AlbedoResult", "A
             "SanityResult"]
 __all__ += ["ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
             "Likelihood", "fit", "FitResult", "FabricModel", "LogPosterior", "write_results",
-            "autocorr_time", "split_rhat", "ess", "interval_summary"]
+            "autocorr_time", "split_rhat", "ess", "interval_summary",
+            "MEASURED", "MeasuredDataset", "load_measured", "measured_spec"]

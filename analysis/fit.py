@@ -11,7 +11,9 @@ Pipeline (:func:`fit`):
 3. ``ensembles`` independent emcee ensembles (different seeds), each with ``walkers`` walkers,
    a vectorized log-probability, moves: an independence Metropolis-Hastings step from a
    Student-t fitted to the Laplace approximation (:class:`LaplaceMove`, share ``laplace_move``,
-   default 0.75) mixed with DEMove (0.8 of the rest) and DESnookerMove (0.2), and an HDF5
+   default 0.75, scaled down when the proposal is poor), refit early in the run to each
+   ensemble's own chain as a mixture of Student-t components, mixed with DEMove (0.8 of the
+   rest) and DESnookerMove (0.2), and an HDF5
    checkpoint ``DIR/chains_<k>.h5``. The ensembles run in lock-step threads whose model
    evaluations are stacked into one batch (:class:`LockStep`), split over ``threads`` worker
    threads.
@@ -43,6 +45,7 @@ import numpy as np
 import emcee
 import scipy.linalg
 import scipy.optimize
+import scipy.special
 
 from analysis import diagnostics
 from analysis.likelihood import Likelihood
@@ -52,6 +55,9 @@ __all__ = ["fit", "FitResult", "LogPosterior", "LockStep", "FabricModel", "point
            "write_results", "CONFIG_FILE"]
 
 CONFIG_FILE = "fit_config.json"
+
+#: Numbers of mixture components tried when the independence proposal is refit to a chain.
+MIXTURE_COMPONENTS = (1, 2, 4)
 
 
 # ---------------------------------------------------------------------------- forward model
@@ -141,32 +147,147 @@ class LogPosterior:
 
 
 class LaplaceMove(emcee.moves.MHMove):
-    r"""Independence Metropolis-Hastings move from a fixed multivariate Student-t.
+    r"""Independence Metropolis-Hastings move from a fixed mixture of multivariate Student-t.
 
-    The proposal q(x) = t_df(x; mean, scale^2 cov) does not depend on the current position and
-    is fixed before sampling (from the Laplace approximation at the point estimate), so the
-    move keeps the posterior invariant with the Hastings factor log q(x) - log q(x'), where
-    log q(x) = -(df + d)/2 log(1 + (x - mean)^T (scale^2 cov)^-1 (x - mean) / df) + const.
-    For the nearly Gaussian posteriors of a well-measured table it is accepted often, which
-    cuts the autocorrelation time; the DE moves mixed with it handle the rest.
+    The proposal
+
+    .. math:: q(x) = \sum_k w_k\, t_{df}(x;\ \mu_k,\ s^2 \Sigma_k)
+
+    does not depend on the current position and is fixed while it is used, so the move keeps
+    the posterior invariant with the Hastings factor log q(x) - log q(x'). One component is
+    the Laplace approximation at the point estimate; :meth:`from_samples` fits several
+    (Gaussian-mixture EM on chain samples), which follows the skewed and curved posteriors of
+    real measurements (parameters against a bound, brightness traded against k_d) far better
+    than one ellipsoid. Where q covers the posterior the move is accepted often and each
+    accepted draw is independent of the last, which cuts the autocorrelation time; the DE
+    moves mixed with it handle the rest.
+
+    Parameters
+    ----------
+    mean : array_like, shape (d,) or (K, d)
+    cov : array_like, shape (d, d) or (K, d, d)
+    df : float
+        Degrees of freedom of every component (heavy tails keep p/q bounded).
+    scale : float
+        Factor s on every component's standard deviations.
+    weights : array_like, shape (K,), optional
+        Mixture weights (default equal).
     """
 
-    def __init__(self, mean, cov, df: float = 5.0, scale: float = 1.2):
-        self.mean = np.asarray(mean, dtype=np.float64)
-        self.chol = np.linalg.cholesky(np.asarray(cov, dtype=np.float64) * scale ** 2)
+    def __init__(self, mean, cov, df: float = 5.0, scale: float = 1.2, weights=None):
+        means = np.atleast_2d(np.asarray(mean, dtype=np.float64))
+        covs = np.asarray(cov, dtype=np.float64)
+        covs = covs[None] if covs.ndim == 2 else covs
+        k = means.shape[0]
+        if covs.shape != (k, means.shape[1], means.shape[1]):
+            raise ValueError(f"cov must have shape (K, d, d) = ({k}, {means.shape[1]}, "
+                             f"{means.shape[1]}); got {covs.shape}")
+        w = np.full(k, 1.0 / k) if weights is None else np.asarray(weights, dtype=np.float64)
         self.df = float(df)
-        super().__init__(self._propose, ndim=self.mean.size)
+        self._set(means, np.linalg.cholesky(covs * scale ** 2), w / w.sum())
+        super().__init__(self._propose, ndim=means.shape[1])
 
-    def _logq(self, x):
-        z = scipy.linalg.solve_triangular(self.chol, (x - self.mean).T, lower=True)
-        return -0.5 * (self.df + self.mean.size) * np.log1p((z * z).sum(axis=0) / self.df)
+    def _set(self, means, chols, weights):
+        self.means, self.chols, self.weights = means, chols, weights
+        self._logw = np.log(weights) - np.log(np.diagonal(chols, axis1=1, axis2=2)).sum(axis=1)
+
+    def copy_from(self, other: "LaplaceMove"):
+        """Take over another proposal's components (the move object itself stays in place)."""
+        self.df = other.df
+        self._set(other.means, other.chols, other.weights)
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Mixture mean, shape (d,)."""
+        return self.weights @ self.means
+
+    @property
+    def n_components(self) -> int:
+        return self.means.shape[0]
+
+    @classmethod
+    def from_samples(cls, x, components: int, rng, *, ridge=None, df: float = 5.0,
+                     scale: float = 1.2, iters: int = 60) -> "LaplaceMove | None":
+        """Fit ``components`` components to samples x (n, d) by Gaussian-mixture EM.
+
+        Seeds by k-means++ from ``rng``; ``ridge`` (d,) is added to every covariance's
+        diagonal. Components left with fewer than 2 d samples' weight are dropped. Returns
+        None when the samples are too few (< 5 d per component) or degenerate.
+        """
+        x = np.asarray(x, dtype=np.float64)
+        n, d = x.shape
+        if n < 5 * d * components:
+            return None
+        ridge = np.zeros(d) if ridge is None else np.asarray(ridge, dtype=np.float64)
+        cov0 = np.cov(x.T).reshape(d, d) + np.diag(ridge)
+        if components == 1:
+            try:
+                return cls(x.mean(axis=0), cov0, df=df, scale=scale)
+            except np.linalg.LinAlgError:
+                return None
+        # k-means++ seeds in the whitened space
+        try:
+            lw = np.linalg.cholesky(cov0)
+        except np.linalg.LinAlgError:
+            return None
+        z = scipy.linalg.solve_triangular(lw, (x - x.mean(axis=0)).T, lower=True).T
+        centres = [z[rng.integers(n)]]
+        for _ in range(components - 1):
+            d2 = np.min([((z - c) ** 2).sum(axis=1) for c in centres], axis=0)
+            centres.append(z[rng.choice(n, p=d2 / d2.sum())])
+        resp = np.exp(-0.5 * np.array([((z - c) ** 2).sum(axis=1) for c in centres]))
+        resp /= np.maximum(resp.sum(axis=0), 1e-300)
+        for _ in range(iters):
+            nk = resp.sum(axis=1)
+            keep = nk > 2 * d
+            resp, nk = resp[keep], nk[keep]
+            w = nk / n
+            mu = resp @ x / nk[:, None]
+            covs = np.empty((len(nk), d, d))
+            logp = np.empty((len(nk), n))
+            for j in range(len(nk)):
+                dx = x - mu[j]
+                covs[j] = (resp[j][:, None] * dx).T @ dx / nk[j] + np.diag(ridge)
+                try:
+                    c = np.linalg.cholesky(covs[j])
+                except np.linalg.LinAlgError:
+                    return None
+                zz = scipy.linalg.solve_triangular(c, dx.T, lower=True)
+                logp[j] = (np.log(w[j]) - np.log(np.diag(c)).sum()
+                           - 0.5 * (zz * zz).sum(axis=0))
+            resp = np.exp(logp - scipy.special.logsumexp(logp, axis=0))
+        try:
+            return cls(mu, covs, df=df, scale=scale, weights=w)
+        except np.linalg.LinAlgError:
+            return None
+
+    def logq(self, x) -> np.ndarray:
+        """log q(x) up to a constant, x (n, d)."""
+        x = np.atleast_2d(x)
+        out = np.empty((self.n_components, x.shape[0]))
+        for j in range(self.n_components):
+            z = scipy.linalg.solve_triangular(self.chols[j], (x - self.means[j]).T, lower=True)
+            out[j] = self._logw[j] - 0.5 * (self.df + x.shape[1]) * np.log1p(
+                (z * z).sum(axis=0) / self.df)
+        return scipy.special.logsumexp(out, axis=0)
+
+    _logq = logq
+
+    def sample(self, n: int, random) -> np.ndarray:
+        """n draws from q; ``random`` a NumPy Generator or RandomState."""
+        d = self.means.shape[1]
+        if self.n_components == 1:
+            comp = np.zeros(n, dtype=int)
+        else:
+            comp = random.choice(self.n_components, size=n, p=self.weights)
+        z = random.standard_normal((n, d))
+        z = np.einsum("nij,nj->ni", self.chols[comp], z)
+        w = random.chisquare(self.df, n) / self.df
+        return self.means[comp] + z / np.sqrt(w)[:, None]
 
     def _propose(self, x0, random):
-        n, d = x0.shape
-        z = random.standard_normal((n, d)) @ self.chol.T
-        w = random.chisquare(self.df, n) / self.df
-        x1 = self.mean + z / np.sqrt(w)[:, None]
-        return x1, self._logq(x0) - self._logq(x1)
+        x1 = self.sample(x0.shape[0], random)
+        return x1, self.logq(x0) - self.logq(x1)
 
 
 class _Aborted(Exception):
@@ -364,11 +485,10 @@ def _hessian_cov(logpost: LogPosterior, x: np.ndarray, h: np.ndarray):
 
 
 def _proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256) -> float:
-    """Importance-sampling ESS fraction of the Laplace proposal: (sum w)^2 / (n sum w^2) with
-    w = p(x) / q(x) for n draws x ~ q; 1 for a perfect proposal, near 0 for a poor one."""
-    z = rng.standard_normal((n, move.mean.size)) @ move.chol.T
-    x = move.mean + z / np.sqrt(rng.chisquare(move.df, n) / move.df)[:, None]
-    lw = logpost(x) - move._logq(x)
+    """Importance-sampling ESS fraction of the independence proposal: (sum w)^2 / (n sum w^2)
+    with w = p(x) / q(x) for n draws x ~ q; 1 for a perfect proposal, near 0 for a poor one."""
+    x = move.sample(n, rng)
+    lw = logpost(x) - move.logq(x)
     if not np.any(np.isfinite(lw)):
         return 0.0
     w = np.exp(lw - np.max(lw[np.isfinite(lw)]))
@@ -576,9 +696,11 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     laplace_move : float
         Largest share of the independence move (0 turns it off).
     adapt : int, optional
-        First of the steps ``adapt``, ``2 adapt``, ``4 adapt`` at which each ensemble may refit
-        its independence proposal to the second half of its own chain so far (default
-        ``2 * check_every``; 0 for never). A refit is kept only when it raises the proposal's
+        First of the steps ``adapt``, ``2 adapt``, ``4 adapt``, ``8 adapt`` at which each
+        ensemble may refit its independence proposal to the second half of its own chain so
+        far, as a mixture of 1, 2 or 4 Student-t components (:data:`MIXTURE_COMPONENTS`,
+        the one with the largest importance-sampling ESS; default ``2 * check_every``; 0 for
+        never). A refit is kept only when it raises the proposal's
         importance-sampling ESS by more than 10%; the first refit not kept ends the
         adaptation of that ensemble. The chain before the last refit is discarded (the
         burn-in is at least that long), so the kept samples come from one fixed kernel.
@@ -636,7 +758,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     logpost = LogPosterior(spec, lik, model)
 
     config = {
-        "version": 2, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
+        "version": 3, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
         "ensembles": ensembles, "walkers": walkers, "seed": seed,
         "table": _table_digest(table), "n_used": lik.n_used,
         "laplace_move": laplace_move, "adapt": adapt,
@@ -705,7 +827,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         share, frac = _laplace_share(logpost, LaplaceMove(best, cov), laplace_move,
                                      np.random.default_rng(seed))
         laplace_info = {"share": share, "importance_ess_fraction": frac}
-    schedule = [a for a in (adapt, 2 * adapt, 4 * adapt) if 0 < a < max_steps]
+    schedule = [a for a in (adapt, 2 * adapt, 4 * adapt, 8 * adapt) if 0 < a < max_steps]
     laplace_info["adapt_schedule"] = schedule
     last_adapt = [0] * ensembles          # step of each ensemble's last kept refit
     adapt_done = [not schedule] * ensembles
@@ -729,20 +851,20 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         the stored chain, so a resumed fit repeats every decision exactly."""
         s = samplers[k]
         x = s.get_chain()[a // 2:a].reshape(-1, ndim)
-        c = np.cov(x.T).reshape(ndim, ndim) if x.shape[0] >= 5 * ndim else None
-        move = None
-        if c is not None:
-            c += np.diag((1e-9 * spec.width) ** 2)
-            try:
-                move = LaplaceMove(x.mean(axis=0), c)
-            except np.linalg.LinAlgError:
-                move = None
+        move, frac, sh, comps = None, -np.inf, 0.0, 0
+        for K in MIXTURE_COMPONENTS:
+            cand = LaplaceMove.from_samples(x, K, np.random.default_rng([seed, k, a, K]),
+                                            ridge=(1e-9 * spec.width) ** 2)
+            if cand is None:
+                continue
+            c_sh, c_frac = _laplace_share(logpost, cand, laplace_move,
+                                          np.random.default_rng([seed, k, a]))
+            if np.isfinite(c_frac) and c_frac > frac:
+                move, frac, sh, comps = cand, c_frac, c_sh, cand.n_components
         lm = laplace_moves[k]
         if move is None:
             adapt_done[k] = True
             return {"step": a, "kept": False}
-        sh, frac = _laplace_share(logpost, move, laplace_move,
-                                  np.random.default_rng([seed, k, a]))
         _, frac_now = _laplace_share(logpost, lm, laplace_move,
                                      np.random.default_rng([seed, k, a]))
         s_weights = np.array(s._weights, dtype=np.float64)
@@ -751,14 +873,14 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
             adapt_done[k] = True
             return {"step": a, "kept": False, "importance_ess_fraction": frac,
                     "current": frac_now}
-        lm.mean, lm.chol = move.mean, move.chol
+        lm.copy_from(move)
         w = s_weights
         w[:-1] = w[:-1] / max(w[:-1].sum(), 1e-300) * (1 - sh)
         w[-1] = sh
         s._weights = w / w.sum()
         last_adapt[k] = a
         return {"step": a, "kept": True, "share": sh, "importance_ess_fraction": frac,
-                "previous": frac_now}
+                "components": comps, "previous": frac_now}
 
     lock = LockStep(logpost, ensembles, threads=threads)
     samplers = []

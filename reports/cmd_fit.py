@@ -89,7 +89,6 @@ def _spec_from_args(args, fab):
 
 
 def run(args) -> int:
-    from analysis.fit import FabricModel
     if args.fabric not in brdf.PRESETS:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")

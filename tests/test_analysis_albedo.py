@@ -1,7 +1,6 @@
 """Tests of analysis.albedo: known answers, error bounds, the per-thread rule, seeds."""
 
 import json
-import math
 import sys
 from pathlib import Path
 

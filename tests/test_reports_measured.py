@@ -28,11 +28,10 @@ def test_datasets_cover_the_issue_list(shared_data):
 
 
 @pytest.fixture(scope="module")
-def fitted(tmp_path_factory):
-    from pathlib import Path
-    data = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+def fitted(tmp_path_factory, shared_data):
     out = tmp_path_factory.mktemp("measured")
-    status = main(["fit-measured", "curet_44_linen", "--data", str(data), "--max-steps", "60",
+    status = main(["fit-measured", "curet_44_linen", "--data", str(shared_data),
+                   "--max-steps", "60",
                    "--no-progress", "-o", str(out)])
     return out, status
 

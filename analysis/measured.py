@@ -17,9 +17,13 @@ Choices, all physically motivated and stated in the report:
   ``albedo1_r/g/b``; thread 2 is tied to thread 1. CUReT is grey and relative, so its albedo
   cannot be separated from the free scale and stays at the preset's.
 - **Tables.** RGL: the tensor file evaluated (:func:`gonio.load_rgl`) at its own incidence
-  nodes below 90 degrees and outgoing directions every ``rgl_step`` degrees (default 15,
-  1008 pairs: the felts' f_r is smooth at that scale, and the time of a fit grows in
-  proportion to the pairs). CUReT: the 205 configurations as measured.
+  nodes below 90 degrees and outgoing directions every ``rgl_step`` degrees (default 15:
+  the felts' f_r is smooth at that scale, and the time of a fit grows in proportion to the
+  pairs). The felt files are isotropic, stored for one incidence azimuth and mirrored about
+  the plane of incidence, so only outgoing azimuths in [0, 180] degrees are kept, and each
+  direction pair once (at theta_o = 0 every azimuth names the same pair): 462 pairs of the
+  1008. The mirrored half and the repeats are the same measurements and would count each
+  several times, making the intervals too narrow. CUReT: the 205 configurations as measured.
 
 Examples
 --------
@@ -34,6 +38,8 @@ from __future__ import annotations
 import dataclasses
 import os
 from pathlib import Path
+
+import numpy as np
 
 __all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir"]
 
@@ -150,7 +156,20 @@ def load_measured(name, data_dir=None, rgl_step: float = 15.0):
         raise FileNotFoundError(2, f"measured data for {d.name} not found (set --data or "
                                    f"MICROCYL_DATA)", str(path))
     if d.kind == "rgl":
-        return gonio.read(path, step=float(rgl_step))
+        table = gonio.read(path, step=float(rgl_step))
+        if gonio.load_rgl(path).isotropic:
+            # one incidence azimuth (0) and a mirror-symmetric file: keep phi_o in [0, pi]
+            keep = np.flatnonzero(table.wo[:, 1] >= -1e-9)
+            # and each direction pair once (at theta_o = 0 every azimuth is the same pair)
+            key = np.round(np.concatenate([table.wi[keep], table.wo[keep]], axis=1), 9) + 0.0
+            keep = np.sort(keep[np.unique(key, axis=0, return_index=True)[1]])
+            meta = dict(table.meta, mirror_half="outgoing azimuths in [0, 180] degrees only "
+                        "(the file is isotropic: the other half mirrors them), each pair once")
+            table = table.replace(wi=table.wi[keep], wo=table.wo[keep],
+                                  values=table.values[keep],
+                                  sigma=None if table.sigma is None else table.sigma[keep],
+                                  meta=meta)
+        return table
     return gonio.load_curet(path.parent, d.sample)
 
 

@@ -18,6 +18,13 @@ def test_datasets_cover_the_issue_list(shared_data):
     assert len(t) == 205 and t.meta["units"] == "relative"
     t = load_measured("rgl_pink_felt", shared_data, rgl_step=30.0)
     assert t.sigma is None and np.all(t.values[t.valid] > 0)
+    # the isotropic felt files mirror phi_o: one half of the azimuths, each pair once.
+    # 7 incidence nodes below 90 degrees; outgoing theta 15..75 by 15 times phi 0..180 by 15,
+    # plus the normal
+    t = load_measured("rgl_white_felt", shared_data, rgl_step=15.0)
+    assert len(t) == 7 * (5 * 13 + 1)
+    assert np.all(t.wo[:, 1] >= -1e-9)
+    assert len(np.unique(np.round(np.c_[t.wi, t.wo], 9), axis=0)) == len(t)
     spec, fab = measured_spec("rgl_pink_felt")
     assert {"albedo1_r", "albedo1_g", "albedo1_b"} <= set(spec.free)
     assert spec.ties["albedo2_g"] == ("albedo1_g", "equal") and fab.name == "linen_plain"

@@ -696,14 +696,14 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     laplace_move : float
         Largest share of the independence move (0 turns it off).
     adapt : int, optional
-        First of the steps ``adapt``, ``2 adapt``, ``4 adapt``, ``8 adapt`` at which each
-        ensemble may refit its independence proposal to the second half of its own chain so
-        far, as a mixture of 1, 2 or 4 Student-t components (:data:`MIXTURE_COMPONENTS`,
-        the one with the largest importance-sampling ESS; default ``2 * check_every``; 0 for
-        never). A refit is kept only when it raises the proposal's
-        importance-sampling ESS by more than 10%; the first refit not kept ends the
-        adaptation of that ensemble. The chain before the last refit is discarded (the
-        burn-in is at least that long), so the kept samples come from one fixed kernel.
+        First of the steps ``adapt``, ``2 adapt``, ``4 adapt``, ... (doubling, below
+        ``max_steps``) at which each ensemble may refit its independence proposal to the
+        second half of its own chain so far, as a mixture of 1, 2 or 4 Student-t components
+        (:data:`MIXTURE_COMPONENTS`, the one with the largest importance-sampling ESS; default
+        ``2 * check_every``; 0 for never). A refit is kept only when it raises the proposal's
+        importance-sampling ESS by more than 10%. The burn-in is at least the step of the last
+        kept refit, up to half the chain; every kernel used leaves the posterior invariant and
+        each depends only on the chain before it, and the number of refits is finite.
     out_dir : path, optional
         Folder for ``fit_config.json`` and the checkpoints ``chains_<k>.h5``; resumes there.
     time_limit : float, optional
@@ -758,7 +758,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     logpost = LogPosterior(spec, lik, model)
 
     config = {
-        "version": 3, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
+        "version": 4, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
         "ensembles": ensembles, "walkers": walkers, "seed": seed,
         "table": _table_digest(table), "n_used": lik.n_used,
         "laplace_move": laplace_move, "adapt": adapt,
@@ -827,7 +827,10 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         share, frac = _laplace_share(logpost, LaplaceMove(best, cov), laplace_move,
                                      np.random.default_rng(seed))
         laplace_info = {"share": share, "importance_ess_fraction": frac}
-    schedule = [a for a in (adapt, 2 * adapt, 4 * adapt, 8 * adapt) if 0 < a < max_steps]
+    # doubling: the proposal keeps up with chains that explore a long ridge slowly
+    schedule = []
+    while 0 < adapt * 2 ** len(schedule) < max_steps:
+        schedule.append(adapt * 2 ** len(schedule))
     laplace_info["adapt_schedule"] = schedule
     last_adapt = [0] * ensembles          # step of each ensemble's last kept refit
     adapt_done = [not schedule] * ensembles
@@ -863,14 +866,12 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                 move, frac, sh, comps = cand, c_frac, c_sh, cand.n_components
         lm = laplace_moves[k]
         if move is None:
-            adapt_done[k] = True
             return {"step": a, "kept": False}
         _, frac_now = _laplace_share(logpost, lm, laplace_move,
                                      np.random.default_rng([seed, k, a]))
         s_weights = np.array(s._weights, dtype=np.float64)
         if not (np.isfinite(frac) and (not np.isfinite(frac_now) or frac > 1.1 * frac_now
                                        or s_weights[-1] == 0)):
-            adapt_done[k] = True
             return {"step": a, "kept": False, "importance_ess_fraction": frac,
                     "current": frac_now}
         lm.copy_from(move)

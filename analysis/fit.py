@@ -197,11 +197,6 @@ class LaplaceMove(emcee.moves.MHMove):
         self._set(other.means, other.chols, other.weights)
 
     @property
-    def mean(self) -> np.ndarray:
-        """Mixture mean, shape (d,)."""
-        return self.weights @ self.means
-
-    @property
     def n_components(self) -> int:
         return self.means.shape[0]
 
@@ -270,8 +265,6 @@ class LaplaceMove(emcee.moves.MHMove):
             out[j] = self._logw[j] - 0.5 * (self.df + x.shape[1]) * np.log1p(
                 (z * z).sum(axis=0) / self.df)
         return scipy.special.logsumexp(out, axis=0)
-
-    _logq = logq
 
     def sample(self, n: int, random) -> np.ndarray:
         """n draws from q; ``random`` a NumPy Generator or RandomState."""
@@ -577,6 +570,11 @@ class FitResult:
             "points": self.counts, "timing": self.timing,
             "ties": {k: list(v) for k, v in self.spec.ties.items()} if self.spec else {},
         }
+        if self.logpost is not None:
+            q = self.residuals()
+            doc["_fit"]["quality"] = {"rms_residual": q["rms"],
+                                      "rms_normalized": q["rms_normalized"],
+                                      "values": int(q["residual"].size)}
         return doc
 
     def samples(self, flat: bool = True) -> np.ndarray:
@@ -612,12 +610,14 @@ def _atomic_write(path: Path, text: str):
     os.replace(tmp, path)
 
 
-def write_results(result: FitResult, out_dir) -> tuple[Path, Path]:
-    """Write ``results.json`` and ``results.csv`` into ``out_dir`` (atomically)."""
+def write_results(result: FitResult, out_dir, doc: Mapping | None = None) -> tuple[Path, Path]:
+    """Write ``results.json`` (``doc``, default ``result.to_json()``) and ``results.csv`` into
+    ``out_dir`` (atomically)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     jpath, cpath = out / "results.json", out / "results.csv"
-    _atomic_write(jpath, json.dumps(result.to_json(), indent=2, default=_json_default) + "\n")
+    doc = result.to_json() if doc is None else doc
+    _atomic_write(jpath, json.dumps(doc, indent=2, default=_json_default) + "\n")
     cols = ["median", "lo68", "hi68", "lo95", "hi95", "tau", "n_over_tau", "rhat", "ess", "unit"]
     lines = ["parameter," + ",".join(cols)]
     for n in result.names:
@@ -833,7 +833,6 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         schedule.append(adapt * 2 ** len(schedule))
     laplace_info["adapt_schedule"] = schedule
     last_adapt = [0] * ensembles          # step of each ensemble's last kept refit
-    adapt_done = [not schedule] * ensembles
     laplace_moves = [None] * ensembles
 
     def make_moves(k):
@@ -932,25 +931,21 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
 
     laplace_info["adaptations"] = []
     adapt_evals = [0]
+    next_adapt = [0]                      # index into schedule of the next refit point
 
     def maybe_adapt():
+        """Refit every ensemble at each schedule point reached (all of them, in order, when a
+        resumed fit starts: the decisions replay exactly from the stored chains)."""
         e0 = logpost.n_evals
+        n = min(s.iteration for s in samplers)
         try:
-            _maybe_adapt()
+            while next_adapt[0] < len(schedule) and schedule[next_adapt[0]] <= n:
+                a = schedule[next_adapt[0]]
+                for k in range(ensembles):
+                    laplace_info["adaptations"].append(dict(adapt_moves(k, a), ensemble=k))
+                next_adapt[0] += 1
         finally:
             adapt_evals[0] += logpost.n_evals - e0
-
-    def _maybe_adapt():
-        n = min(s.iteration for s in samplers)
-        for a in schedule:
-            if a > n:
-                break
-            for k in range(ensembles):
-                if not adapt_done[k] and last_adapt[k] < a and \
-                        all(d["step"] != a for d in laplace_info["adaptations"]
-                            if d.get("ensemble") == k):
-                    info = adapt_moves(k, a)
-                    laplace_info["adaptations"].append(dict(info, ensemble=k))
 
     bar = None
     if progress:

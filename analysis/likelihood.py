@@ -32,13 +32,21 @@ import math
 import numpy as np
 from scipy.special import gammaln
 
-__all__ = ["Likelihood", "KINDS", "is_relative"]
+__all__ = ["Likelihood", "KINDS", "is_relative", "is_grey"]
 
 KINDS = ("gaussian", "relative", "student-t")
 _LOG_2PI = math.log(2.0 * math.pi)
 
 
-def _is_grey(a) -> bool:
+def is_grey(a) -> bool:
+    """True when the (n, 3) array holds the same value in R, G and B at every row (NaN equal).
+
+    Examples
+    --------
+    >>> is_grey(np.array([[0.1, 0.1, 0.1], [np.nan, np.nan, np.nan]]))
+    True
+    """
+    a = np.asarray(a)
     return bool(np.array_equal(a[:, 0], a[:, 1], equal_nan=True)
                 and np.array_equal(a[:, 0], a[:, 2], equal_nan=True))
 
@@ -112,7 +120,7 @@ class Likelihood:
         sigma = None if table.sigma is None else np.asarray(table.sigma, dtype=np.float64)
         good_sigma = np.ones((n, 3), bool) if sigma is None else np.isfinite(sigma) & (sigma > 0)
         mask = good_value & above & good_sigma
-        self.grey = _is_grey(values) and (sigma is None or _is_grey(sigma))
+        self.grey = is_grey(values) and (sigma is None or is_grey(sigma))
         if self.grey:
             mask[:, 1:] = False
             good_value, above, good_sigma = (a[:, :1] for a in (good_value, above, good_sigma))

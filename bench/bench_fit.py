@@ -21,7 +21,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 from scipy import stats
 
 import brdf
@@ -126,12 +125,9 @@ def real(args):
         spec, fab = measured_spec(name)
         r = fit(table, spec, FabricModel(fab, table.wi, table.wo), seed=0, progress=False,
                 max_steps=args.max_steps, time_limit=args.time_limit, out_dir=out_root / name)
-        lik = r.logpost.lik
-        med = np.median(r.chains_internal.reshape(-1, len(r.names)), axis=0)
-        res = lik.y - lik.transform(r.logpost.predict(med[None]))[0]
         kept = [a["step"] for a in r.timing["laplace_move"]["adaptations"] if a.get("kept")]
         print(f"{name} (from {d.preset}): {len(table)} pairs, {r.counts['used']} values; "
-              f"rms residual (log space) {np.sqrt(np.mean(res ** 2)):.3f}; "
+              f"rms residual (log space) {r.residuals()['rms']:.3f}; "
               f"{r.timing['wall_s']:.0f} s, {r.timing['evals_per_s']:.0f} evals/s; proposal "
               f"refits kept at {kept}; {r.reason}", flush=True)
         print("   " + ", ".join(f"{n}={r.summary[n]['median']:.4g}" for n in r.names))

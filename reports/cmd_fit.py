@@ -9,7 +9,6 @@ checkpoints ``DIR/chains_<k>.h5``; the same command run again resumes from them.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import brdf
@@ -139,22 +138,16 @@ def fit_and_write(table, fab, spec, out, *, plots: bool = True, **fit_kw):
         CIEDE2000 albedo difference.
     """
     from analysis.fit import FabricModel, fit, write_results
-    from gonio import atomic_write
     out = Path(out)
     model = FabricModel(fab, table.wi, table.wo)
     result = fit(table, spec, model, out_dir=out, **fit_kw)
-    jpath, _ = write_results(result, out)
-    doc = json.loads(jpath.read_text())
-    q = result.residuals()
-    doc["_fit"]["quality"] = {"rms_residual": q["rms"], "rms_normalized": q["rms_normalized"],
-                              "values": int(q["residual"].size)}
+    doc = result.to_json()
     if plots:
         from reports.fitplots import write_fit_plots
         extra = write_fit_plots(result, table, lambda wi, wo: FabricModel(fab, wi, wo), out)
         extra["plots"] = {k: Path(v).name for k, v in extra["plots"].items()}
         doc["_fit"]["report"] = extra
-    with atomic_write(jpath, "w") as fh:
-        fh.write(json.dumps(doc, indent=2) + "\n")
+    write_results(result, out, doc)
     return result, doc
 
 

@@ -214,10 +214,9 @@ def albedo_colours(table, prediction):
     -------
     measured, predicted : ndarray (3,)
     """
+    from analysis.likelihood import is_grey
     prediction = np.asarray(prediction, dtype=np.float64)
-    v = np.asarray(table.values, dtype=np.float64)
-    if np.array_equal(v[:, 0], v[:, 1], equal_nan=True) and \
-            np.array_equal(v[:, 0], v[:, 2], equal_nan=True):
+    if is_grey(table.values):
         prediction = np.repeat(prediction.mean(axis=-1, keepdims=True), 3, axis=-1)
     valid = table.valid & np.isfinite(prediction)
     cos_o = np.clip(table.wo[:, 2], 0, None)[:, None]

@@ -11,8 +11,9 @@ Pipeline (:func:`fit`):
 3. ``ensembles`` independent emcee ensembles (different seeds), each with ``walkers`` walkers,
    a vectorized log-probability, moves: an independence Metropolis-Hastings step from a
    Student-t fitted to the Laplace approximation (:class:`LaplaceMove`, share ``laplace_move``,
-   default 0.75, scaled down when the proposal is poor), refit early in the run to each
-   ensemble's own chain as a mixture of Student-t components, mixed with DEMove (0.8 of the
+   default 0.75, scaled down when the proposal is poor), refit at doubling steps to each
+   ensemble's own chain as a mixture of Student-t components in coordinates warped per
+   parameter towards a normal marginal (:func:`choose_warps`), mixed with DEMove (0.8 of the
    rest) and DESnookerMove (0.2), and an HDF5
    checkpoint ``DIR/chains_<k>.h5``. The ensembles run in lock-step threads whose model
    evaluations are stacked into one batch (:class:`LockStep`), split over ``threads`` worker
@@ -51,13 +52,96 @@ from analysis import diagnostics
 from analysis.likelihood import Likelihood
 from analysis.params import ParamSpec
 
-__all__ = ["fit", "FitResult", "LogPosterior", "LockStep", "FabricModel", "point_estimate",
-           "write_results", "CONFIG_FILE"]
+__all__ = ["fit", "FitResult", "LogPosterior", "LockStep", "FabricModel", "LaplaceMove",
+           "point_estimate", "write_results", "choose_warps", "warp", "unwarp", "WARPS",
+           "MIXTURE_COMPONENTS", "CONFIG_FILE"]
 
 CONFIG_FILE = "fit_config.json"
 
 #: Numbers of mixture components tried when the independence proposal is refit to a chain.
-MIXTURE_COMPONENTS = (1, 2, 4)
+MIXTURE_COMPONENTS = (1, 2, 4, 8)
+
+#: Maps of one internal coordinate u = logit(q) into the proposal's space: the identity,
+#: log q and -log(1 - q) (see :func:`choose_warps`).
+WARPS = ("logit", "log", "log1m")
+
+
+def warp(u, warps) -> tuple[np.ndarray, np.ndarray]:
+    r"""Internal coordinates u (n, d) -> proposal coordinates v (n, d) and log |dv/du| (n,).
+
+    Per coordinate, by ``warps[i]`` (an index into :data:`WARPS`): 0 keeps v = u = logit q;
+    1 gives v = log q = -softplus(-u), with dv/du = 1 - q; 2 gives v = -log(1 - q) =
+    softplus(u), with dv/du = q. The log warp pulls a long tail towards the lower bound
+    (q -> 0) in, the log1m one a tail towards the upper bound.
+
+    Examples
+    --------
+    >>> v, lj = warp(np.array([[0.0, 0.0, 0.0]]), [0, 1, 2])
+    >>> np.round(v, 6).tolist(), round(float(lj[0]), 6)     # log 1/2, 2 log 1/2
+    ([[0.0, -0.693147, 0.693147]], -1.386294)
+    """
+    u = np.atleast_2d(np.asarray(u, dtype=np.float64))
+    k = np.asarray(warps)
+    v = u.copy()
+    lj = np.zeros(u.shape[0])
+    m = k == 1
+    if m.any():
+        v[:, m] = -np.logaddexp(0.0, -u[:, m])
+        lj -= np.logaddexp(0.0, u[:, m]).sum(axis=1)
+    m = k == 2
+    if m.any():
+        v[:, m] = np.logaddexp(0.0, u[:, m])
+        lj -= np.logaddexp(0.0, -u[:, m]).sum(axis=1)
+    return v, lj
+
+
+def unwarp(v, warps) -> np.ndarray:
+    """Inverse of :func:`warp`: proposal coordinates v (n, d) -> internal u (n, d); rows that
+    lie outside the image of the map (v >= 0 for log, v <= 0 for log1m) are NaN."""
+    v = np.atleast_2d(np.asarray(v, dtype=np.float64))
+    k = np.asarray(warps)
+    u = v.copy()
+    bad = np.zeros(v.shape[0], dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        m = k == 1
+        if m.any():
+            bad |= np.any(~(v[:, m] < 0), axis=1)
+            u[:, m] = v[:, m] - np.log(-np.expm1(v[:, m]))
+        m = k == 2
+        if m.any():
+            bad |= np.any(~(v[:, m] > 0), axis=1)
+            u[:, m] = v[:, m] + np.log(-np.expm1(-v[:, m]))
+    bad |= ~np.all(np.isfinite(u), axis=1)
+    u[bad] = np.nan
+    return u
+
+
+def choose_warps(x) -> np.ndarray:
+    r"""Per coordinate of samples x (n, d), the map of :data:`WARPS` under which the marginal
+    is most nearly Gaussian: the largest profile log-likelihood of a normal fitted to v,
+    :math:`-\tfrac{n}{2}\log \widehat{\mathrm{var}}(v) + \sum \log |dv/du|` (Box and Cox's
+    criterion). Returns an int array (d,).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> q = np.exp(rng.normal(-3.0, 0.5, (4000, 1)))         # log-normal, near q = 0
+    >>> u = np.log(q) - np.log1p(-q)
+    >>> choose_warps(np.concatenate([u, -u, rng.normal(size=(4000, 1))], axis=1)).tolist()
+    [1, 2, 0]
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=np.float64))
+    n, d = x.shape
+    out = np.zeros(d, dtype=int)
+    for i in range(d):
+        best = -np.inf
+        for k in range(len(WARPS)):
+            v, lj = warp(x[:, i:i + 1], [k])
+            var = float(np.var(v))
+            ll = -0.5 * n * np.log(var) + lj.sum() if var > 0 else -np.inf
+            if ll > best:
+                best, out[i] = ll, k
+    return out
 
 
 # ---------------------------------------------------------------------------- forward model
@@ -154,7 +238,10 @@ class LaplaceMove(emcee.moves.MHMove):
     .. math:: q(x) = \sum_k w_k\, t_{df}(x;\ \mu_k,\ s^2 \Sigma_k)
 
     does not depend on the current position and is fixed while it is used, so the move keeps
-    the posterior invariant with the Hastings factor log q(x) - log q(x'). One component is
+    the posterior invariant with the Hastings factor log q(x) - log q(x'). The components live
+    in warped coordinates v = w(x) (:func:`warp`, per coordinate the identity, log q or
+    -log(1 - q)), so that q(x) = q_v(w(x)) |dw/dx|; a draw outside the image of w is a
+    proposal of zero target density and is rejected. One component is
     the Laplace approximation at the point estimate; :meth:`from_samples` fits several
     (Gaussian-mixture EM on chain samples), which follows the skewed and curved posteriors of
     real measurements (parameters against a bound, brightness traded against k_d) far better
@@ -172,9 +259,13 @@ class LaplaceMove(emcee.moves.MHMove):
         Factor s on every component's standard deviations.
     weights : array_like, shape (K,), optional
         Mixture weights (default equal).
+    warps : array_like of int, shape (d,), optional
+        The map of each coordinate (:data:`WARPS`; default all 0, the identity); ``mean`` and
+        ``cov`` are in the warped coordinates.
     """
 
-    def __init__(self, mean, cov, df: float = 5.0, scale: float = 1.2, weights=None):
+    def __init__(self, mean, cov, df: float = 5.0, scale: float = 1.2, weights=None,
+                 warps=None):
         means = np.atleast_2d(np.asarray(mean, dtype=np.float64))
         covs = np.asarray(cov, dtype=np.float64)
         covs = covs[None] if covs.ndim == 2 else covs
@@ -184,6 +275,8 @@ class LaplaceMove(emcee.moves.MHMove):
                              f"{means.shape[1]}); got {covs.shape}")
         w = np.full(k, 1.0 / k) if weights is None else np.asarray(weights, dtype=np.float64)
         self.df = float(df)
+        self.warps = (np.zeros(means.shape[1], dtype=int) if warps is None
+                      else np.asarray(warps, dtype=int))
         self._set(means, np.linalg.cholesky(covs * scale ** 2), w / w.sum())
         super().__init__(self._propose, ndim=means.shape[1])
 
@@ -194,6 +287,7 @@ class LaplaceMove(emcee.moves.MHMove):
     def copy_from(self, other: "LaplaceMove"):
         """Take over another proposal's components (the move object itself stays in place)."""
         self.df = other.df
+        self.warps = other.warps
         self._set(other.means, other.chols, other.weights)
 
     @property
@@ -202,22 +296,25 @@ class LaplaceMove(emcee.moves.MHMove):
 
     @classmethod
     def from_samples(cls, x, components: int, rng, *, ridge=None, df: float = 5.0,
-                     scale: float = 1.2, iters: int = 60) -> "LaplaceMove | None":
+                     scale: float = 1.2, iters: int = 60, warps=None) -> "LaplaceMove | None":
         """Fit ``components`` components to samples x (n, d) by Gaussian-mixture EM.
 
-        Seeds by k-means++ from ``rng``; ``ridge`` (d,) is added to every covariance's
-        diagonal. Components left with fewer than 2 d samples' weight are dropped. Returns
-        None when the samples are too few (< 5 d per component) or degenerate.
+        The fit is made in the coordinates ``warp(x, warps)`` (default the identity). Seeds by
+        k-means++ from ``rng``; ``ridge`` (d,) is added to every covariance's diagonal.
+        Components left with fewer than 2 d samples' weight are dropped. Returns None when the
+        samples are too few (< 5 d per component) or degenerate.
         """
         x = np.asarray(x, dtype=np.float64)
         n, d = x.shape
+        warps = np.zeros(d, dtype=int) if warps is None else np.asarray(warps, dtype=int)
+        x = warp(x, warps)[0]
         if n < 5 * d * components:
             return None
         ridge = np.zeros(d) if ridge is None else np.asarray(ridge, dtype=np.float64)
         cov0 = np.cov(x.T).reshape(d, d) + np.diag(ridge)
         if components == 1:
             try:
-                return cls(x.mean(axis=0), cov0, df=df, scale=scale)
+                return cls(x.mean(axis=0), cov0, df=df, scale=scale, warps=warps)
             except np.linalg.LinAlgError:
                 return None
         # k-means++ seeds in the whitened space
@@ -252,22 +349,23 @@ class LaplaceMove(emcee.moves.MHMove):
                            - 0.5 * (zz * zz).sum(axis=0))
             resp = np.exp(logp - scipy.special.logsumexp(logp, axis=0))
         try:
-            return cls(mu, covs, df=df, scale=scale, weights=w)
+            return cls(mu, covs, df=df, scale=scale, weights=w, warps=warps)
         except np.linalg.LinAlgError:
             return None
 
     def logq(self, x) -> np.ndarray:
-        """log q(x) up to a constant, x (n, d)."""
-        x = np.atleast_2d(x)
+        """log q(x) up to a constant, x (n, d) in internal coordinates."""
+        x, logjac = warp(x, self.warps)
         out = np.empty((self.n_components, x.shape[0]))
         for j in range(self.n_components):
             z = scipy.linalg.solve_triangular(self.chols[j], (x - self.means[j]).T, lower=True)
             out[j] = self._logw[j] - 0.5 * (self.df + x.shape[1]) * np.log1p(
                 (z * z).sum(axis=0) / self.df)
-        return scipy.special.logsumexp(out, axis=0)
+        return scipy.special.logsumexp(out, axis=0) + logjac
 
     def sample(self, n: int, random) -> np.ndarray:
-        """n draws from q; ``random`` a NumPy Generator or RandomState."""
+        """n draws from q in internal coordinates, (n, d); ``random`` a NumPy Generator or
+        RandomState. Draws outside the image of the warp are rows of NaN."""
         d = self.means.shape[1]
         if self.n_components == 1:
             comp = np.zeros(n, dtype=int)
@@ -276,11 +374,15 @@ class LaplaceMove(emcee.moves.MHMove):
         z = random.standard_normal((n, d))
         z = np.einsum("nij,nj->ni", self.chols[comp], z)
         w = random.chisquare(self.df, n) / self.df
-        return self.means[comp] + z / np.sqrt(w)[:, None]
+        return unwarp(self.means[comp] + z / np.sqrt(w)[:, None], self.warps)
 
     def _propose(self, x0, random):
         x1 = self.sample(x0.shape[0], random)
-        return x1, self.logq(x0) - self.logq(x1)
+        bad = np.isnan(x1[:, 0])
+        x1[bad] = x0[bad]                 # a proposal outside the support: rejected
+        factor = self.logq(x0) - self.logq(x1)
+        factor[bad] = -np.inf
+        return x1, factor
 
 
 class _Aborted(Exception):
@@ -477,25 +579,43 @@ def _hessian_cov(logpost: LogPosterior, x: np.ndarray, h: np.ndarray):
     return cov
 
 
-def _proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256) -> float:
-    """Importance-sampling ESS fraction of the independence proposal: (sum w)^2 / (n sum w^2)
-    with w = p(x) / q(x) for n draws x ~ q; 1 for a perfect proposal, near 0 for a poor one."""
-    x = move.sample(n, rng)
-    lw = logpost(x) - move.logq(x)
+def _proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256, chain=None,
+                      chain_logp=None) -> float:
+    """How good the independence proposal q is, from n draws y ~ q and w = p / q.
+
+    Without ``chain``: the importance-sampling ESS fraction (sum w)^2 / (n sum w^2), 1 for a
+    perfect proposal, near 0 for a poor one. With ``chain`` (m, d), samples of the posterior,
+    and ``chain_logp`` (m,), their log-posterior: the move's expected acceptance rate at
+    stationarity, the mean over pairs of min(1, w(y) / w(x)), x from the chain. This also sees
+    what the ESS misses: posterior regions that q under-covers, where a walker would stick.
+    Draws outside the proposal's support count as rejected (w = 0)."""
+    y = move.sample(n, rng)
+    ok = ~np.isnan(y[:, 0])
+    lw = np.full(n, -np.inf)
+    if ok.any():
+        with np.errstate(invalid="ignore"):
+            lw[ok] = logpost(y[ok]) - move.logq(y[ok])
+    lw = np.where(np.isfinite(lw), lw, -np.inf)
     if not np.any(np.isfinite(lw)):
         return 0.0
-    w = np.exp(lw - np.max(lw[np.isfinite(lw)]))
-    w = np.where(np.isfinite(w), w, 0.0)
+    if chain is not None:
+        lwx = np.asarray(chain_logp, dtype=np.float64) - move.logq(chain)
+        lwx = lwx[np.isfinite(lwx)]
+        if lwx.size == 0:
+            return 0.0
+        return float(np.mean(np.exp(np.minimum(0.0, lw[None, :] - lwx[:, None]))))
+    w = np.exp(lw - np.max(lw))
     return float(w.sum() ** 2 / (n * (w * w).sum()))
 
 
-def _laplace_share(logpost, move: "LaplaceMove", laplace_move: float, rng):
-    """Share of the independence move: ``laplace_move`` scaled by its importance-sampling ESS
-    fraction (full share from 0.2 up, at least 0.05), and that fraction.
+def _laplace_share(logpost, move: "LaplaceMove", laplace_move: float, rng, chain=None,
+                   chain_logp=None):
+    """Share of the independence move: ``laplace_move`` scaled by its quality
+    (:func:`_proposal_quality`; full share from 0.2 up, at least 0.05), and that quality.
 
     A poor approximation (non-Gaussian posterior, parameters at bounds) would waste the move's
     evaluations, so it gets little."""
-    frac = _proposal_quality(logpost, move, rng)
+    frac = _proposal_quality(logpost, move, rng, chain=chain, chain_logp=chain_logp)
     share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
     return max(share, 0.05), frac
 
@@ -698,10 +818,11 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     adapt : int, optional
         First of the steps ``adapt``, ``2 adapt``, ``4 adapt``, ... (doubling, below
         ``max_steps``) at which each ensemble may refit its independence proposal to the
-        second half of its own chain so far, as a mixture of 1, 2 or 4 Student-t components
-        (:data:`MIXTURE_COMPONENTS`, the one with the largest importance-sampling ESS; default
-        ``2 * check_every``; 0 for never). A refit is kept only when it raises the proposal's
-        importance-sampling ESS by more than 10%. The burn-in is at least the step of the last
+        second half of its own chain so far, as a mixture of 1, 2, 4 or 8 Student-t
+        components (:data:`MIXTURE_COMPONENTS`) in coordinates warped per parameter
+        (:func:`choose_warps`), fitted to half the walkers; the one with the largest expected
+        acceptance rate on the other half is taken (default ``2 * check_every``; 0 for never).
+        A refit is kept only when it raises that rate by more than 10%. The burn-in is at least the step of the last
         kept refit, up to half the chain; every kernel used leaves the posterior invariant and
         each depends only on the chain before it, and the number of refits is finite.
     out_dir : path, optional
@@ -758,7 +879,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     logpost = LogPosterior(spec, lik, model)
 
     config = {
-        "version": 4, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
+        "version": 5, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
         "ensembles": ensembles, "walkers": walkers, "seed": seed,
         "table": _table_digest(table), "n_used": lik.n_used,
         "laplace_move": laplace_move, "adapt": adapt,
@@ -849,38 +970,46 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
 
     def adapt_moves(k, a):
         """Refit ensemble k's independence proposal at step ``a`` to its own chain over steps
-        a/2 to a; kept only if it is clearly better than the current one. Deterministic given
-        the stored chain, so a resumed fit repeats every decision exactly."""
+        a/2 to a: warps chosen and mixtures of :data:`MIXTURE_COMPONENTS` components fitted to
+        the even-numbered walkers, judged by the expected acceptance rate on the odd-numbered
+        ones; kept only if clearly better than the current one. Deterministic given the stored
+        chain, so a resumed fit repeats every decision exactly."""
         s = samplers[k]
-        x = s.get_chain()[a // 2:a].reshape(-1, ndim)
+        chain = s.get_chain()[a // 2:a]
+        lps = s.get_log_prob()[a // 2:a]
+        x = chain[:, 0::2].reshape(-1, ndim)
+        xt, lpt = chain[:, 1::2].reshape(-1, ndim), lps[:, 1::2].reshape(-1)
+        pick = np.random.default_rng([seed, k, a, 1]).permutation(len(xt))[:1024]
+        xt, lpt = xt[pick], lpt[pick]
+        warps = choose_warps(x)
         move, frac, sh, comps = None, -np.inf, 0.0, 0
         for K in MIXTURE_COMPONENTS:
             cand = LaplaceMove.from_samples(x, K, np.random.default_rng([seed, k, a, K]),
-                                            ridge=(1e-9 * spec.width) ** 2)
+                                            ridge=(1e-9 * spec.width) ** 2, warps=warps)
             if cand is None:
                 continue
             c_sh, c_frac = _laplace_share(logpost, cand, laplace_move,
-                                          np.random.default_rng([seed, k, a]))
+                                          np.random.default_rng([seed, k, a]), xt, lpt)
             if np.isfinite(c_frac) and c_frac > frac:
                 move, frac, sh, comps = cand, c_frac, c_sh, cand.n_components
         lm = laplace_moves[k]
         if move is None:
             return {"step": a, "kept": False}
         _, frac_now = _laplace_share(logpost, lm, laplace_move,
-                                     np.random.default_rng([seed, k, a]))
+                                     np.random.default_rng([seed, k, a]), xt, lpt)
         s_weights = np.array(s._weights, dtype=np.float64)
         if not (np.isfinite(frac) and (not np.isfinite(frac_now) or frac > 1.1 * frac_now
                                        or s_weights[-1] == 0)):
-            return {"step": a, "kept": False, "importance_ess_fraction": frac,
-                    "current": frac_now}
+            return {"step": a, "kept": False, "acceptance": frac, "current": frac_now}
         lm.copy_from(move)
         w = s_weights
         w[:-1] = w[:-1] / max(w[:-1].sum(), 1e-300) * (1 - sh)
         w[-1] = sh
         s._weights = w / w.sum()
         last_adapt[k] = a
-        return {"step": a, "kept": True, "share": sh, "importance_ess_fraction": frac,
-                "components": comps, "previous": frac_now}
+        return {"step": a, "kept": True, "share": sh, "acceptance": frac,
+                "components": comps, "warps": [WARPS[i] for i in warps],
+                "previous": frac_now}
 
     lock = LockStep(logpost, ensembles, threads=threads)
     samplers = []

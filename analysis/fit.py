@@ -819,10 +819,11 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         First of the steps ``adapt``, ``2 adapt``, ``4 adapt``, ... (doubling, below
         ``max_steps``) at which each ensemble may refit its independence proposal to the
         second half of its own chain so far, as a mixture of 1, 2, 4 or 8 Student-t
-        components (:data:`MIXTURE_COMPONENTS`) in coordinates warped per parameter
-        (:func:`choose_warps`), fitted to half the walkers; the one with the largest expected
-        acceptance rate on the other half is taken (default ``2 * check_every``; 0 for never).
-        A refit is kept only when it raises that rate by more than 10%. The burn-in is at least the step of the last
+        components (:data:`MIXTURE_COMPONENTS`), in internal coordinates and in coordinates
+        warped per parameter (:func:`choose_warps`), fitted to half the walkers; the one
+        with the largest mean log density on the other half is taken (default
+        ``2 * check_every``; 0 for never). A refit is kept only when it raises the expected
+        acceptance rate of the move on that half by more than 10%. The burn-in is at least the step of the last
         kept refit, up to half the chain; every kernel used leaves the posterior invariant and
         each depends only on the chain before it, and the number of refits is finite.
     out_dir : path, optional
@@ -879,7 +880,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     logpost = LogPosterior(spec, lik, model)
 
     config = {
-        "version": 5, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
+        "version": 6, "spec": spec.describe(), "likelihood": likelihood, "nu": nu,
         "ensembles": ensembles, "walkers": walkers, "seed": seed,
         "table": _table_digest(table), "n_used": lik.n_used,
         "laplace_move": laplace_move, "adapt": adapt,
@@ -970,31 +971,37 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
 
     def adapt_moves(k, a):
         """Refit ensemble k's independence proposal at step ``a`` to its own chain over steps
-        a/2 to a: warps chosen and mixtures of :data:`MIXTURE_COMPONENTS` components fitted to
-        the even-numbered walkers, judged by the expected acceptance rate on the odd-numbered
-        ones; kept only if clearly better than the current one. Deterministic given the stored
-        chain, so a resumed fit repeats every decision exactly."""
+        a/2 to a: mixtures of :data:`MIXTURE_COMPONENTS` components, in internal and in warped
+        coordinates (:func:`choose_warps`), fitted to the even-numbered walkers; the one with
+        the largest mean log q on the odd-numbered ones (held out) is compared with the current
+        proposal by their expected acceptance rates there and kept if clearly better.
+        Deterministic given the stored chain, so a resumed fit repeats every decision
+        exactly."""
         s = samplers[k]
         chain = s.get_chain()[a // 2:a]
         lps = s.get_log_prob()[a // 2:a]
         x = chain[:, 0::2].reshape(-1, ndim)
         xt, lpt = chain[:, 1::2].reshape(-1, ndim), lps[:, 1::2].reshape(-1)
-        pick = np.random.default_rng([seed, k, a, 1]).permutation(len(xt))[:1024]
+        pick = np.random.default_rng([seed, k, a, 1]).permutation(len(xt))[:2048]
         xt, lpt = xt[pick], lpt[pick]
-        warps = choose_warps(x)
-        move, frac, sh, comps = None, -np.inf, 0.0, 0
-        for K in MIXTURE_COMPONENTS:
-            cand = LaplaceMove.from_samples(x, K, np.random.default_rng([seed, k, a, K]),
-                                            ridge=(1e-9 * spec.width) ** 2, warps=warps)
-            if cand is None:
-                continue
-            c_sh, c_frac = _laplace_share(logpost, cand, laplace_move,
-                                          np.random.default_rng([seed, k, a]), xt, lpt)
-            if np.isfinite(c_frac) and c_frac > frac:
-                move, frac, sh, comps = cand, c_frac, c_sh, cand.n_components
+        x = x[np.random.default_rng([seed, k, a, 2]).permutation(len(x))[:16384]]
+        move, score = None, -np.inf
+        chosen = choose_warps(x)
+        for warps in [np.zeros(ndim, dtype=int)] + ([chosen] if chosen.any() else []):
+            for K in MIXTURE_COMPONENTS:
+                cand = LaplaceMove.from_samples(x, K, np.random.default_rng([seed, k, a, K]),
+                                                ridge=(1e-9 * spec.width) ** 2, warps=warps)
+                if cand is None:
+                    continue
+                with np.errstate(invalid="ignore"):
+                    sc = float(np.mean(cand.logq(xt)))
+                if np.isfinite(sc) and sc > score:
+                    move, score = cand, sc
         lm = laplace_moves[k]
         if move is None:
             return {"step": a, "kept": False}
+        sh, frac = _laplace_share(logpost, move, laplace_move,
+                                  np.random.default_rng([seed, k, a]), xt, lpt)
         _, frac_now = _laplace_share(logpost, lm, laplace_move,
                                      np.random.default_rng([seed, k, a]), xt, lpt)
         s_weights = np.array(s._weights, dtype=np.float64)
@@ -1008,7 +1015,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         s._weights = w / w.sum()
         last_adapt[k] = a
         return {"step": a, "kept": True, "share": sh, "acceptance": frac,
-                "components": comps, "warps": [WARPS[i] for i in warps],
+                "components": move.n_components, "warps": [WARPS[i] for i in move.warps],
                 "previous": frac_now}
 
     lock = LockStep(logpost, ensembles, threads=threads)

@@ -93,11 +93,7 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     spath = out / SUMMARY_FILE
-    try:
-        doc = json.loads(spath.read_text()) if spath.exists() else {}
-    except ValueError:
-        doc = {}
-    doc.setdefault("datasets", {})
+    doc = _read_summary(spath)
     for n in names:
         d = MEASURED[n]
         spec, fab = measured_spec(n)
@@ -116,6 +112,8 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
             "albedo_delta_e2000": res["_fit"].get("report", {}).get("albedo_delta_e2000"),
             "results": f"{n}/results.json",
         }
+        # read again: another fit-measured run may have added its datasets meanwhile
+        doc = _read_summary(spath)
         doc["datasets"][n] = entry
         with atomic_write(spath, "w") as fh:
             fh.write(json.dumps(doc, indent=2) + "\n")
@@ -124,6 +122,18 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
              f"{entry['quality']['rms_residual']:.3f}"
              + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
                 if entry["albedo_delta_e2000"] is not None else ""))
+    return doc
+
+
+def _read_summary(path: Path) -> dict:
+    """The summary document at ``path`` ({"datasets": {}} when missing or unreadable)."""
+    try:
+        doc = json.loads(path.read_text()) if path.exists() else {}
+    except ValueError:
+        doc = {}
+    if not isinstance(doc, dict):
+        doc = {}
+    doc.setdefault("datasets", {})
     return doc
 
 

@@ -76,3 +76,24 @@ def test_report_page_of_measured_fits(fitted, tmp_path):
     with pytest.raises(ValueError, match="measured.json: not found"):
         build_report(["velvet"], tmp_path / "rep2", sections=["parameters"], progress=False,
                      quality="fast", measured=tmp_path)
+
+
+def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeypatch):
+    """Two fit-measured runs into one folder: the one that finishes last must not drop the
+    entry the other wrote while it was fitting."""
+    import reports.cmd_fit
+    from reports.cmd_measured import fit_measured
+    real = reports.cmd_fit.fit_and_write
+
+    def fit_and_other_run_finishing(*a, **kw):
+        out = real(*a, **kw)
+        (tmp_path / "measured.json").write_text(json.dumps(
+            {"datasets": {"curet_07_velvet": {"converged": True, "steps": 1}}}))
+        return out
+
+    monkeypatch.setattr(reports.cmd_fit, "fit_and_write", fit_and_other_run_finishing)
+    doc = fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, max_steps=20,
+                       plots=False, progress=False, echo=lambda *_: None)
+    on_disk = json.loads((tmp_path / "measured.json").read_text())
+    assert set(on_disk["datasets"]) == set(doc["datasets"]) == {"curet_07_velvet",
+                                                               "curet_44_linen"}

@@ -73,7 +73,9 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     Returns
     -------
     dict
-        The ``measured.json`` document: ``{"datasets": {name: {...}}}``.
+        The ``measured.json`` document: ``{"datasets": {name: {...}}}``; each entry's
+        ``wall_s`` is the time of the run that wrote it (a resumed fit counts only its last
+        run, a finished one only the re-summary).
 
     Raises
     ------
@@ -118,7 +120,7 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
         with atomic_write(spath, "w") as fh:
             fh.write(json.dumps(doc, indent=2) + "\n")
         echo(f"{n}: {'converged' if result.converged else 'NOT converged'} after "
-             f"{result.steps} steps ({entry['wall_s']:.0f} s); residual rms "
+             f"{result.steps} steps (this run {entry['wall_s']:.0f} s); residual rms "
              f"{entry['quality']['rms_residual']:.3f}"
              + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
                 if entry["albedo_delta_e2000"] is not None else ""))

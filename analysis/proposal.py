@@ -261,15 +261,32 @@ class LaplaceMove(emcee.moves.MHMove):
 
 
 def proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256, chain=None,
-                      chain_logp=None) -> float:
-    """How good the independence proposal q is, from n draws y ~ q and w = p / q.
+                     chain_logp=None) -> float:
+    r"""How good the independence proposal q is, from n draws y ~ q and w = p / q.
 
-    Without ``chain``: the importance-sampling ESS fraction (sum w)^2 / (n sum w^2), 1 for a
-    perfect proposal, near 0 for a poor one. With ``chain`` (m, d), samples of the posterior,
-    and ``chain_logp`` (m,), their log-posterior: the move's expected acceptance rate at
-    stationarity, the mean over pairs of min(1, w(y) / w(x)), x from the chain. This also sees
-    what the ESS misses: posterior regions that q under-covers, where a walker would stick.
-    Draws outside the proposal's support count as rejected (w = 0)."""
+    Parameters
+    ----------
+    logpost : callable
+        Vectorized log-posterior, internal coordinates (n, d) -> (n,).
+    move : LaplaceMove
+        The proposal.
+    rng : numpy.random.Generator
+        Source of the draws.
+    n : int
+        Number of draws (each costs one log-posterior evaluation).
+    chain, chain_logp : array_like, optional
+        Posterior samples (m, d) and their log-posterior values (m,).
+
+    Returns
+    -------
+    float
+        Without ``chain``: the importance-sampling ESS fraction
+        :math:`(\sum w)^2 / (n \sum w^2)`, 1 for a perfect proposal, near 0 for a poor one.
+        With ``chain``: the move's expected acceptance rate at stationarity,
+        :math:`\mathrm{mean}_{x, y} \min(1, w(y) / w(x))` over the chain's x and the draws y.
+        This also sees what the ESS misses: posterior regions that q under-covers, where a
+        walker would stick. Draws outside the proposal's support count as rejected (w = 0).
+    """
     y = move.sample(n, rng)
     ok = ~np.isnan(y[:, 0])
     lw = np.full(n, -np.inf)
@@ -290,12 +307,18 @@ def proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256, chain=None
 
 
 def proposal_share(logpost, move: "LaplaceMove", laplace_move: float, rng, chain=None,
-                   chain_logp=None):
-    """Share of the independence move: ``laplace_move`` scaled by its quality
-    (:func:`proposal_quality`; full share from 0.2 up, at least 0.05), and that quality.
+                   chain_logp=None) -> tuple[float, float]:
+    """Share of the independence move among the moves, and the proposal's quality.
 
     A poor approximation (non-Gaussian posterior, parameters at bounds) would waste the move's
-    evaluations, so it gets little."""
+    evaluations, so it gets little: the share is ``laplace_move`` scaled by the quality of
+    :func:`proposal_quality` (same parameters) over 0.2, at most ``laplace_move`` and at least
+    0.05.
+
+    Returns
+    -------
+    share, quality : float
+    """
     frac = proposal_quality(logpost, move, rng, chain=chain, chain_logp=chain_logp)
     share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
     return max(share, 0.05), frac

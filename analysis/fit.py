@@ -540,9 +540,10 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         warped per parameter (:func:`choose_warps`), fitted to half the walkers; the one
         with the largest mean log density on the other half is taken (default
         ``2 * check_every``; 0 for never). A refit is kept only when it raises the expected
-        acceptance rate of the move on that half by more than 10%. The burn-in is at least the step of the last
-        kept refit, up to half the chain; every kernel used leaves the posterior invariant and
-        each depends only on the chain before it, and the number of refits is finite.
+        acceptance rate of the move on that half by more than 10%. The burn-in is at least the
+        step of the last kept refit, up to half the chain; every kernel used leaves the
+        posterior invariant and each depends only on the chain before it, and the number of
+        refits is finite.
     out_dir : path, optional
         Folder for ``fit_config.json`` and the checkpoints ``chains_<k>.h5``; resumes there.
     time_limit : float, optional
@@ -695,8 +696,9 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         Deterministic given the stored chain, so a resumed fit repeats every decision
         exactly."""
         s = samplers[k]
-        chain = s.get_chain()[a // 2:a]
-        lps = s.get_log_prob()[a // 2:a]
+        # read only steps a/2 to a from the checkpoint (a resumed fit replays early refits)
+        chain = s.get_chain(discard=a // 2)[:a - a // 2]
+        lps = s.get_log_prob(discard=a // 2)[:a - a // 2]
         x = chain[:, 0::2].reshape(-1, ndim)
         xt, lpt = chain[:, 1::2].reshape(-1, ndim), lps[:, 1::2].reshape(-1)
         pick = np.random.default_rng([seed, k, a, 1]).permutation(len(xt))[:2048]

@@ -95,7 +95,6 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     spath = out / SUMMARY_FILE
-    doc = _read_summary(spath)
     for n in names:
         d = MEASURED[n]
         spec, fab = measured_spec(n)
@@ -114,7 +113,7 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
             "albedo_delta_e2000": res["_fit"].get("report", {}).get("albedo_delta_e2000"),
             "results": f"{n}/results.json",
         }
-        # read again: another fit-measured run may have added its datasets meanwhile
+        # read just before writing: another fit-measured run may have added its datasets
         doc = _read_summary(spath)
         doc["datasets"][n] = entry
         with atomic_write(spath, "w") as fh:

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from analysis.likelihood import is_grey
+
 __all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "albedo_colours",
            "albedo_delta_e", "posterior_draws", "write_fit_plots"]
 
@@ -214,7 +216,6 @@ def albedo_colours(table, prediction):
     -------
     measured, predicted : ndarray (3,)
     """
-    from analysis.likelihood import is_grey
     prediction = np.asarray(prediction, dtype=np.float64)
     if is_grey(table.values):
         prediction = np.repeat(prediction.mean(axis=-1, keepdims=True), 3, axis=-1)

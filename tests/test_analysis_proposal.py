@@ -84,6 +84,7 @@ def test_warped_mixture_move_leaves_the_target_invariant():
     import emcee
     from analysis.proposal import LaplaceMove
     from scipy.special import betaln, expit
+    from scipy.stats import beta
     a1, b1, a2, b2 = 2.0, 30.0, 30.0, 2.0
 
     def logp(u):   # u = logit(q), q1 ~ Beta(2, 30), q2 ~ Beta(30, 2): density q^a (1-q)^b
@@ -102,7 +103,7 @@ def test_warped_mixture_move_leaves_the_target_invariant():
     # 80,000 draws with an autocorrelation of a few steps; Beta means 1/16 and 15/16 with a
     # standard deviation of 0.042: the standard error of each mean is below 5e-4
     np.testing.assert_allclose(q.mean(axis=0), [a1 / (a1 + b1), a2 / (a2 + b2)], atol=2e-3)
-    assert abs(np.mean(q[:, 0] < 0.05) - __import__("scipy").stats.beta.cdf(0.05, a1, b1)) < 0.02
+    assert abs(np.mean(q[:, 0] < 0.05) - beta.cdf(0.05, a1, b1)) < 0.02
 
 
 def test_proposal_quality_is_the_expected_acceptance():

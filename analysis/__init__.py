@@ -6,7 +6,7 @@ from analysis.energy import VARIANTS, EnergyReport, energy_report, white_furnace
 from analysis.reciprocity import ReciprocityResult, reciprocity, reciprocity_report
 from analysis.sanity import SanityResult, sanity_scan
 from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rhat
-from analysis.fit import FabricModel, FitResult, LogPosterior, fit, write_results
+from analysis.fit import FabricModel, FitResult, LogPosterior, fit_fabric, write_results
 from analysis.likelihood import Likelihood
 from analysis.measured import MEASURED, MeasuredDataset, load_measured, measured_spec
 from analysis.params import (DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec,
@@ -18,6 +18,6 @@ __all__ += ["albedo", "albedo_curve", "albedo_hemispherical", "AlbedoResult", "A
             "reciprocity", "reciprocity_report", "ReciprocityResult", "sanity_scan",
             "SanityResult"]
 __all__ += ["ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
-            "Likelihood", "fit", "FitResult", "FabricModel", "LogPosterior", "write_results",
+            "Likelihood", "fit_fabric", "FitResult", "FabricModel", "LogPosterior", "write_results",
             "autocorr_time", "split_rhat", "ess", "interval_summary",
             "MEASURED", "MeasuredDataset", "load_measured", "measured_spec"]

@@ -36,12 +36,20 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import json
 import os
+import time
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir"]
+from gonio import atomic_write
+
+__all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir",
+           "fit_measured", "SUMMARY_FILE"]
+
+#: The summary written beside the per-dataset folders by :func:`fit_measured`.
+SUMMARY_FILE = "measured.json"
 
 _SHARED_FREE = ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1")
 _SHARED_TIES = ("eta2=eta1", "kd2=kd1", "gamma_s2=gamma_s1", "gamma_v2=gamma_v1",
@@ -193,3 +201,96 @@ def measured_spec(name, fab=None):
     d = _dataset(name)
     fab = fab if fab is not None else brdf.fabric(d.preset)
     return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties), fab
+
+
+def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
+                 max_steps: int = 20000, time_limit: float | None = None,
+                 rgl_step: float = 15.0, plots=None, progress: bool = True,
+                 echo=None) -> dict:
+    """Fit measured datasets; write ``out_dir/NAME/`` and ``out_dir/measured.json``.
+
+    Parameters
+    ----------
+    names : sequence of str, optional
+        Keys of :data:`analysis.measured.MEASURED` (default all).
+    out_dir : path
+        Output folder; existing fits there are resumed.
+    data_dir : path, optional
+        The measured-data folder (default :func:`analysis.measured.default_data_dir`).
+    seed, max_steps, time_limit
+        Passed to :func:`analysis.fit.fit` (time limit per dataset, seconds).
+    rgl_step : float
+        Outgoing step for sampling the RGL files, degrees.
+    plots : callable, optional
+        Draws each fit's plots (see :func:`analysis.fit.fit_fabric`).
+    progress : bool
+        A progress bar per fit.
+    echo : callable, optional
+        Called with one line per finished dataset.
+
+    Returns
+    -------
+    dict
+        The ``measured.json`` document: ``{"datasets": {name: {...}}}``; each entry's
+        ``wall_s`` is the time of the run that wrote it (a resumed fit counts only its last
+        run, a finished one only the re-summary).
+
+    Raises
+    ------
+    ValueError
+        An unknown dataset name (before any fit).
+    FileNotFoundError
+        A missing data file (before any fit).
+    """
+    from analysis.fit import fit_fabric
+    names = list(names) if names else list(MEASURED)
+    bad = [n for n in names if n not in MEASURED]
+    if bad:
+        raise ValueError(f"unknown measured dataset {bad[0]!r}; valid: {', '.join(MEASURED)}")
+    tables = {n: load_measured(n, data_dir, rgl_step=rgl_step) for n in names}
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    spath = out / SUMMARY_FILE
+    for n in names:
+        d = MEASURED[n]
+        spec, fab = measured_spec(n)
+        t0 = time.perf_counter()
+        result = fit_fabric(
+            tables[n], fab, spec, out / n, plots=plots, seed=seed, max_steps=max_steps,
+            time_limit=time_limit, progress=progress,
+            config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
+        entry = {
+            "title": d.title, "preset": d.preset, "source": str(tables[n].meta.get("source", "")),
+            "pairs": len(tables[n]), "values_used": result.counts["used"],
+            "free": list(result.names), "ties": list(d.ties),
+            "converged": bool(result.converged), "reason": result.reason,
+            "steps": result.steps, "wall_s": round(time.perf_counter() - t0, 2),
+            "quality": result.quality,
+            "albedo_delta_e2000": result.quality.get("albedo_delta_e2000"),
+            "results": f"{n}/results.json",
+        }
+        # read just before writing: another fit-measured run may have added its datasets
+        doc = _read_summary(spath)
+        doc["datasets"][n] = entry
+        with atomic_write(spath, "w") as fh:
+            fh.write(json.dumps(doc, indent=2) + "\n")
+        if echo is None:
+            continue
+        echo(f"{n}: {'converged' if result.converged else 'NOT converged'} after "
+             f"{result.steps} steps (this run {entry['wall_s']:.0f} s); residual rms "
+             f"{entry['quality']['rms_residual']:.3f}"
+             + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
+                if entry["albedo_delta_e2000"] is not None else ""))
+    return doc
+
+
+def _read_summary(path: Path) -> dict:
+    """The summary document at ``path`` ({"datasets": {}} when missing or unreadable)."""
+    try:
+        doc = json.loads(path.read_text()) if path.exists() else {}
+    except ValueError:
+        doc = {}
+    if not isinstance(doc, dict):
+        doc = {}
+    doc.setdefault("datasets", {})
+    return doc

@@ -14,7 +14,7 @@ from pathlib import Path
 import brdf
 from reports import cliutil
 
-__all__ = ["register", "run", "read_table", "fit_and_write", "format_summary"]
+__all__ = ["register", "run", "read_table", "format_summary"]
 
 
 def read_table(path, sample=None):
@@ -88,6 +88,8 @@ def _spec_from_args(args, fab):
 
 
 def run(args) -> int:
+    """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
+    from analysis.fit import fit_fabric
     if args.fabric not in brdf.PRESETS:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")
@@ -95,60 +97,23 @@ def run(args) -> int:
     spec = _spec_from_args(args, fab)
     out = cliutil.check_writable_dir(Path(args.output))
     table = read_table(args.table, args.sample)
-    result, doc = fit_and_write(
-        table, fab, spec, out, plots=not args.no_plots,
-        likelihood=args.likelihood, nu=args.nu, ensembles=args.ensembles,
-        walkers=args.walkers, seed=args.seed, max_steps=args.max_steps,
-        check_every=args.check_every, time_limit=args.time_limit,
+    plots = None
+    if not args.no_plots:
+        from reports.fitplots import write_fit_plots as plots
+    result = fit_fabric(
+        table, fab, spec, out, plots=plots, likelihood=args.likelihood, nu=args.nu,
+        ensembles=args.ensembles, walkers=args.walkers, seed=args.seed,
+        max_steps=args.max_steps, check_every=args.check_every, time_limit=args.time_limit,
         progress=not args.no_progress,
         config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
     print(format_summary(result))
-    q = doc["_fit"]["quality"]
+    q = result.quality
     print(f"residuals at the posterior median: rms {q['rms_residual']:.4f} in the "
           f"likelihood's space, {q['rms_normalized']:.2f} in units of the noise")
-    if not args.no_plots:
-        print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "
-              f"{doc['_fit']['report']['albedo_delta_e2000']:.2f}; plots in {out}")
+    print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "
+          f"{q['albedo_delta_e2000']:.2f}" + ("" if args.no_plots else f"; plots in {out}"))
     print(f"results: {out / 'results.json'}")
     return 0
-
-
-def fit_and_write(table, fab, spec, out, *, plots: bool = True, **fit_kw):
-    """Fit ``table`` (:func:`analysis.fit.fit`), write ``results.json``/``.csv`` and the plots.
-
-    Parameters
-    ----------
-    table : gonio.Table
-    fab : brdf.Fabric
-        The fabric whose parameters the spec fixes (and whose geometry is evaluated).
-    spec : analysis.params.ParamSpec
-    out : path
-        Output folder (checkpoints, results, plots); a rerun resumes there.
-    plots : bool
-        Write corner, trace, lobe and residual plots (and the albedo colour difference).
-    **fit_kw
-        Passed to :func:`analysis.fit.fit`.
-
-    Returns
-    -------
-    result : FitResult
-    doc : dict
-        The ``results.json`` document; ``doc["_fit"]["quality"]`` holds the residual rms
-        (likelihood space and normalized), ``doc["_fit"]["report"]`` the plots and the
-        CIEDE2000 albedo difference.
-    """
-    from analysis.fit import FabricModel, fit, write_results
-    out = Path(out)
-    model = FabricModel(fab, table.wi, table.wo)
-    result = fit(table, spec, model, out_dir=out, **fit_kw)
-    doc = result.to_json()
-    if plots:
-        from reports.fitplots import write_fit_plots
-        extra = write_fit_plots(result, table, lambda wi, wo: FabricModel(fab, wi, wo), out)
-        extra["plots"] = {k: Path(v).name for k, v in extra["plots"].items()}
-        doc["_fit"]["report"] = extra
-    write_results(result, out, doc)
-    return result, doc
 
 
 def format_summary(result) -> str:

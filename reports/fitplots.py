@@ -1,5 +1,5 @@
-r"""Plots of a Bayesian fit: corner, traces, posterior-predictive lobes, residual maps, and the
-CIEDE2000 colour difference between predicted and measured albedo.
+r"""Plots of a Bayesian fit: corner, traces, posterior-predictive lobes, residual maps (the
+fit's quality figures themselves are computed in :mod:`analysis.fit.quality`).
 
 Every function takes ``ax=`` (or ``fig=`` for the corner plot), returns ``(fig, ax)``, saves only
 when given ``filename`` and never calls ``show()``.
@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.likelihood import is_grey
 
-__all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "albedo_colours",
-           "albedo_delta_e", "posterior_draws", "write_fit_plots"]
+__all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "posterior_draws",
+           "write_fit_plots"]
 
 
 def _plt():
@@ -23,8 +22,13 @@ def _plt():
 
 
 def _save(fig, filename):
+    """Save whole or not at all (gonio.atomic_write), in the format of the file's suffix."""
     if filename is not None:
-        fig.savefig(filename, dpi=110, bbox_inches="tight")
+        from pathlib import Path
+        from gonio import atomic_write
+        with atomic_write(filename, "wb") as fh:
+            fig.savefig(fh, format=Path(filename).suffix[1:] or "png", dpi=110,
+                        bbox_inches="tight")
 
 
 def corner_plot(result, truths=None, fig=None, filename=None):
@@ -32,7 +36,7 @@ def corner_plot(result, truths=None, fig=None, filename=None):
 
     Parameters
     ----------
-    result : analysis.fit.FitResult
+    result : analysis.fit.results.FitResult
     truths : mapping name -> value, optional
         Drawn as lines (e.g. the simulation's parameters).
     """
@@ -202,57 +206,17 @@ def residual_map(result, table, prediction, ax=None, filename=None):
     return fig, ax
 
 
-def albedo_colours(table, prediction):
-    r"""Albedo colours (linear RGB) of the table and of a prediction, by the same estimator.
-
-    rho = 2 pi mean over valid points of f_r cos(theta_o): the uniform-hemisphere Monte Carlo
-    estimate of the directional albedo averaged over the table's incidences; the prediction uses
-    the same points and mask, so the two are comparable whatever the sampling.
-
-    A grey table (R = G = B everywhere: CUReT) is compared with the grey of the prediction,
-    the mean of its channels, as the grey value was measured.
-
-    Returns
-    -------
-    measured, predicted : ndarray (3,)
-    """
-    prediction = np.asarray(prediction, dtype=np.float64)
-    if is_grey(table.values):
-        prediction = np.repeat(prediction.mean(axis=-1, keepdims=True), 3, axis=-1)
-    valid = table.valid & np.isfinite(prediction)
-    cos_o = np.clip(table.wo[:, 2], 0, None)[:, None]
-    meas = np.where(valid, table.values, 0.0) * cos_o
-    pred = np.where(valid, prediction, 0.0) * cos_o
-    cnt = np.maximum(valid.sum(0), 1)
-    return 2 * np.pi * meas.sum(0) / cnt, 2 * np.pi * pred.sum(0) / cnt
-
-
-def albedo_delta_e(measured, predicted) -> float:
-    """CIEDE2000 difference between two linear-sRGB colours (colour-science).
-
-    Examples
-    --------
-    >>> albedo_delta_e([0.2, 0.2, 0.2], [0.2, 0.2, 0.2])
-    0.0
-    >>> albedo_delta_e([0.2, 0.1, 0.05], [0.2, 0.2, 0.2]) > 5
-    True
-    """
-    import colour
-    labs = [colour.XYZ_to_Lab(colour.sRGB_to_XYZ(np.clip(np.asarray(c, float), 0, None),
-                                                 apply_cctf_decoding=False))
-            for c in (measured, predicted)]
-    return float(colour.delta_E(labs[0], labs[1], method="CIE 2000"))
-
-
 def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
-    """Write corner.png, traces.png, lobes.png, residuals.png into ``out_dir``; return the
-    albedo colours and their CIEDE2000 difference (JSON-ready)."""
+    """Write corner.png, traces.png, lobes.png, residuals.png into ``out_dir``.
+
+    The signature :func:`analysis.fit.fit_fabric` expects of its ``plots``; returns
+    ``{name: path}``.
+    """
     from pathlib import Path
     plt = _plt()
     out = Path(out_dir)
     files = {}
-    med = np.median(result.chains_internal.reshape(-1, len(result.names)), axis=0)
-    pred = _predict_at(result, model_factory, table.wi, table.wo, med[None])[0]
+    pred = _predict_at(result, model_factory, table.wi, table.wo, result.median_internal()[None])[0]
     for name, call in (
             ("corner.png", lambda f: corner_plot(result, truths=truths, filename=f)),
             ("traces.png", lambda f: trace_plot(result, filename=f)),
@@ -261,6 +225,4 @@ def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
         fig, _ = call(out / name)
         plt.close(fig)
         files[name[:-4]] = str(out / name)
-    meas, prd = albedo_colours(table, pred)
-    return {"plots": files, "albedo_measured": meas.tolist(), "albedo_predicted": prd.tolist(),
-            "albedo_delta_e2000": albedo_delta_e(meas, prd)}
+    return files

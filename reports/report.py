@@ -489,15 +489,14 @@ def _sec_fit(p: _Page) -> str:
     if results is None:
         raise Unavailable("no fitting results for this fabric (run `microcyl fit` and pass its "
                           "results.json)")
+    from analysis.fit.results import read_results
     try:
-        data = json.loads(Path(results).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise Unavailable(f"cannot read {results}: {exc}") from None
-    rows = []
-    for k, v in data.items():
-        if isinstance(v, dict) and "median" in v:
-            rows.append([k] + [_fmt(v.get(f)) for f in ("median", "lo68", "hi68", "lo95",
-                                                         "hi95", "tau", "rhat", "ess")])
+        data = read_results(results)
+    except ValueError as exc:
+        raise Unavailable(str(exc)) from None
+    rows = [[k] + [_fmt(v.get(f)) for f in ("median", "lo68", "hi68", "lo95", "hi95", "tau",
+                                            "rhat", "ess")]
+            for k, v in data["parameters"].items()]
     p.summary["fit"] = data
     verdict = data.get("converged")
     return (_table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat", "ESS"],

@@ -41,6 +41,7 @@ def read_measured(folder) -> dict:
     ValueError
         The folder holds no readable ``measured.json`` (the message names it).
     """
+    from analysis.fit.results import read_results
     folder = Path(folder)
     path = folder / "measured.json"
     try:
@@ -55,10 +56,7 @@ def read_measured(folder) -> dict:
     for name, entry in datasets.items():
         e = dict(entry)
         rpath = folder / e.get("results", f"{name}/results.json")
-        try:
-            e["results"] = json.loads(rpath.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise ValueError(f"{rpath}: unreadable ({exc})") from None
+        e["results"] = read_results(rpath)
         e["folder"] = rpath.parent
         out[name] = e
     return out
@@ -113,9 +111,9 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             'levels).</p>', overview_table(measured)]
     summary = {}
     for name, e in measured.items():
-        res = e["results"]
-        fit = res.get("_fit", {})
-        params = [k for k, v in res.items() if isinstance(v, dict) and "median" in v]
+        doc = e["results"]
+        res = doc.get("parameters", {})
+        params = list(res)
         rows = [[k, _f(res[k]["median"]), f"[{_f(res[k]['lo68'])}, {_f(res[k]['hi68'])}]",
                  f"[{_f(res[k]['lo95'])}, {_f(res[k]['hi95'])}]", res[k].get("unit", ""),
                  _f(res[k].get("tau"), ".1f"), _f(res[k].get("rhat"), ".4f"),
@@ -123,7 +121,7 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         dest = root / folder / name
         dest.mkdir(parents=True, exist_ok=True)
         figs = []
-        plots = fit.get("report", {}).get("plots", {})
+        plots = doc.get("plots", {})
         for key, caption in PLOTS.items():
             src = plots.get(key)
             if src is None:

@@ -47,12 +47,13 @@ def test_fit_writes_results_and_plots(table_file, tmp_path, capsys):
             "--no-progress", "-o", str(out)]
     assert main(args) == 0
     doc = json.loads((out / "results.json").read_text())
-    assert set(doc) >= {"gamma_s1", "kd1", "converged"}
+    par = doc["parameters"]
+    assert set(par) == {"gamma_s1", "kd1"} and isinstance(doc["converged"], bool)
     for k in ("median", "lo68", "hi68", "lo95", "hi95", "tau", "rhat", "ess"):
-        assert np.isfinite(doc["kd1"][k])
-    assert doc["gamma_s1"]["lo95"] < 5.0 < doc["gamma_s1"]["hi95"]
-    rep = doc["_fit"]["report"]
-    assert rep["albedo_delta_e2000"] < 2.0          # same model, 5% noise: barely visible
+        assert np.isfinite(par["kd1"][k])
+    assert par["gamma_s1"]["lo95"] < 5.0 < par["gamma_s1"]["hi95"]
+    assert doc["quality"]["albedo_delta_e2000"] < 2.0   # same model, 5% noise: barely visible
+    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals"}
     for name in ("corner", "traces", "lobes", "residuals"):
         assert (out / f"{name}.png").stat().st_size > 1000
     assert (out / "results.csv").exists()

@@ -51,11 +51,14 @@ def test_fit_measured_writes_results_and_summary(fitted):
     assert e["preset"] == "linen_plain" and e["values_used"] == 205    # grey: once per point
     assert not e["converged"] and "step limit 60" in e["reason"]
     res = json.loads((out / "curet_44_linen" / "results.json").read_text())
-    assert set(res) >= {"eta1", "kd1", "gamma_s1", "gamma_v1", "area1", "scale", "log_noise"}
-    q = res["_fit"]["quality"]
+    assert res["schema"] == "microcyl-fit" and res["schema_version"] == 2
+    assert set(res["parameters"]) >= {"eta1", "kd1", "gamma_s1", "gamma_v1", "area1", "scale",
+                                      "log_noise"}
+    q = res["quality"]
+    assert q == e["quality"] and q["albedo_delta_e2000"] == e["albedo_delta_e2000"]
     # the fitted noise explains the residuals: normalized rms near 1, raw rms near exp(noise)
     assert 0.7 < q["rms_normalized"] < 1.3
-    assert q["rms_residual"] == pytest.approx(np.exp(res["log_noise"]["median"]), rel=0.3)
+    assert q["rms_residual"] == pytest.approx(np.exp(res["parameters"]["log_noise"]["median"]), rel=0.3)
     for name in ("lobes", "residuals", "corner", "traces"):
         assert (out / "curet_44_linen" / f"{name}.png").stat().st_size > 1000
 
@@ -81,9 +84,9 @@ def test_report_page_of_measured_fits(fitted, tmp_path):
 def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeypatch):
     """Two fit-measured runs into one folder: the one that finishes last must not drop the
     entry the other wrote while it was fitting."""
-    import reports.cmd_fit
-    from reports.cmd_measured import fit_measured
-    real = reports.cmd_fit.fit_and_write
+    import analysis.fit
+    from analysis.measured import fit_measured
+    real = analysis.fit.fit_fabric
 
     def fit_and_other_run_finishing(*a, **kw):
         out = real(*a, **kw)
@@ -91,9 +94,9 @@ def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeyp
             {"datasets": {"curet_07_velvet": {"converged": True, "steps": 1}}}))
         return out
 
-    monkeypatch.setattr(reports.cmd_fit, "fit_and_write", fit_and_other_run_finishing)
+    monkeypatch.setattr(analysis.fit, "fit_fabric", fit_and_other_run_finishing)
     doc = fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, max_steps=20,
-                       plots=False, progress=False, echo=lambda *_: None)
+                       plots=None, progress=False)
     on_disk = json.loads((tmp_path / "measured.json").read_text())
     assert set(on_disk["datasets"]) == set(doc["datasets"]) == {"curet_07_velvet",
                                                                "curet_44_linen"}

@@ -1,4 +1,4 @@
-"""Tests of analysis.proposal: the mixture independence proposal and its warps."""
+"""Tests of analysis.fit.proposal: the mixture independence proposal and its warps."""
 
 import numpy as np
 
@@ -13,7 +13,7 @@ def _two_blobs(n, rng):
 
 
 def test_mixture_proposal_finds_the_components():
-    from analysis.proposal import LaplaceMove
+    from analysis.fit.proposal import LaplaceMove
     x, k = _two_blobs(4000, np.random.default_rng(1))
     from scipy.stats import norm
     move = LaplaceMove.from_samples(x, 2, np.random.default_rng(2), df=1e6, scale=1.0)
@@ -36,7 +36,7 @@ def test_mixture_move_leaves_the_target_invariant():
     different widths) must still sample the target: the Hastings factor needs each
     component's normalization."""
     import emcee
-    from analysis.proposal import LaplaceMove
+    from analysis.fit.proposal import LaplaceMove
     from scipy.special import logsumexp
 
     def logp(x):
@@ -58,7 +58,7 @@ def test_mixture_move_leaves_the_target_invariant():
 
 
 def test_warp_round_trip_and_jacobian():
-    from analysis.proposal import warp, unwarp
+    from analysis.fit.proposal import warp, unwarp
     rng = np.random.default_rng(7)
     u = rng.normal(scale=4.0, size=(500, 3))
     kinds = [0, 1, 2]
@@ -82,7 +82,7 @@ def test_warped_mixture_move_leaves_the_target_invariant():
     off (centres, widths) and putting mass outside the warps' images: the chain must still
     sample the target, which needs the warp's Jacobian in log q(x)."""
     import emcee
-    from analysis.proposal import LaplaceMove
+    from analysis.fit.proposal import LaplaceMove
     from scipy.special import betaln, expit
     from scipy.stats import beta
     a1, b1, a2, b2 = 2.0, 30.0, 30.0, 2.0
@@ -111,7 +111,7 @@ def test_proposal_quality_is_the_expected_acceptance():
     independence MH at stationarity, E min(1, w(y) / w(x)) with x ~ p, y ~ q and w = p / q, by
     brute-force Monte Carlo here; the importance-sampling ESS fraction of N(0, 4) for N(0, 1)
     is sqrt(7) / 4 in closed form (E_q w^2 = 4 / sqrt(7))."""
-    from analysis.proposal import LaplaceMove, proposal_quality
+    from analysis.fit.proposal import LaplaceMove, proposal_quality
 
     def logp(x):
         return -0.5 * (np.asarray(x)[:, 0] ** 2)

@@ -5,7 +5,7 @@ mixture of multivariate Student-t components, first the Laplace approximation at
 estimate, later mixtures fitted to the chain (:meth:`LaplaceMove.from_samples`) in coordinates
 warped per parameter towards a normal marginal (:func:`warp`, :func:`choose_warps`).
 :func:`proposal_quality` and :func:`proposal_share` judge a proposal and give its share of the
-moves. Used by :func:`analysis.fit.fit`.
+moves. Used by :mod:`analysis.fit.moves`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ import scipy.linalg
 import scipy.special
 
 __all__ = ["LaplaceMove", "warp", "unwarp", "choose_warps", "proposal_quality",
-           "proposal_share", "WARPS", "MIXTURE_COMPONENTS"]
+           "proposal_share", "share_from_quality", "draw_log_weights", "ess_fraction",
+           "expected_acceptance", "WARPS", "MIXTURE_COMPONENTS"]
 
 
 #: Numbers of mixture components tried when the independence proposal is refit to a chain.
@@ -169,6 +170,23 @@ class LaplaceMove(emcee.moves.MHMove):
     def n_components(self) -> int:
         return self.means.shape[0]
 
+    def state(self) -> dict:
+        """The proposal as plain arrays (for checkpoints): means, chols, weights, warps, df."""
+        return {"means": self.means, "chols": self.chols, "weights": self.weights,
+                "warps": self.warps, "df": np.float64(self.df)}
+
+    @classmethod
+    def from_state(cls, state) -> "LaplaceMove":
+        """The proposal saved by :meth:`state`, bit for bit."""
+        move = cls.__new__(cls)
+        move.df = float(np.asarray(state["df"]))
+        move.warps = np.asarray(state["warps"], dtype=int)
+        move._set(np.asarray(state["means"], dtype=np.float64),
+                  np.asarray(state["chols"], dtype=np.float64),
+                  np.asarray(state["weights"], dtype=np.float64))
+        emcee.moves.MHMove.__init__(move, move._propose, ndim=move.means.shape[1])
+        return move
+
     @classmethod
     def from_samples(cls, x, components: int, rng, *, ridge=None, df: float = 5.0,
                      scale: float = 1.2, iters: int = 60, warps=None) -> "LaplaceMove | None":
@@ -287,23 +305,46 @@ def proposal_quality(logpost, move: "LaplaceMove", rng, n: int = 256, chain=None
         This also sees what the ESS misses: posterior regions that q under-covers, where a
         walker would stick. Draws outside the proposal's support count as rejected (w = 0).
     """
+    lw = draw_log_weights(logpost, move, rng, n)
+    if chain is not None:
+        return expected_acceptance(move, lw, chain, chain_logp)
+    return ess_fraction(lw)
+
+
+def draw_log_weights(logpost, move: "LaplaceMove", rng, n: int = 256) -> np.ndarray:
+    """log w = log p - log q (up to constants) of n draws y ~ q, -inf for draws outside the
+    proposal's support or of zero posterior density: (n,). Costs n log-posterior evaluations;
+    the result stays valid as long as the proposal does (it does not depend on the chain)."""
     y = move.sample(n, rng)
     ok = ~np.isnan(y[:, 0])
     lw = np.full(n, -np.inf)
     if ok.any():
         with np.errstate(invalid="ignore"):
             lw[ok] = logpost(y[ok]) - move.logq(y[ok])
-    lw = np.where(np.isfinite(lw), lw, -np.inf)
+    return np.where(np.isfinite(lw), lw, -np.inf)
+
+
+def ess_fraction(lw) -> float:
+    r"""Importance-sampling ESS fraction :math:`(\sum w)^2 / (n \sum w^2)` of log weights."""
+    lw = np.asarray(lw, dtype=np.float64)
     if not np.any(np.isfinite(lw)):
         return 0.0
-    if chain is not None:
-        lwx = np.asarray(chain_logp, dtype=np.float64) - move.logq(chain)
-        lwx = lwx[np.isfinite(lwx)]
-        if lwx.size == 0:
-            return 0.0
-        return float(np.mean(np.exp(np.minimum(0.0, lw[None, :] - lwx[:, None]))))
     w = np.exp(lw - np.max(lw))
-    return float(w.sum() ** 2 / (n * (w * w).sum()))
+    return float(w.sum() ** 2 / (lw.size * (w * w).sum()))
+
+
+def expected_acceptance(move: "LaplaceMove", lw_draws, chain, chain_logp) -> float:
+    r"""Expected acceptance of the independence move at stationarity,
+    :math:`\mathrm{mean}_{x, y} \min(1, w(y) / w(x))`, from the log weights of draws
+    (:func:`draw_log_weights`) and posterior samples x (m, d) with their log-posterior (m,)."""
+    lw = np.asarray(lw_draws, dtype=np.float64)
+    if not np.any(np.isfinite(lw)):
+        return 0.0
+    lwx = np.asarray(chain_logp, dtype=np.float64) - move.logq(chain)
+    lwx = lwx[np.isfinite(lwx)]
+    if lwx.size == 0:
+        return 0.0
+    return float(np.mean(np.exp(np.minimum(0.0, lw[None, :] - lwx[:, None]))))
 
 
 def proposal_share(logpost, move: "LaplaceMove", laplace_move: float, rng, chain=None,
@@ -320,5 +361,11 @@ def proposal_share(logpost, move: "LaplaceMove", laplace_move: float, rng, chain
     share, quality : float
     """
     frac = proposal_quality(logpost, move, rng, chain=chain, chain_logp=chain_logp)
+    return share_from_quality(frac, laplace_move), frac
+
+
+def share_from_quality(frac: float, laplace_move: float) -> float:
+    """The independence move's share for a proposal of quality ``frac``: ``laplace_move``
+    scaled by ``frac / 0.2``, within [0.05, ``laplace_move``]."""
     share = laplace_move * min(1.0, frac / 0.2) if np.isfinite(frac) else 0.0
-    return max(share, 0.05), frac
+    return max(share, 0.05)

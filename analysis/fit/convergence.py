@@ -1,0 +1,100 @@
+r"""When a fit has converged: tau, N / tau, the change of tau and split R-hat at each check.
+
+At a check the first ``burn_fraction`` of every chain is discarded (at least up to the last
+kept proposal refit, at most half); tau per ensemble (emcee, ``tol=0``) is averaged over the
+ensembles. The fit has converged when for every parameter (N - burn) / tau > ``min_ratio``,
+tau changed by less than ``tau_tol`` (relative) since the previous check, and split R-hat
+across ensembles is below ``rhat_max`` (:mod:`analysis.diagnostics`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from analysis import diagnostics
+
+__all__ = ["Criteria", "Diagnosis", "diagnose"]
+
+
+@dataclasses.dataclass(frozen=True)
+class Criteria:
+    """The convergence criteria (see the module notes)."""
+
+    min_ratio: float = 50.0
+    tau_tol: float = 0.05
+    rhat_max: float = 1.01
+    burn_fraction: float = 0.2
+
+
+@dataclasses.dataclass
+class Diagnosis:
+    """The state of the chains at one check.
+
+    Attributes
+    ----------
+    step : int
+        Steps every ensemble has made.
+    burn : int
+        Steps discarded.
+    chains : ndarray (ensembles, step - burn, walkers, ndim)
+    log_prob : ndarray (ensembles, step - burn, walkers)
+    taus : ndarray (ensembles, ndim)
+        tau of each ensemble, steps.
+    tau, rhat : ndarray (ndim,)
+        Mean tau over ensembles (steps) and split R-hat.
+    """
+
+    step: int
+    burn: int
+    chains: np.ndarray
+    log_prob: np.ndarray
+    taus: np.ndarray
+    tau: np.ndarray
+    rhat: np.ndarray
+
+    @property
+    def kept(self) -> int:
+        """Steps after the burn-in."""
+        return self.step - self.burn
+
+    @property
+    def ratio(self) -> np.ndarray:
+        """(N - burn) / tau per parameter."""
+        return self.kept / self.tau
+
+    def tau_change(self, tau_prev) -> float:
+        """Largest relative change of tau since ``tau_prev`` (inf without one)."""
+        if tau_prev is None:
+            return float("inf")
+        return float(np.max(np.abs(self.tau - np.asarray(tau_prev)) / self.tau))
+
+    def verdict(self, tau_prev, c: Criteria) -> tuple[bool, str]:
+        """Whether the criteria hold, and why (one line)."""
+        ratio, dtau = self.ratio, self.tau_change(tau_prev)
+        if (np.all(ratio > c.min_ratio) and dtau < c.tau_tol
+                and np.all(self.rhat < c.rhat_max)):
+            return True, (f"converged at step {self.step}: N/tau > {c.min_ratio:g} for every "
+                          f"parameter (min {ratio.min():.1f}), tau changed {100 * dtau:.1f}% "
+                          f"< {100 * c.tau_tol:g}% since the last check, R-hat < "
+                          f"{c.rhat_max:g}")
+        stuck = ("; tau undefined for some parameter (a walker did not move)"
+                 if np.any(~np.isfinite(self.tau)) else "")
+        return False, (f"min N/tau {np.nanmin(ratio):.1f} (need > {c.min_ratio:g}), tau change "
+                       f"{100 * dtau:.1f}% (need < {100 * c.tau_tol:g}%), max R-hat "
+                       f"{np.nanmax(self.rhat):.3f} (need < {c.rhat_max:g}){stuck}")
+
+
+def diagnose(chains, burn_fraction: float, last_refit: int = 0) -> Diagnosis:
+    """Diagnose :class:`~analysis.fit.ensemble.Chain` objects at their common step count.
+
+    The burn-in is ``max(burn_fraction N, min(last_refit, N / 2))`` steps.
+    """
+    n = min(c.steps for c in chains)
+    burn = max(int(burn_fraction * n), min(last_refit, n // 2))
+    x = np.stack([c.chain(burn, n) for c in chains])             # (m, steps, w, d)
+    lp = np.stack([c.log_prob(burn, n) for c in chains])
+    taus = np.stack([diagnostics.autocorr_time(c) for c in x])
+    return Diagnosis(step=n, burn=burn, chains=x, log_prob=lp, taus=taus,
+                     tau=taus.mean(axis=0), rhat=diagnostics.split_rhat(x))

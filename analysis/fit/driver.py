@@ -1,0 +1,249 @@
+"""``fit``: options checked up front, point estimate, sampling, the result.
+
+BLAS is held to one thread for the whole fit (threadpoolctl): the fit's own threads already
+use the cores, and a multi-threaded BLAS inside each of them (the proposal's triangular solves,
+the EM fits) fights them for the cores.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import os
+import time
+from typing import Callable, Mapping
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from analysis.fit.checkpoint import FitFolder, table_digest
+from analysis.fit.convergence import Criteria
+from analysis.fit.optimize import optimize_start
+from analysis.fit.posterior import LogPosterior
+from analysis.fit.results import FitResult, summarize
+from analysis.fit.sampler import FitSampler
+from analysis.likelihood import Likelihood
+from analysis.params import ParamSpec
+
+__all__ = ["fit", "FitOptions", "CONFIG_VERSION"]
+
+#: Version of the sampler's configuration; a folder fitted by another version is refused.
+CONFIG_VERSION = 7
+
+
+@dataclasses.dataclass(frozen=True)
+class FitOptions:
+    """Options of :func:`fit` (see its parameters); :meth:`resolve` checks and completes them."""
+
+    likelihood: str = "gaussian"
+    nu: float = 4.0
+    ensembles: int = 4
+    walkers: int | None = None
+    seed: int = 0
+    max_steps: int = 20000
+    check_every: int = 50
+    criteria: Criteria = Criteria()
+    n_starts: int = 4
+    laplace_move: float = 0.75
+    adapt: int | None = None
+    threads: int | None = None
+    time_limit: float | None = None
+
+    def resolve(self, ndim: int) -> "FitOptions":
+        """Defaults filled in for ``ndim`` free parameters; a ValueError naming the first bad
+        option otherwise."""
+        walkers = self.walkers
+        if walkers is None:
+            walkers = 2 * ndim + 2
+            walkers += walkers % 2
+        adapt = self.adapt
+        if adapt is None:
+            adapt = 2 * self.check_every if self.laplace_move > 0 else 0
+        checks = [
+            (self.ensembles >= 2, f"ensembles must be >= 2 (R-hat is computed across them); "
+                                  f"got {self.ensembles}"),
+            (walkers >= 2 * ndim, f"walkers must be >= 2 x ndim = {2 * ndim}; got {walkers}"),
+            (self.max_steps >= 1, f"max_steps must be >= 1; got {self.max_steps}"),
+            (self.check_every >= 1, f"check_every must be >= 1; got {self.check_every}"),
+            (0 <= self.laplace_move <= 1, f"laplace_move must be in [0, 1]; got "
+                                          f"{self.laplace_move}"),
+            (adapt >= 0 and not (adapt and self.laplace_move <= 0),
+             f"adapt must be >= 0, and 0 when laplace_move is 0; got {adapt}"),
+            (self.n_starts >= 1, f"n_starts must be >= 1; got {self.n_starts}"),
+            (self.time_limit is None or self.time_limit > 0,
+             f"time_limit must be > 0 seconds; got {self.time_limit}"),
+            (self.threads is None or self.threads >= 1,
+             f"threads must be >= 1; got {self.threads}"),
+        ]
+        for ok, message in checks:
+            if not ok:
+                raise ValueError(message)
+        return dataclasses.replace(self, walkers=walkers, adapt=adapt,
+                                   threads=self.threads or min(2, os.cpu_count() or 1))
+
+    def config(self, spec: ParamSpec, table, lik: Likelihood, extra=None) -> dict:
+        """What a checkpoint must match to be resumed (everything that changes the chains)."""
+        return {"version": CONFIG_VERSION, "spec": spec.describe(),
+                "likelihood": self.likelihood, "nu": self.nu, "ensembles": self.ensembles,
+                "walkers": self.walkers, "seed": self.seed, "table": table_digest(table),
+                "n_used": lik.n_used, "laplace_move": self.laplace_move, "adapt": self.adapt,
+                "check_every": self.check_every,
+                **({"extra": dict(extra)} if extra else {})}
+
+
+def _with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
+    """``spec`` plus ``log_noise`` when the table has no sigma and ``scale`` for relative
+    data, unless already free."""
+    extra = []
+    if not lik.has_sigma and "log_noise" not in spec.free:
+        extra.append("log_noise")
+    if lik.relative_data and "scale" not in spec.free:
+        extra.append("scale")
+    if not extra:
+        return spec
+    return ParamSpec(list(spec.free) + extra,
+                     defaults={n: p.default for n, p in spec.params.items()}, ties=spec.ties,
+                     bounds={n: (p.lo, p.hi) for n, p in spec.params.items()},
+                     priors={n: p.prior for n, p in spec.params.items()})
+
+
+def _check_points(lik: Likelihood, ndim: int):
+    if lik.n_used <= ndim:
+        c = lik.counts
+        raise ValueError(
+            f"table has {lik.n_used} valid values for {ndim} free parameters (need more than "
+            f"{ndim}); masked: {c['invalid_value']} NaN/negative, {c['below_horizon']} below "
+            f"the horizon, {c['bad_sigma']} with bad sigma, {c['zero_value']} zero")
+
+
+@contextlib.contextmanager
+def _progress(progress, total: int, initial: int):
+    """(tick, postfix) callables for the sampler: a tqdm bar when ``progress`` is True, the
+    caller's ``progress(steps)`` when it is callable, nothing when False."""
+    if callable(progress):
+        yield progress, None
+        return
+    if not progress:
+        yield None, None
+        return
+    from tqdm.auto import tqdm
+    bar = tqdm(total=total, initial=initial, desc="emcee", unit="step", leave=False)
+
+    def tick(steps):
+        bar.n = steps
+        bar.refresh()
+    try:
+        yield tick, (lambda d: bar.set_postfix(d, refresh=True))
+    finally:
+        bar.close()
+
+
+def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian",
+        nu: float = 4.0, ensembles: int = 4, walkers: int | None = None, seed: int = 0,
+        max_steps: int = 20000, check_every: int = 50, min_ratio: float = 50.0,
+        tau_tol: float = 0.05, rhat_max: float = 1.01, burn_fraction: float = 0.2,
+        n_starts: int = 4, laplace_move: float = 0.75, adapt: int | None = None,
+        threads: int | None = None, out_dir=None, time_limit: float | None = None,
+        progress: bool | Callable = True, config_extra: Mapping | None = None) -> FitResult:
+    """Fit the free parameters of ``spec`` to ``table``; see :mod:`analysis.fit`.
+
+    Parameters
+    ----------
+    table : gonio.Table-like
+        The measurements (f_r in 1/sr, or relative when its meta says so).
+    spec : ParamSpec
+        Free, fixed and tied parameters. ``log_noise`` is added to the free set when the table
+        has no sigma; ``scale`` when the table's meta says its values are relative.
+    model : callable
+        ``model(**kwargs) -> (B, n, 3)`` f_r (1/sr) at the table's pairs, e.g.
+        :class:`~analysis.fit.posterior.FabricModel`.
+    likelihood : {"gaussian", "relative", "student-t"}
+    ensembles : int
+        Independent ensembles (>= 2 for R-hat).
+    walkers : int, optional
+        Walkers per ensemble (>= 2 x ndim; default 2 x ndim + 2, even).
+    seed : int
+        Seeds the optimizer starts and every ensemble (via SeedSequence).
+    max_steps : int
+        Step limit per ensemble.
+    check_every : int
+        Steps between convergence checks, which are also the checkpoints.
+    min_ratio, tau_tol, rhat_max, burn_fraction : float
+        Convergence criteria (:mod:`analysis.fit.convergence`).
+    laplace_move : float
+        Largest share of the independence move (0 turns it off).
+    adapt : int, optional
+        First refit point of the independence proposal (then doubling; default
+        ``2 * check_every``, 0 for never; :func:`analysis.fit.moves.refit`).
+    threads : int, optional
+        Threads sharing each batched evaluation (default min(2, cores)).
+    out_dir : path, optional
+        Folder of ``fit_config.json`` and ``checkpoint.h5``; a fit resumes there.
+    time_limit : float, optional
+        Seconds after which sampling stops (checked at each convergence check).
+    progress : bool or callable
+        A tqdm bar (True), none (False), or ``progress(steps)`` called about every 0.25 s.
+    config_extra : mapping, optional
+        Also recorded in (and matched against) the stored configuration.
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    ValueError
+        Too few valid values for the free parameters, bad options, a checkpoint made with
+        another configuration, or a corrupt checkpoint: all before sampling starts.
+    FitInterrupted
+        On Ctrl-C during sampling, after checkpointing the steps done (a KeyboardInterrupt).
+    """
+    t0 = time.perf_counter()
+    opts = FitOptions(likelihood=likelihood, nu=nu, ensembles=ensembles, walkers=walkers,
+                      seed=seed, max_steps=max_steps, check_every=check_every,
+                      criteria=Criteria(min_ratio, tau_tol, rhat_max, burn_fraction),
+                      n_starts=n_starts, laplace_move=laplace_move, adapt=adapt,
+                      threads=threads, time_limit=time_limit)
+    lik = Likelihood(table, kind=likelihood, nu=nu)
+    spec = _with_nuisance(spec, lik)
+    _check_points(lik, spec.ndim)
+    opts = opts.resolve(spec.ndim)
+    logpost = LogPosterior(spec, lik, model)
+    config = opts.config(spec, table, lik, config_extra)
+    folder = None if out_dir is None else FitFolder(out_dir)
+    start = None if folder is None else folder.read_start(config)
+    ckpt = None if start is None else folder.read_checkpoint()
+    rng_opt, *rngs = [np.random.default_rng(s)
+                      for s in np.random.SeedSequence(seed).spawn(ensembles + 1)]
+    with threadpool_limits(limits=1, user_api="blas"):
+        if start is None:
+            best, best_logp, cov = optimize_start(logpost, n_starts, rng_opt)
+            if folder is not None:
+                folder.write_start(config, best, best_logp, cov)
+        else:
+            best, best_logp, cov = start["best"], start["best_logp"], start["cov"]
+        t_opt = time.perf_counter() - t0
+        sampler = FitSampler(logpost, opts, best, cov, rngs, ckpt)
+        with _progress(progress, max_steps, sampler.steps) as (tick, postfix):
+            out = sampler.run(folder, tick, t0, postfix)
+    return _result(spec, lik, logpost, opts, sampler, out, best, best_logp,
+                   {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt})
+
+
+def _result(spec, lik, logpost, opts, sampler, out, best, best_logp, timing) -> FitResult:
+    diag = out.diagnosis
+    summary = summarize(spec, diag)
+    ess_min = min(s["ess"] for s in summary.values())
+    timing.update(sample_s=out.sample_s, log_prob_evals=int(out.evals),
+                  refit_evals=int(out.refit_evals),
+                  evals_per_s=out.evals / out.sample_s if out.sample_s > 0 else float("nan"),
+                  ess_per_s=ess_min / out.sample_s if out.sample_s > 0 else float("nan"))
+    return FitResult(
+        names=spec.free, units=spec.units, chains=spec.to_natural(diag.chains),
+        chains_internal=diag.chains, log_prob=diag.log_prob, summary=summary,
+        converged=out.converged, reason=out.reason, steps=diag.step, burn=diag.burn,
+        walkers=opts.walkers, ensembles=opts.ensembles,
+        acceptance=[float(np.mean(c.acceptance_fraction)) for c in sampler.chains],
+        best=dict(zip(spec.free, spec.to_natural(best).tolist())), best_logp=best_logp,
+        counts=dict(lik.counts), timing=timing, proposal=sampler.proposal_info, spec=spec,
+        logpost=logpost)

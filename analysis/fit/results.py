@@ -1,0 +1,197 @@
+"""What a fit produced (:class:`FitResult`) and its files: ``results.json`` and ``results.csv``.
+
+``results.json`` (schema ``microcyl-fit``, version :data:`SCHEMA_VERSION`)::
+
+    {"schema": "microcyl-fit", "schema_version": 2,
+     "converged": true, "reason": "converged at step 350: ...",
+     "parameters": {"kd1": {"median": ..., "lo68": ..., "hi68": ..., "lo95": ..., "hi95": ...,
+                            "tau": ..., "n_over_tau": ..., "rhat": ..., "ess": ...,
+                            "unit": "1"}, ...},
+     "fit": {"steps", "burn", "walkers", "ensembles", "acceptance_fraction", "map",
+             "map_log_posterior", "points", "ties", "timing", "proposal"},
+     "quality": {"rms_residual", "rms_normalized", "values", and with the table:
+                 "albedo_measured", "albedo_predicted", "albedo_delta_e2000"},
+     "plots": {"corner": "corner.png", ...}}
+
+Intervals are central (68%: 15.9-84.1 percentiles), in each parameter's natural unit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+
+from analysis import diagnostics
+from analysis.fit.checkpoint import json_plain
+from analysis.fit.quality import residuals
+from gonio import atomic_write
+
+__all__ = ["FitResult", "write_results", "read_results", "summarize", "SCHEMA_VERSION", "SUMMARY_COLUMNS"]
+
+#: Version of the ``results.json`` layout.
+SCHEMA_VERSION = 2
+#: Columns of each parameter's summary (and of ``results.csv``).
+SUMMARY_COLUMNS = ("median", "lo68", "hi68", "lo95", "hi95", "tau", "n_over_tau", "rhat",
+                   "ess", "unit")
+
+
+@dataclasses.dataclass
+class FitResult:
+    """Everything a fit produced.
+
+    Attributes
+    ----------
+    names, units : tuple of str
+        Free parameters, in order, and their units.
+    chains : ndarray (ensembles, steps, walkers, ndim)
+        Post-burn-in samples in natural units.
+    chains_internal : ndarray
+        The same in the sampler's internal coordinates.
+    log_prob : ndarray (ensembles, steps, walkers)
+    summary : dict name -> dict
+        :data:`SUMMARY_COLUMNS` per parameter.
+    converged : bool
+    reason : str
+        Why sampling stopped (criterion met, step limit, time limit).
+    steps, burn : int
+        Steps per ensemble, and those discarded.
+    best : dict
+        Point estimate (natural units); ``best_logp`` its log-posterior.
+    counts : dict
+        Values used and masked (:attr:`analysis.likelihood.Likelihood.counts`).
+    timing : dict
+        Seconds and evaluation counts.
+    proposal : dict
+        The independence proposal's initial share and every refit decision.
+    quality : dict
+        Residuals at the posterior median and, when the workflow had the table, the albedo
+        colours and their CIEDE2000 difference (:mod:`analysis.fit.quality`).
+    plots : dict
+        Plot names -> file names, when plots were written.
+    """
+
+    names: tuple
+    units: tuple
+    chains: np.ndarray
+    chains_internal: np.ndarray
+    log_prob: np.ndarray
+    summary: dict
+    converged: bool
+    reason: str
+    steps: int
+    burn: int
+    walkers: int
+    ensembles: int
+    acceptance: list
+    best: dict
+    best_logp: float
+    counts: dict
+    timing: dict
+    proposal: dict = dataclasses.field(default_factory=dict)
+    quality: dict = dataclasses.field(default_factory=dict)
+    plots: dict = dataclasses.field(default_factory=dict)
+    spec: object = dataclasses.field(repr=False, default=None)
+    logpost: object = dataclasses.field(repr=False, default=None)
+
+    def samples(self, flat: bool = True) -> np.ndarray:
+        """Natural-unit samples, (N, ndim) when flat."""
+        return self.chains.reshape(-1, len(self.names)) if flat else self.chains
+
+    def median_internal(self) -> np.ndarray:
+        """Posterior median in internal coordinates (ndim,)."""
+        return np.median(self.chains_internal.reshape(-1, len(self.names)), axis=0)
+
+    def residuals(self) -> dict:
+        """Residuals at the posterior median (:func:`analysis.fit.quality.residuals`)."""
+        return residuals(self)
+
+    def to_json(self) -> dict:
+        """The ``results.json`` document (see the module notes)."""
+        quality = dict(self.quality)
+        if self.logpost is not None and "rms_residual" not in quality:
+            q = self.residuals()
+            quality.update(rms_residual=q["rms"], rms_normalized=q["rms_normalized"],
+                           values=int(q["residual"].size))
+        doc = {
+            "schema": "microcyl-fit", "schema_version": SCHEMA_VERSION,
+            "converged": bool(self.converged), "reason": self.reason,
+            "parameters": {n: dict(self.summary[n]) for n in self.names},
+            "fit": {"steps": self.steps, "burn": self.burn, "walkers": self.walkers,
+                    "ensembles": self.ensembles,
+                    "acceptance_fraction": [float(a) for a in self.acceptance],
+                    "map": dict(self.best), "map_log_posterior": float(self.best_logp),
+                    "points": dict(self.counts), "timing": dict(self.timing),
+                    "ties": ({k: list(v) for k, v in self.spec.ties.items()}
+                             if self.spec is not None else {}),
+                    "proposal": self.proposal},
+            "quality": quality, "plots": dict(self.plots)}
+        return json.loads(json.dumps(doc, default=json_plain))
+
+
+def summarize(spec, diag) -> dict:
+    """Per free parameter: median, 68% / 95% intervals (natural units), tau, N/tau, R-hat, ESS
+    and unit, from a :class:`~analysis.fit.convergence.Diagnosis`."""
+    natural = spec.to_natural(diag.chains)
+    summ = diagnostics.interval_summary(natural)
+    ess = diagnostics.ess(diag.chains, diag.taus)
+    out = {}
+    for i, n in enumerate(spec.free):
+        out[n] = {k: float(summ[k][i]) for k in summ}
+        out[n].update(tau=float(diag.tau[i]), n_over_tau=float(diag.kept / diag.tau[i]),
+                      rhat=float(diag.rhat[i]), ess=float(ess[i]), unit=spec.params[n].unit)
+    return out
+
+
+def write_results(result: FitResult, out_dir) -> tuple[Path, Path]:
+    """Write ``results.json`` and ``results.csv`` into ``out_dir``, each atomically.
+
+    Returns
+    -------
+    json_path, csv_path : Path
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    jpath, cpath = out / "results.json", out / "results.csv"
+    with atomic_write(jpath, "w") as fh:
+        fh.write(json.dumps(result.to_json(), indent=2) + "\n")
+    lines = ["parameter," + ",".join(SUMMARY_COLUMNS)]
+    for n in result.names:
+        s = result.summary[n]
+        lines.append(n + "," + ",".join(
+            s[c] if isinstance(s[c], str) else f"{float(s[c]):.8g}" for c in SUMMARY_COLUMNS))
+    lines.append(f"# converged,{str(result.converged).lower()},{result.reason}")
+    with atomic_write(cpath, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    return jpath, cpath
+
+
+def read_results(path) -> dict:
+    """Read a ``results.json`` into the current layout (schema version 2).
+
+    Files of the first layout (parameters at the top level, the rest under ``_fit``) are
+    converted. Returns the document; raises ``ValueError`` naming the file when it is not a
+    fit's results.
+    """
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{path}: cannot read fit results ({exc})") from None
+    if not isinstance(doc, dict):
+        raise ValueError(f"{path}: not a fit's results.json (not a JSON object)")
+    if doc.get("schema") == "microcyl-fit":
+        return doc
+    old = doc.get("_fit", {})
+    report = old.get("report", {})
+    quality = dict(old.get("quality", {}))
+    quality.update({k: v for k, v in report.items() if k.startswith("albedo")})
+    return {"schema": "microcyl-fit", "schema_version": 1,
+            "converged": doc.get("converged"), "reason": old.get("reason", ""),
+            "parameters": {k: v for k, v in doc.items()
+                           if isinstance(v, dict) and "median" in v},
+            "fit": {k: v for k, v in old.items() if k not in ("quality", "report", "reason")},
+            "quality": quality,
+            "plots": {k: Path(v).name for k, v in report.get("plots", {}).items()}}

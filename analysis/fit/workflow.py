@@ -1,0 +1,52 @@
+"""The workflow of ``microcyl fit``: fit a fabric to a table, write its results (and plots)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from analysis.fit.driver import fit
+from analysis.fit.posterior import FabricModel
+from analysis.fit.quality import fit_quality
+from analysis.fit.results import FitResult, write_results
+
+__all__ = ["fit_fabric"]
+
+
+def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
+               **fit_kw) -> FitResult:
+    """Fit ``fabric``'s free parameters to ``table`` and write the results into ``out_dir``.
+
+    The fit (:func:`analysis.fit.fit`) checkpoints into ``out_dir`` and resumes there. Then the
+    quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
+    colours and their CIEDE2000 difference), the plots drawn when ``plots`` is given, and
+    ``results.json`` / ``results.csv`` written, once, atomically.
+
+    Parameters
+    ----------
+    table : gonio.Table
+    fabric : brdf.Fabric
+        The fabric whose parameters ``spec`` fixes and whose geometry is evaluated.
+    spec : analysis.params.ParamSpec
+    out_dir : path
+        Output folder.
+    plots : callable, optional
+        ``plots(result, table, model_factory, out_dir) -> {name: path}`` (for example
+        ``reports.fitplots.write_fit_plots``); ``model_factory(wi, wo)`` is a
+        :class:`~analysis.fit.posterior.FabricModel` of the fabric at other pairs.
+    **fit_kw
+        Passed to :func:`analysis.fit.fit`.
+
+    Returns
+    -------
+    FitResult
+        With ``quality`` and ``plots`` filled in.
+    """
+    out = Path(out_dir)
+    result = fit(table, spec, FabricModel(fabric, table.wi, table.wo), out_dir=out, **fit_kw)
+    result.quality = fit_quality(result, table)
+    if plots is not None:
+        files = plots(result, table, lambda wi, wo: FabricModel(fabric, wi, wo), out)
+        result.plots = {k: Path(v).name for k, v in files.items()}
+    write_results(result, out)
+    return result

@@ -3,6 +3,7 @@ r"""A fabric: two threads woven at right angles, with the options of MODEL.md.""
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -10,7 +11,7 @@ import numpy as np
 from brdf import validate
 from brdf.curve import SAMPLING_METHODS
 from brdf.directions import as_directions, normalize
-from brdf.kernel import thread_geometry, thread_shade
+from brdf.kernel import SHADE_BLOCK, thread_geometry, thread_shade
 from brdf.thread import Thread
 
 __all__ = ["Fabric", "Prepared", "OPTIONS", "TRANSMISSION_METHODS", "GAP_METHODS"]
@@ -242,16 +243,17 @@ class Fabric:
                                reweighting=self._options["reweighting"],
                                keep_cos=self._options["transmission"] == "longitudinal")
 
-    def _q(self, geoms, area1, area2, zi, zo):
-        """Q of MODEL.md; 1 with reweighting off. Broadcasts area (B..., 1) over pairs."""
+    def _q(self, pmeans, area1, area2, zi, zo):
+        """Q of MODEL.md from the threads' P means; 1 with reweighting off. Broadcasts area
+        (B..., 1) over pairs."""
         if not self._options["reweighting"]:
             return 1.0
         gap = zi if self._options["gap"] == "incident" else zo
-        return area1 * geoms[0].pmean + area2 * geoms[1].pmean + (1.0 - area1 - area2) * gap
+        return area1 * pmeans[0] + area2 * pmeans[1] + (1.0 - area1 - area2) * gap
 
     def _combine(self, geoms, shades, zi, zo, split):
         t1, t2 = self._threads
-        q = self._q(geoms, t1.area, t2.area, zi, zo)
+        q = self._q([g.pmean for g in geoms], t1.area, t2.area, zi, zo)
         denom = q * zi
         parts = [t.area * (s[0][:, None] + np.asarray(t.albedo) * s[1][:, None])
                  for t, s in zip(self._threads, shades)]
@@ -282,6 +284,13 @@ class Prepared:
     ``eval`` shades the pairs for batches of optical parameters; tangent curves and options
     are those of the fabric it was prepared from.
 
+    Attributes
+    ----------
+    block_elements : int or None
+        (Parameter set, pair, sample) elements shaded per block; None (the default) takes
+        :data:`brdf.kernel.SHADE_BLOCK`. Only the speed and the rounding of the
+        weighted sums over samples depend on it.
+
     Examples
     --------
     >>> import brdf
@@ -294,6 +303,8 @@ class Prepared:
     >>> prep.eval(eta=np.full((5, 2), 1.4)).shape
     (5, 2, 3)
     """
+
+    block_elements: int | None = None
 
     def __init__(self, fabric: Fabric, wi, wo):
         wi, wo, shape, bad, below = _pairs(wi, wo)
@@ -349,21 +360,46 @@ class Prepared:
         alb = param("albedo", albedo, [t.albedo for t in th])
         batch = np.broadcast_shapes(eta.shape[:-1], kd.shape[:-1], gs.shape[:-1],
                                     gv.shape[:-1], area.shape[:-1], alb.shape[:-2])
-        parts = []
+        nb = math.prod(batch)
+
+        def flat(x, k):  # (B..., *tail) with k tail axes -> (nb, *tail)
+            tail = x.shape[x.ndim - k:]
+            return np.broadcast_to(x, batch + tail).reshape((nb,) + tail)
+
+        eta, kd, gs, gv, area = (flat(x, 1) for x in (eta, kd, gs, gv, area))
+        shades = np.empty((2, 2, nb, self._zi.size))     # thread, (surf, vol), set, pair
         for j, (g, c) in enumerate(zip(self._geoms, fab._const)):
-            surf, vol = thread_shade(g, c.weight, np.broadcast_to(eta[..., j], batch),
-                                     kd[..., j], gs[..., j], gv[..., j],
-                                     fab.options["transmission"])
-            a = area[..., j, None]                           # (B..., 1)
-            parts.append(a[..., None] * (surf[..., None] + alb[..., None, j, :] * vol[..., None]))
-        q = fab._q(self._geoms, area[..., 0, None], area[..., 1, None], self._zi, self._zo)
-        denom = q * self._zi
-        inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
-        vals = (parts[0] + parts[1]) * inv[..., None]
-        out = np.zeros(batch + (self._ok.size, 3))
-        out[..., self._ok, :] = vals
-        out[..., self._bad, :] = np.nan
+            thread_shade(g, c.weight, eta[:, j], kd[:, j], gs[:, j], gv[:, j],
+                         fab.options["transmission"], out=tuple(shades[j]),
+                         block=self.block_elements)
+        out = np.zeros((nb, self._ok.size, 3))
+        vals = out if self._ok.all() else np.empty((nb, self._zi.size, 3))
+        self._combine_into(shades, area, flat(alb, 2), vals)
+        if vals is not out:
+            out[:, self._ok] = vals
+        out[:, self._bad] = np.nan
         return out.reshape(batch + self.shape + (3,))
+
+    def _combine_into(self, shades, area, alb, vals):
+        """f_r = (a_1 S_1 + a_2 S_2) / (Q n.wi) into ``vals`` (nb, C, 3), in blocks of pairs.
+
+        ``shades`` (2, 2, nb, C): per thread the surface and volume sums; ``area`` (nb, 2),
+        ``alb`` (nb, 2, 3).
+        """
+        nb, nc = shades.shape[2:]
+        step = max(1, (self.block_elements or SHADE_BLOCK) // (3 * max(nb, 1)))
+        a1, a2 = area[:, 0, None], area[:, 1, None]
+        for c0 in range(0, nc, step):
+            sl = slice(c0, c0 + step)
+            pmeans = [None if g.pmean is None else g.pmean[sl] for g in self._geoms]
+            q = self.fabric._q(pmeans, a1, a2, self._zi[sl], self._zo[sl])
+            denom = q * self._zi[sl]
+            inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
+            parts = [area[:, j, None, None] * (shades[j, 0, :, sl, None]
+                                               + alb[:, None, j, :] * shades[j, 1, :, sl, None])
+                     for j in range(2)]
+            parts[0] += parts[1]
+            np.multiply(parts[0], inv[..., None], out=vals[:, sl])
 
 
 def _pairs(wi, wo):

@@ -23,6 +23,7 @@ digits in the angle but not in its square, which is all the Gaussians see.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -33,6 +34,12 @@ __all__ = ["ThreadGeometry", "thread_geometry", "thread_shade", "GAUSS_NORM"]
 
 _K_U = -0.5 / SIGMA_U**2          # u(x) = exp(_K_U x^2)
 GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
+
+#: Default (parameter set, pair, sample) elements per block of :func:`thread_shade`: each of
+#: its four float64 temporaries then takes 1 MiB. Chosen by bench/bench_prepared.py (2 cores,
+#: 1 MiB L2 each, 32 MiB L3): blocks of 2^14..2^15, which stay in L2, lost more to the ~25
+#: NumPy calls a block costs than they gained; 2^18 was no faster.
+SHADE_BLOCK = 1 << 17
 
 
 class ThreadGeometry(NamedTuple):
@@ -202,23 +209,135 @@ def _blend(a, b, cos_delta, k):
 
 def _fresnel_from_cos(eta2, c, c2):
     """Unpolarized dielectric Fresnel reflectance from c = cos and c2 = cos^2 (broadcasting)."""
-    g = c2 + (eta2 - 1.0)
-    np.sqrt(g, out=g)
-    rs = c - g
-    rs /= c + g
-    e2c = eta2 * c
-    rp = e2c - g
-    e2c += g
-    rp /= e2c
-    rs *= rs
-    rp *= rp
-    rs += rp
+    shape = np.broadcast_shapes(np.shape(eta2), np.shape(c), np.shape(c2))
+    rs = _fresnel2_into(eta2, c, c2, *(np.empty(shape) for _ in range(4)))
     rs *= 0.5
     return rs
 
 
+def _fresnel2_into(eta2, c, c2, g, rs, t, rp):
+    r"""Twice the unpolarized Fresnel reflectance, :math:`2F = r_s^2 + r_p^2`, into ``rs``.
+
+    ``eta2`` is :math:`\eta^2`, ``c`` and ``c2`` the cosine and its square (broadcasting to
+    the buffers); ``g``, ``rs``, ``t``, ``rp`` are distinct float64 buffers of the broadcast
+    shape, overwritten. Returns ``rs``. The factor 1/2 is left to the caller: scaling by a
+    power of two is exact, so leaving it for later changes no bit of the results.
+    """
+    np.add(c2, eta2 - 1.0, out=g)
+    np.sqrt(g, out=g)
+    np.subtract(c, g, out=rs)
+    np.add(c, g, out=t)
+    rs /= t
+    np.multiply(eta2, c, out=t)
+    np.subtract(t, g, out=rp)
+    t += g
+    rp /= t
+    rs *= rs
+    rp *= rp
+    rs += rp
+    return rs
+
+
+class _ShadeParams(NamedTuple):
+    """Per-row constants of a flattened batch of nb parameter sets (see thread_shade)."""
+
+    eta2: np.ndarray      # (nb, 1, 1) eta^2
+    cs: np.ndarray        # (nb, 1, 1) -1 / (8 gamma_s^2), 1/rad^2
+    cv: np.ndarray        # (nb, 1, 1) -1 / (8 gamma_v^2), 1/rad^2
+    once: np.ndarray      # (nb,) bool: gamma_v == 2 gamma_s, surface lobe = volume lobe^4
+    s_scale: np.ndarray   # (nb, 1) GAUSS_NORM / gamma_s / 2 (the 1/2 of F), 1/rad
+    v_scale: np.ndarray   # (nb, 1, 1) (1 - k_d) GAUSS_NORM / gamma_v, 1/rad
+    kd: np.ndarray        # (nb, 1, 1)
+
+    def rows(self, sl):
+        """The constants of rows ``sl``."""
+        return _ShadeParams(*(a[sl] for a in self))
+
+
+def _shade_params(eta, kd, gamma_s, gamma_v) -> _ShadeParams:
+    """Row constants from 1-D arrays (nb,) of eta, k_d and the gammas (radians)."""
+    c3 = (slice(None), None, None)
+    s_scale = GAUSS_NORM / gamma_s
+    s_scale *= 0.5
+    return _ShadeParams((eta * eta)[c3], (-0.125 / (gamma_s * gamma_s))[c3],
+                        (-0.125 / (gamma_v * gamma_v))[c3], gamma_v == 2.0 * gamma_s,
+                        s_scale[:, None], ((1.0 - kd) * GAUSS_NORM / gamma_v)[c3], kd[c3])
+
+
+def _blocks(nb, nc, ns, block):
+    """Slices (rows, pairs) tiling (nb, nc) into blocks of at most about ``block`` (row, pair,
+    sample) elements, of near-equal sizes: as many pairs as fit, then as many rows; pairs
+    outermost. (Long runs of pairs in a block keep NumPy's inner loops long: by measurement
+    few rows of many pairs beat many rows of few pairs.)"""
+    rows = max(1, block // ns)
+    cb = _even(nc, rows)
+    bb = _even(nb, max(1, rows // cb))
+    for c0 in range(0, nc, cb):
+        for b0 in range(0, nb, bb):
+            yield slice(b0, b0 + bb), slice(c0, c0 + cb)
+
+
+def _even(n, most):
+    """The size of near-equal parts of n items, none over ``most`` (at least 1)."""
+    parts = -(-n // max(1, most))
+    return max(1, -(-n // max(1, parts)))
+
+
+def _weighted_sum(x, weight, out):
+    """out = x @ weight over the last axis (a product, not a matrix call, for one sample)."""
+    if weight.size == 1:
+        np.multiply(x[..., 0], weight[0], out=out)
+    else:
+        np.matmul(x, weight, out=out)
+
+
+def _shade_block(geom, weight, par, transmission, surf, vol, work):
+    """One block of :func:`thread_shade`: geometry (c, S), constants of b rows, outputs (b, c).
+
+    ``work`` is a float64 buffer of at least 4 b c S elements, overwritten.
+    """
+    shape = (par.eta2.shape[0],) + geom.th2.shape
+    n = shape[0] * shape[1] * shape[2]
+    a, f2, es, d = (work[k * n:(k + 1) * n].reshape(shape) for k in range(4))
+    _fresnel2_into(par.eta2, geom.cg, geom.cg2, a, f2, es, d)     # 2F in f2
+    # Volume lobe exp(-theta_h^2 / (2 gamma_v^2)); theta_h^2 = th2 / 4.
+    ev = np.multiply(geom.th2, par.cv, out=a)
+    np.exp(ev, out=ev)
+    if par.once.all():
+        np.multiply(ev, ev, out=es)     # exp(a)^4 = exp(4 a): gamma_s = gamma_v / 2 (Table II)
+        es *= es
+    else:
+        np.multiply(geom.th2, par.cs, out=es)
+        np.exp(es, out=es)
+        if par.once.any():              # those rows as in the single-set evaluation
+            once = par.once
+            lobe = ev[once]
+            lobe *= lobe
+            lobe *= lobe
+            es[once] = lobe
+    es *= f2
+    es *= geom.ks
+    _weighted_sum(es, weight, surf)
+    surf *= par.s_scale
+    if transmission == "half_angle":
+        ft = np.subtract(2.0, f2, out=f2)   # 2 (1 - F), exactly
+        ft *= ft
+        scale = 0.25
+    else:
+        ft = 1.0 - _fresnel_from_cos(par.eta2, geom.ci, geom.ci * geom.ci)
+        ft *= 1.0 - _fresnel_from_cos(par.eta2, geom.cr, geom.cr * geom.cr)
+        scale = 1.0
+    ev *= par.v_scale
+    ev += par.kd
+    ev *= ft
+    ev *= geom.kv
+    _weighted_sum(ev, weight, vol)
+    if scale != 1.0:
+        vol *= scale
+
+
 def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
-                 transmission="half_angle"):
+                 transmission="half_angle", *, out=None, block=None):
     r"""Weighted sums of one thread's surface and volume terms.
 
     Parameters
@@ -232,6 +351,13 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
     gamma_s, gamma_v : float or ndarray of shape (B...)
         Lobe widths, radians.
     transmission : {"half_angle", "longitudinal"}
+    out : tuple of two ndarray, shape (B..., C), optional
+        C-contiguous float64 arrays to write ``surf`` and ``vol`` into (returned).
+    block : int, optional
+        Target number of (parameter set, pair, sample) elements per block (default
+        :data:`SHADE_BLOCK`): the batch and the pairs are shaded in blocks of about this
+        size, so that the temporaries stay in cache. Only the speed and the rounding of
+        the weighted sums depend on it.
 
     Returns
     -------
@@ -244,42 +370,21 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
     :math:`f_{rs} = F_r(\eta, \cos g)\cos(\phi_d/2)\, g(\gamma_s, \theta_h) / \cos^2\theta_d`,
     :math:`f_{rv} = F_T\,((1-k_d) g(\gamma_v, \theta_h) + k_d) / (\cos\theta_i + \cos\theta_r)
     \,A / \cos^2\theta_d`, with :math:`g(\gamma, x) = e^{-x^2/2\gamma^2}/(\gamma\sqrt{2\pi})`
-    and :math:`\theta_h^2 = \mathrm{th2}/4`.
+    and :math:`\theta_h^2 = \mathrm{th2}/4`. Where :math:`\gamma_v = 2\gamma_s` (Table II) the
+    surface lobe is the volume lobe to the fourth power, one ``exp`` for both.
     """
-    eta = np.asarray(eta, dtype=np.float64)
-    kd = np.asarray(kd, dtype=np.float64)
-    gamma_s = np.asarray(gamma_s, dtype=np.float64)
-    gamma_v = np.asarray(gamma_v, dtype=np.float64)
-    batch = np.broadcast_shapes(eta.shape, kd.shape, gamma_s.shape, gamma_v.shape)
-    ex = (Ellipsis,) + (None,) * geom.th2.ndim
-
-    def b(x):  # parameter (B...) -> (B..., 1, 1), broadcast to the whole batch
-        return np.broadcast_to(x, batch)[ex] if batch else x
-
-    eta2 = b(eta * eta)
-    f = _fresnel_from_cos(eta2, geom.cg, geom.cg2)
-    # Volume lobe exp(-theta_h^2 / (2 gamma_v^2)); theta_h^2 = th2 / 4.
-    ev = geom.th2 * b(-0.125 / (gamma_v * gamma_v))
-    np.exp(ev, out=ev)
-    if not batch and float(gamma_v) == 2.0 * float(gamma_s):
-        es = ev * ev          # exp(a)^4 = exp(4 a): gamma_s = gamma_v / 2, as in Table II
-        es *= es
-    else:
-        es = geom.th2 * b(-0.125 / (gamma_s * gamma_s))
-        np.exp(es, out=es)
-    es *= f
-    es *= geom.ks
-    surf = es @ weight
-    surf *= b(GAUSS_NORM / gamma_s)[..., 0] if batch else GAUSS_NORM / gamma_s
-    if transmission == "half_angle":
-        ft = np.subtract(1.0, f, out=f)
-        ft *= ft
-    else:
-        ft = 1.0 - _fresnel_from_cos(eta2, geom.ci, geom.ci * geom.ci)
-        ft *= 1.0 - _fresnel_from_cos(eta2, geom.cr, geom.cr * geom.cr)
-    ev *= b((1.0 - kd) * GAUSS_NORM / gamma_v)
-    ev += b(kd)
-    ev *= ft
-    ev *= geom.kv
-    vol = ev @ weight
-    return surf, vol
+    params = [np.asarray(x, dtype=np.float64) for x in (eta, kd, gamma_s, gamma_v)]
+    batch = np.broadcast_shapes(*(x.shape for x in params))
+    nb = math.prod(batch)
+    par = _shade_params(*(np.broadcast_to(x, batch).reshape(nb) for x in params))
+    nc, ns = geom.th2.shape
+    if out is None:
+        out = (np.empty(batch + (nc,)), np.empty(batch + (nc,)))
+    surf, vol = (o.reshape(nb, nc) for o in out)
+    block = SHADE_BLOCK if block is None else max(1, int(block))
+    work = np.empty(4 * min(nb * nc * ns, max(block, ns)))
+    for rows, pairs in _blocks(nb, nc, ns, block):
+        g = ThreadGeometry(*(None if x is None else x[pairs] for x in geom))
+        _shade_block(g, weight, par.rows(rows), transmission, surf[rows, pairs],
+                     vol[rows, pairs], work)
+    return out

@@ -228,6 +228,35 @@ def test_prepare_matches_eval_for_other_parameters(pairs):
         prep.eval(eta=[1.4, 1.4, 1.4])
 
 
+def test_blocked_batch_matches_per_set_evaluation():
+    # A batch of 7 random parameter sets shaded in many small blocks (over pairs and sets)
+    # against each set evaluated on its own by Fabric.eval of a fabric with those threads.
+    wi, wo = random_pairs(2000, np.random.default_rng(11))
+    wi[:3, 2] = -0.2                     # below the horizon: 0
+    wo[3] = 0.0                          # a bad vector: NaN
+    rng = np.random.default_rng(5)
+    b = 7
+    gs = rng.uniform(3.0, 20.0, (b, 2))
+    gv = np.where(rng.random((b, 2)) < 0.5, 2.0 * gs, rng.uniform(5.0, 40.0, (b, 2)))
+    kw = dict(eta=rng.uniform(1.2, 1.8, (b, 2)), kd=rng.uniform(0.0, 1.0, (b, 2)),
+              gamma_s=gs, gamma_v=gv, area=rng.uniform(0.05, 0.5, (b, 2)),
+              albedo=rng.uniform(0.0, 1.0, (b, 2, 3)))
+    for preset, options in [("linen_plain", {}), ("silk_crepe_de_chine", {}),
+                            ("velvet", {"transmission": "longitudinal"}),
+                            ("silk_shot", {"reweighting": False})]:
+        fab = brdf.fabric(preset).replace(**options)
+        prep = fab.prepare(wi, wo)
+        prep.block_elements = 3000       # 93 pairs of linen by 1 set: over 150 blocks
+        batch = prep.eval(**kw)
+        assert batch.shape == (b, len(wi), 3)
+        for i in range(b):
+            threads = [t.replace(**{k: v[i, j] for k, v in kw.items()})
+                       for j, t in enumerate(fab.threads)]
+            single = fab.replace(threads=threads).eval(wi, wo)
+            np.testing.assert_allclose(batch[i], single, rtol=1e-13, atol=0)
+        assert np.isnan(batch[:, 3]).all() and (batch[:, :3] == 0.0).all()
+
+
 # -- bad input -------------------------------------------------------------------------------
 GOOD = dict(eta=1.46, albedo=(0.1, 0.2, 0.3), kd=0.3, gamma_s=12, gamma_v=24, area=0.33,
             offsets=(-25, 25), lengths=(1,))

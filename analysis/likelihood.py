@@ -151,6 +151,9 @@ class Likelihood:
             self.y = np.log1p(f * c)
             sy = None if sigma is None else c * sigma[self.pt, self.ch] / (1.0 + f * c)
         self.sigma_y2 = None if sy is None else sy * sy
+        if self.sigma_y2 is not None:
+            self._inv_s2 = 1.0 / self.sigma_y2
+            self._gauss_const = -0.5 * float(np.sum(np.log(self.sigma_y2) + _LOG_2PI))
         if kind == "student-t":
             nu = self.nu
             self._t_const = gammaln((nu + 1) / 2) - gammaln(nu / 2) - 0.5 * math.log(nu * math.pi)
@@ -203,19 +206,30 @@ class Likelihood:
             mu = np.log(np.maximum(m, 1e-300))
         else:
             mu = np.log1p(np.maximum(m, 0.0) * self.cos_i)
-        r = self.y - mu
+        r = np.subtract(self.y, mu, out=mu)
+        if log_noise is None and self.sigma_y2 is None:
+            raise ValueError("the table has no sigma: a log_noise parameter is needed")
+        if self.kind == "student-t":
+            out = self._student_t(r, log_noise)
+        elif log_noise is None:           # fixed sigma: sum r^2 / s^2 as one product
+            out = -0.5 * ((r * r) @ self._inv_s2) + self._gauss_const
+        elif self.sigma_y2 is None:       # s^2 = exp(2 log_noise), one value per row
+            ln = np.asarray(log_noise, dtype=np.float64)
+            n = r.shape[-1]
+            out = (-0.5 * np.exp(-2.0 * ln) * np.einsum("...i,...i->...", r, r)
+                   - n * ln - 0.5 * n * _LOG_2PI)
+        else:
+            s2 = self.sigma_y2 + np.exp(2.0 * np.asarray(log_noise, dtype=np.float64))[..., None]
+            out = -0.5 * (r * r / s2 + np.log(s2) + _LOG_2PI).sum(axis=-1)
+        return np.where(np.isfinite(out), out, -np.inf)
+
+    def _student_t(self, r, log_noise):
         if log_noise is None:
-            if self.sigma_y2 is None:
-                raise ValueError("the table has no sigma: a log_noise parameter is needed")
             s2 = self.sigma_y2
         else:
             ln = np.asarray(log_noise, dtype=np.float64)[..., None]
             s2 = np.exp(2.0 * ln) if self.sigma_y2 is None else self.sigma_y2 + np.exp(2.0 * ln)
         s2 = np.broadcast_to(s2, r.shape)
-        if self.kind == "student-t":
-            z2 = r * r / s2
-            ll = self._t_const - 0.5 * (self.nu + 1) * np.log1p(z2 / self.nu) - 0.5 * np.log(s2)
-        else:
-            ll = -0.5 * (r * r / s2 + np.log(s2) + _LOG_2PI)
-        out = ll.sum(axis=-1)
-        return np.where(np.isfinite(out), out, -np.inf)
+        z2 = r * r / s2
+        ll = self._t_const - 0.5 * (self.nu + 1) * np.log1p(z2 / self.nu) - 0.5 * np.log(s2)
+        return ll.sum(axis=-1)

@@ -26,6 +26,7 @@ from scipy import stats
 import brdf
 import gonio
 from analysis.fit import FabricModel, fit
+from analysis.measured import MEASURED, load_measured, measured_spec
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -56,6 +57,8 @@ def speed(args):
     print(f"verdict: {r.reason}")
     print(f"log-probability evaluations per second: {t['evals_per_s']:.0f} "
           f"({t['log_prob_evals']} in {t['sample_s']:.1f} s of sampling)")
+    print(f"proposal refits: {t['refit_evals']} evaluations; kept at "
+          f"{[a['step'] for a in r.proposal['adaptations'] if a.get('kept')]}")
     print(f"effective samples per second (smallest ESS over parameters): {t['ess_per_s']:.1f}")
     print(f"wall time of the default fit: {t['wall_s']:.1f} s (point estimate "
           f"{t['optimize_s']:.1f} s); max tau {max(s['tau'] for s in r.summary.values()):.1f} "
@@ -112,7 +115,6 @@ def calibration(args):
 
 def real(args):
     """Fits of the measured datasets (analysis.measured): verdict, residuals, time."""
-    from analysis.measured import MEASURED, load_measured, measured_spec
     if not SHARED.is_dir():
         print(f"measured data not found at {SHARED}")
         return 1
@@ -125,7 +127,7 @@ def real(args):
         spec, fab = measured_spec(name)
         r = fit(table, spec, FabricModel(fab, table.wi, table.wo), seed=0, progress=False,
                 max_steps=args.max_steps, time_limit=args.time_limit, out_dir=out_root / name)
-        kept = [a["step"] for a in r.timing["laplace_move"]["adaptations"] if a.get("kept")]
+        kept = [a["step"] for a in r.proposal["adaptations"] if a.get("kept")]
         print(f"{name} (from {d.preset}): {len(table)} pairs, {r.counts['used']} values; "
               f"rms residual (log space) {r.residuals()['rms']:.3f}; "
               f"{r.timing['wall_s']:.0f} s, {r.timing['evals_per_s']:.0f} evals/s; proposal "

@@ -68,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         status = args.func(args)
     except KeyboardInterrupt as exc:      # a fit says where its checkpoint is
-        print(f"microcyl {args.command}: {exc or 'interrupted'}", file=sys.stderr)
+        print(f"microcyl {args.command}: {str(exc) or 'interrupted'}", file=sys.stderr)
         return 130
     except (ValueError, OSError, KeyError, RuntimeError) as exc:
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__

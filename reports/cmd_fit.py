@@ -131,5 +131,7 @@ def format_summary(result) -> str:
     lines.append(f"acceptance {min(result.acceptance):.2f}-{max(result.acceptance):.2f}; "
                  f"{result.ensembles} ensembles x {result.walkers} walkers x {result.steps} "
                  f"steps; wall {result.timing['wall_s']:.1f} s")
+    if result.timing.get("resumed_from"):
+        lines.append(f"resumed from the checkpoint at step {result.timing['resumed_from']}")
     lines.append(("CONVERGED: " if result.converged else "") + result.reason)
     return "\n".join(lines)

@@ -224,10 +224,12 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
             best, best_logp, cov = start["best"], start["best_logp"], start["cov"]
         t_opt = time.perf_counter() - t0
         sampler = FitSampler(logpost, opts, best, cov, rngs, ckpt)
+        resumed = sampler.steps if ckpt is not None else 0
         with _progress(progress, max_steps, sampler.steps) as (tick, postfix):
             out = sampler.run(folder, tick, t0, postfix)
     return _result(spec, lik, logpost, opts, sampler, out, best, best_logp,
-                   {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt})
+                   {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt,
+                    "resumed_from": resumed})
 
 
 def _result(spec, lik, logpost, opts, sampler, out, best, best_logp, timing) -> FitResult:

@@ -189,12 +189,15 @@ class LaplaceMove(emcee.moves.MHMove):
 
     @classmethod
     def from_samples(cls, x, components: int, rng, *, ridge=None, df: float = 5.0,
-                     scale: float = 1.2, iters: int = 60, warps=None) -> "LaplaceMove | None":
+                     scale: float = 1.2, iters: int = 60, warps=None,
+                     tol: float = 1e-3) -> "LaplaceMove | None":
         """Fit ``components`` components to samples x (n, d) by Gaussian-mixture EM.
 
         The fit is made in the coordinates ``warp(x, warps)`` (default the identity). Seeds by
         k-means++ from ``rng``; ``ridge`` (d,) is added to every covariance's diagonal.
-        Components left with fewer than 2 d samples' weight are dropped. Returns None when the
+        Components left with fewer than 2 d samples' weight are dropped; EM stops after
+        ``iters`` iterations or when the mean log-likelihood per sample gains less than
+        ``tol``. Returns None when the
         samples are too few (< 5 d per component) or degenerate.
         """
         x = np.asarray(x, dtype=np.float64)
@@ -222,6 +225,7 @@ class LaplaceMove(emcee.moves.MHMove):
             centres.append(z[rng.choice(n, p=d2 / d2.sum())])
         resp = np.exp(-0.5 * np.array([((z - c) ** 2).sum(axis=1) for c in centres]))
         resp /= np.maximum(resp.sum(axis=0), 1e-300)
+        ll_prev = -np.inf
         for _ in range(iters):
             nk = resp.sum(axis=1)
             keep = nk > 2 * d
@@ -240,7 +244,12 @@ class LaplaceMove(emcee.moves.MHMove):
                 zz = scipy.linalg.solve_triangular(c, dx.T, lower=True)
                 logp[j] = (np.log(w[j]) - np.log(np.diag(c)).sum()
                            - 0.5 * (zz * zz).sum(axis=0))
-            resp = np.exp(logp - scipy.special.logsumexp(logp, axis=0))
+            norm = scipy.special.logsumexp(logp, axis=0)
+            resp = np.exp(logp - norm)
+            ll = float(np.mean(norm))
+            if ll - ll_prev < tol:        # EM converged (mean log-likelihood per sample)
+                break
+            ll_prev = ll
         try:
             return cls(mu, covs, df=df, scale=scale, weights=w, warps=warps)
         except np.linalg.LinAlgError:

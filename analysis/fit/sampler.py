@@ -167,17 +167,12 @@ class FitSampler:
                   + [a for a in self.schedule if a > n])
         return min(o.max_steps, nxt)
 
-    def _advance(self, folder, tick):
-        """Run to the next check and refit; on Ctrl-C checkpoint what is done and raise
-        :class:`FitInterrupted`."""
-        try:
-            self.runner.run_to(self._next_target(), tick)
-        except KeyboardInterrupt:
-            tau = None if self.tau_prev is None else self.tau_prev.tolist()
-            self._checkpoint(folder, self._last_check, self._tau_before, tau)
-            where = "" if folder is None else f"; the checkpoint in {folder.path} resumes"
-            raise FitInterrupted(f"interrupted at step {self.steps}{where}") from None
-        self._refit_due()
+    def _interrupted(self, folder) -> FitInterrupted:
+        """Checkpoint the completed steps after Ctrl-C; the exception to raise."""
+        tau = None if self.tau_prev is None else self.tau_prev.tolist()
+        self._checkpoint(folder, self._last_check, self._tau_before, tau)
+        where = "" if folder is None else f"; the checkpoint in {folder.path} resumes"
+        return FitInterrupted(f"interrupted at step {self.steps}{where}")
 
     def run(self, folder, tick=None, t0: float | None = None, postfix=None) -> Outcome:
         """Sample until converged, ``max_steps`` or ``time_limit`` (seconds since ``t0``).
@@ -190,7 +185,8 @@ class FitSampler:
         try:
             while True:
                 if not self.recheck:
-                    self._advance(folder, tick)
+                    self.runner.run_to(self._next_target(), tick)
+                    self._refit_due()
                 self.recheck = False
                 diag = diagnose(self.chains, c.burn_fraction,
                                 max(p.last_kept for p in self.proposals))
@@ -212,6 +208,10 @@ class FitSampler:
                     why = (f"NOT converged: time limit {o.time_limit:g} s reached at step "
                            f"{diag.step}; {why}")
                     break
+        except FitInterrupted:
+            raise
+        except KeyboardInterrupt:
+            raise self._interrupted(folder) from None
         finally:
             self.runner.close()
         refits = self.refit_evals - r0

@@ -198,13 +198,18 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     FitInterrupted
         On Ctrl-C during sampling, after checkpointing the steps done (a KeyboardInterrupt).
     """
-    t0 = time.perf_counter()
     opts = FitOptions(likelihood=likelihood, nu=nu, ensembles=ensembles, walkers=walkers,
                       seed=seed, max_steps=max_steps, check_every=check_every,
                       criteria=Criteria(min_ratio, tau_tol, rhat_max, burn_fraction),
                       n_starts=n_starts, laplace_move=laplace_move, adapt=adapt,
                       threads=threads, time_limit=time_limit)
-    lik = Likelihood(table, kind=likelihood, nu=nu)
+    return _run(table, spec, model, opts, out_dir, progress, config_extra)
+
+
+def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra) -> FitResult:
+    """:func:`fit` once its options are gathered: checks, start, sampling, result."""
+    t0 = time.perf_counter()
+    lik = Likelihood(table, kind=opts.likelihood, nu=opts.nu)
     spec = _with_nuisance(spec, lik)
     _check_points(lik, spec.ndim)
     opts = opts.resolve(spec.ndim)
@@ -214,10 +219,10 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     start = None if folder is None else folder.read_start(config)
     ckpt = None if start is None else folder.read_checkpoint()
     rng_opt, *rngs = [np.random.default_rng(s)
-                      for s in np.random.SeedSequence(seed).spawn(ensembles + 1)]
+                      for s in np.random.SeedSequence(opts.seed).spawn(opts.ensembles + 1)]
     with threadpool_limits(limits=1, user_api="blas"):
         if start is None:
-            best, best_logp, cov = optimize_start(logpost, n_starts, rng_opt)
+            best, best_logp, cov = optimize_start(logpost, opts.n_starts, rng_opt, opts.threads)
             if folder is not None:
                 folder.write_start(config, best, best_logp, cov)
         else:
@@ -225,7 +230,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         t_opt = time.perf_counter() - t0
         sampler = FitSampler(logpost, opts, best, cov, rngs, ckpt)
         resumed = sampler.steps if ckpt is not None else 0
-        with _progress(progress, max_steps, sampler.steps) as (tick, postfix):
+        with _progress(progress, opts.max_steps, sampler.steps) as (tick, postfix):
             out = sampler.run(folder, tick, t0, postfix)
     return _result(spec, lik, logpost, opts, sampler, out, best, best_logp,
                    {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt,

@@ -7,10 +7,16 @@ a few single evaluations.
 
 from __future__ import annotations
 
+import concurrent.futures as cf
+
 import numpy as np
+import scipy
 import scipy.optimize
 
 __all__ = ["point_estimate", "laplace_cov", "initial_walkers", "optimize_start"]
+
+#: SciPy's L-BFGS-B is C (re-entrant) from 1.15 on; before, Fortran with shared state.
+_LBFGSB_THREAD_SAFE = tuple(int(v) for v in scipy.__version__.split(".")[:2]) >= (1, 15)
 
 
 def _fd_grad_batch(x, h, lower, upper):
@@ -21,7 +27,7 @@ def _fd_grad_batch(x, h, lower, upper):
     return pts, steps
 
 
-def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300):
+def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int = 1):
     """Maximum a posteriori estimate from several starts (L-BFGS-B, batched FD gradient).
 
     Parameters
@@ -29,6 +35,8 @@ def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300):
     logpost : LogPosterior
     starts : ndarray, shape (k, ndim)
         Internal coordinates of the starts.
+    threads : int
+        Starts optimized at once (each independent of the others: same result for any value).
 
     Returns
     -------
@@ -52,15 +60,20 @@ def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300):
         fi = np.where(np.isfinite(lp[1:]), -lp[1:], f0 + 1e6 * np.abs(steps))
         return float(f0), (fi - f0) / steps
 
-    results = []
-    for s in np.atleast_2d(starts):
+    def one(s):
         if not np.isfinite(logpost(s[None])[0]):
-            results.append((s, -np.inf))
-            continue
+            return s, -np.inf
         r = scipy.optimize.minimize(fun_grad, s, jac=True, method="L-BFGS-B",
                                     bounds=list(zip(lower, upper)),
                                     options={"maxiter": maxiter})
-        results.append((r.x, -float(r.fun) if r.fun < big else -np.inf))
+        return r.x, (-float(r.fun) if r.fun < big else -np.inf)
+
+    starts = np.atleast_2d(starts)
+    if threads > 1 and _LBFGSB_THREAD_SAFE:
+        with cf.ThreadPoolExecutor(threads) as ex:
+            results = list(ex.map(one, starts))
+    else:
+        results = [one(s) for s in starts]
     i = int(np.argmax([r[1] for r in results]))
     return results[i][0], results[i][1], [r[1] for r in results]
 
@@ -148,7 +161,8 @@ def initial_walkers(logpost, best, cov, nwalkers, rng) -> tuple[np.ndarray, np.n
                        "log-posterior is not finite near it")
 
 
-def optimize_start(logpost, n_starts: int, rng) -> tuple[np.ndarray, float, np.ndarray | None]:
+def optimize_start(logpost, n_starts: int, rng,
+                   threads: int = 1) -> tuple[np.ndarray, float, np.ndarray | None]:
     """Point estimate from the spec's start and ``n_starts - 1`` perturbations of it (5% of
     each parameter's internal range, from ``rng``), then the Laplace covariance there.
 
@@ -175,5 +189,5 @@ def optimize_start(logpost, n_starts: int, rng) -> tuple[np.ndarray, float, np.n
     for _ in range(max(0, n_starts - 1)):
         starts.append(np.clip(start + rng.normal(scale=0.05 * spec.width), spec.lower,
                               spec.upper))
-    best, best_logp, _ = point_estimate(logpost, np.array(starts))
+    best, best_logp, _ = point_estimate(logpost, np.array(starts), threads=threads)
     return best, best_logp, laplace_cov(logpost, best)

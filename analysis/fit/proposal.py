@@ -159,6 +159,8 @@ class LaplaceMove(emcee.moves.MHMove):
     def _set(self, means, chols, weights):
         self.means, self.chols, self.weights = means, chols, weights
         self._logw = np.log(weights) - np.log(np.diagonal(chols, axis1=1, axis2=2)).sum(axis=1)
+        # inverse factors: each log q is then one small matrix product per component
+        self._inv = np.linalg.inv(chols)
 
     def copy_from(self, other: "LaplaceMove"):
         """Take over another proposal's components (the move object itself stays in place)."""
@@ -241,7 +243,7 @@ class LaplaceMove(emcee.moves.MHMove):
                     c = np.linalg.cholesky(covs[j])
                 except np.linalg.LinAlgError:
                     return None
-                zz = scipy.linalg.solve_triangular(c, dx.T, lower=True)
+                zz = np.linalg.inv(c) @ dx.T
                 logp[j] = (np.log(w[j]) - np.log(np.diag(c)).sum()
                            - 0.5 * (zz * zz).sum(axis=0))
             norm = scipy.special.logsumexp(logp, axis=0)
@@ -260,7 +262,7 @@ class LaplaceMove(emcee.moves.MHMove):
         x, logjac = warp(x, self.warps)
         out = np.empty((self.n_components, x.shape[0]))
         for j in range(self.n_components):
-            z = scipy.linalg.solve_triangular(self.chols[j], (x - self.means[j]).T, lower=True)
+            z = self._inv[j] @ (x - self.means[j]).T
             out[j] = self._logw[j] - 0.5 * (self.df + x.shape[1]) * np.log1p(
                 (z * z).sum(axis=0) / self.df)
         return scipy.special.logsumexp(out, axis=0) + logjac

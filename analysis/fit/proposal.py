@@ -234,19 +234,18 @@ class LaplaceMove(emcee.moves.MHMove):
             resp, nk = resp[keep], nk[keep]
             w = nk / n
             mu = resp @ x / nk[:, None]
-            covs = np.empty((len(nk), d, d))
-            logp = np.empty((len(nk), n))
-            for j in range(len(nk)):
-                dx = x - mu[j]
-                covs[j] = (resp[j][:, None] * dx).T @ dx / nk[j] + np.diag(ridge)
-                try:
-                    c = np.linalg.cholesky(covs[j])
-                except np.linalg.LinAlgError:
-                    return None
-                zz = np.linalg.inv(c) @ dx.T
-                logp[j] = (np.log(w[j]) - np.log(np.diag(c)).sum()
-                           - 0.5 * (zz * zz).sum(axis=0))
-            norm = scipy.special.logsumexp(logp, axis=0)
+            dx = x[None] - mu[:, None]                              # (K, n, d)
+            covs = ((resp[:, :, None] * dx).transpose(0, 2, 1) @ dx) / nk[:, None, None] \
+                + np.diag(ridge)
+            try:
+                c = np.linalg.cholesky(covs)
+            except np.linalg.LinAlgError:
+                return None
+            zz = np.linalg.inv(c) @ dx.transpose(0, 2, 1)          # (K, d, n)
+            logp = (np.log(w) - np.log(np.diagonal(c, axis1=1, axis2=2)).sum(axis=1))[:, None] \
+                - 0.5 * (zz * zz).sum(axis=1)
+            top = logp.max(axis=0)
+            norm = top + np.log(np.exp(logp - top).sum(axis=0))
             resp = np.exp(logp - norm)
             ll = float(np.mean(norm))
             if ll - ll_prev < tol:        # EM converged (mean log-likelihood per sample)

@@ -20,7 +20,7 @@ test: $(STAMP)
 report: $(STAMP)
 	$(VENV)/bin/microcyl report $(if $(wildcard fits/measured.json),--measured fits)
 
-# fits of the RGL felts and CUReT fabrics (about 1.5 h on 2 cores; resumable: run it again)
+# fits of the RGL felts and CUReT fabrics (about 17 min on 2 cores; resumable: run it again)
 fits: $(STAMP)
 	$(VENV)/bin/microcyl fit-measured -o fits
 

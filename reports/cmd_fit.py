@@ -4,7 +4,8 @@
 
 The preset gives the fixed values and the starting point. Writes ``DIR/results.json`` and
 ``DIR/results.csv`` (medians, 68%/95% intervals, tau, R-hat, ESS, verdict), the plots, and the
-checkpoints ``DIR/chains_<k>.h5``; the same command run again resumes from them.
+checkpoint ``DIR/checkpoint.h5``; the same command run again resumes from it. The work is
+:func:`analysis.fit.fit_fabric`; this module parses the arguments and prints.
 """
 
 from __future__ import annotations

@@ -40,5 +40,10 @@ def test_readme_example_runs(k, tmp_path, monkeypatch, shared_data):
     if "analysis.albedo" in code:             # the reflectance is physical and bounded
         assert np.all((ns["r"].value > 0) & (ns["r"].value < 1))
         assert np.all(ns["r"].error < 1e-3)
+    if "fit_fabric" in code:                  # the fit wrote its results; velvet's gamma_s
+        import json                            # (6 deg in Table II) inside its 95% interval
+        doc = json.loads((tmp_path / "velvet_fit" / "results.json").read_text())
+        g = doc["parameters"]["gamma_s1"]
+        assert g["lo95"] < 6.0 < g["hi95"] and ns["result"].names == ("gamma_s1", "kd1")
     if "plot_polar_lobe" in code:
         assert (tmp_path / "lobe.png").stat().st_size > 1000

@@ -18,10 +18,31 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ReciprocityResult", "reciprocity", "reciprocity_report", "random_pairs", "LUMINANCE"]
+__all__ = ["ReciprocityResult", "reciprocity", "reciprocity_report", "random_pairs", "LUMINANCE",
+           "relative_asymmetry"]
 
 #: Rec. ITU-R BT.709 luminance weights of linear RGB.
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+def relative_asymmetry(a, b) -> np.ndarray:
+    """The reciprocity error of microcyl, r = |a - b| / max(|a|, |b|), elementwise.
+
+    ``a`` = f(wi, wo) and ``b`` = f(wo, wi) in any one unit (1/sr); r is unitless, in [0, 1]
+    for non-negative values (1 where one of the two is 0). NaN where both are 0 or either is
+    not finite: such pairs say nothing about reciprocity. The report's maps and the pair
+    statistics of :func:`reciprocity` both use this definition.
+
+    Examples
+    --------
+    >>> relative_asymmetry([1.0, 0.0, 2.0, 0.0], [0.5, 0.0, 2.0, 3.0]).tolist()
+    [0.5, nan, 0.0, 1.0]
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    big = np.maximum(np.abs(a), np.abs(b))
+    ok = np.isfinite(a) & np.isfinite(b) & (big > 0)
+    return np.divide(np.abs(a - b), big, out=np.full(np.shape(big), np.nan), where=ok)
+
 
 _CHANNELS = {"luminance": None, "r": 0, "g": 1, "b": 2, 0: 0, 1: 1, 2: 2}
 
@@ -187,10 +208,7 @@ def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance"
     finite = np.isfinite(a) & np.isfinite(b)
     zero = finite & (a == 0) & (b == 0)
     inc = finite & ~zero
-    with np.errstate(all="ignore"):
-        r = np.abs(a - b) / np.maximum(a, b)
-    # a negative value (invalid BRDF) can make the ratio meaningless: clip into [0, inf)
-    r = np.where(inc, np.abs(r), np.nan)
+    r = relative_asymmetry(a, b)
     ri = r[inc]
     if ri.size:
         med, p95, mx, mean = (float(np.median(ri)), float(np.percentile(ri, 95)),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from analysis.reciprocity import relative_asymmetry
 from reports._plotting import eval_brdf, finish, from_angles, new_axes
 
 __all__ = ["reciprocity_map", "plot_reciprocity_map"]
@@ -28,8 +29,9 @@ def reciprocity_map(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45, quantit
     -------
     theta_deg : numpy.ndarray, shape (resolution,)
     error : numpy.ndarray, shape (resolution, resolution)
-        error[i, o] = |f(wi, wo) - f(wo, wi)| / max(f(wi, wo), f(wo, wi)) (unitless, 0 where
-        both are 0), rows theta_i, columns theta_o.
+        error[i, o] = :func:`analysis.reciprocity.relative_asymmetry` of f(wi, wo) and
+        f(wo, wi) (unitless, 0 where both are 0, NaN where one is not finite), rows theta_i,
+        columns theta_o.
     """
     if quantity not in ("luminance", "rgb"):
         raise ValueError(f"quantity must be 'luminance' or 'rgb'; got {quantity!r}")
@@ -45,8 +47,8 @@ def reciprocity_map(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45, quantit
     if quantity == "luminance":
         from reports.colour import luminance
         a, b = luminance(a), luminance(b)
-    big = np.maximum(np.abs(a), np.abs(b))
-    err = np.divide(np.abs(a - b), big, out=np.zeros_like(big), where=big > 0)
+    err = relative_asymmetry(a, b)
+    err[(a == 0) & (b == 0)] = 0.0          # both zero: drawn as reciprocal
     if quantity == "rgb":
         err = err.max(axis=-1)
     return theta, err

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from brdf.frames import to_angles
+
 __all__ = ["ReciprocityResult", "reciprocity", "reciprocity_report", "random_pairs", "LUMINANCE",
            "relative_asymmetry"]
 
@@ -121,9 +123,9 @@ def random_pairs(n: int, seed=0) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _angles_deg(w):
-    theta = np.degrees(np.arccos(np.clip(w[..., 2], -1, 1)))
-    phi = np.degrees(np.arctan2(w[..., 1], w[..., 0])) % 360.0
-    return theta, phi
+    """theta in [0, 180] and phi in [0, 360) degrees (the worst pairs' report)."""
+    theta, phi = to_angles(w)
+    return np.degrees(theta), np.degrees(phi) % 360.0
 
 
 def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance",

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from brdf.frames import from_angles, to_angles
+
 __all__ = ["SanityResult", "sanity_scan", "edge_pairs"]
 
 _EPS_DEG = (1e-9, 1e-6, 1e-3, 0.1)
@@ -52,9 +54,7 @@ class SanityResult:
 
 
 def _dirs(theta_deg, phi_deg):
-    t, p = np.radians(theta_deg), np.radians(phi_deg)
-    s = np.sin(t)
-    return np.stack([s * np.cos(p), s * np.sin(p), np.cos(t)], axis=-1)
+    return from_angles(np.radians(theta_deg), np.radians(phi_deg))
 
 
 def edge_pairs(offsets_deg=(-90.0, -45.0, 0.0, 45.0, 90.0)) -> dict[str, tuple]:
@@ -127,9 +127,8 @@ def edge_pairs(offsets_deg=(-90.0, -45.0, 0.0, 45.0, 90.0)) -> dict[str, tuple]:
 
 
 def _angles(w):
-    th = np.degrees(np.arccos(np.clip(w[..., 2], -1, 1)))
-    ph = np.degrees(np.arctan2(w[..., 1], w[..., 0])) % 360.0
-    return th, ph
+    th, ph = to_angles(w)
+    return np.degrees(th), np.degrees(ph) % 360.0
 
 
 def _check(brdf, pname, dname, wi, wo, n_examples, below=False):

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf.frames import from_angles
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.table import Table
@@ -31,19 +32,6 @@ __all__ = ["read_exr", "write_exr", "from_angles", "meta_to_json"]
 FORMAT = "microcyl-table/1"
 _MAGIC = b"\x76\x2f\x31\x01"
 ANGLE_CHANNELS = ("theta_i", "phi_i", "theta_o", "phi_o")
-
-
-def from_angles(theta, phi) -> np.ndarray:
-    """Unit vectors (..., 3) from polar angle ``theta`` and azimuth ``phi`` in radians.
-
-    Examples
-    --------
-    >>> from_angles(np.pi / 2, 0.0).round(12)
-    array([1., 0., 0.])
-    """
-    theta, phi = np.broadcast_arrays(np.asarray(theta, np.float64), np.asarray(phi, np.float64))
-    s = np.sin(theta)
-    return np.stack([s * np.cos(phi), s * np.sin(phi), np.cos(theta)], axis=-1)
 
 
 def _jsonable(x):

@@ -35,6 +35,14 @@ from typing import Any
 
 import numpy as np
 
+from brdf.frames import (directions_to_half_diff, directions_to_plane, from_angles,
+                         half_diff_to_directions, plane_to_directions, rotate_z,
+                         to_angles)
+
+#: The frame helpers under the names gonio has always exported (:mod:`brdf.frames`).
+directions_from_angles = from_angles
+angles_from_directions = to_angles
+
 __all__ = [
     "Geometry",
     "full_grid",
@@ -63,203 +71,6 @@ SPEC_HELP = ("full:STEP[:PHI_STEP] | full:TI:PI:TO:PO | plane:{warp,weft,45,AZ}:
              "(angles in degrees)")
 
 _PLANE_NAMES = {"warp": 0.0, "weft": 90.0, "45": 45.0}
-
-
-# ----------------------------------------------------------------------------- angle helpers
-
-def directions_from_angles(theta, phi) -> np.ndarray:
-    """Unit vectors from polar and azimuth angles.
-
-    Parameters
-    ----------
-    theta, phi : array_like
-        Polar angle from n = +z and azimuth from +x toward +y, in radians; broadcast together.
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        (sin theta cos phi, sin theta sin phi, cos theta).
-
-    Examples
-    --------
-    >>> directions_from_angles(np.pi / 2, np.pi / 2).round(12)
-    array([0., 1., 0.])
-    """
-    theta, phi = np.broadcast_arrays(np.asarray(theta, float), np.asarray(phi, float))
-    s = np.sin(theta)
-    return np.stack([s * np.cos(phi), s * np.sin(phi), np.cos(theta)], axis=-1)
-
-
-def angles_from_directions(w) -> tuple[np.ndarray, np.ndarray]:
-    """Polar angle and azimuth (radians) of (..., 3) directions; phi in (-pi, pi].
-
-    Examples
-    --------
-    >>> t, p = angles_from_directions([0.0, -1.0, 0.0])
-    >>> float(np.degrees(t)), float(np.degrees(p))
-    (90.0, -90.0)
-    """
-    w = np.asarray(w, float)
-    w = w / np.linalg.norm(w, axis=-1, keepdims=True)
-    return np.arccos(np.clip(w[..., 2], -1.0, 1.0)), np.arctan2(w[..., 1], w[..., 0])
-
-
-def rotate_z(w, angle) -> np.ndarray:
-    """Rotate (..., 3) vectors by ``angle`` (radians, broadcast) about +z, counter-clockwise.
-
-    Examples
-    --------
-    >>> rotate_z([1.0, 0.0, 0.0], np.pi / 2).round(12)
-    array([0., 1., 0.])
-    """
-    w = np.asarray(w, float)
-    c, s = np.cos(angle), np.sin(angle)
-    x, y = w[..., 0], w[..., 1]
-    return np.stack(np.broadcast_arrays(c * x - s * y, s * x + c * y, w[..., 2]), axis=-1)
-
-
-def _rotate_y(w, angle) -> np.ndarray:
-    """Rotate (..., 3) vectors by ``angle`` (radians) about +y (right hand: z toward x)."""
-    c, s = np.cos(angle), np.sin(angle)
-    x, z = w[..., 0], w[..., 2]
-    return np.stack(np.broadcast_arrays(c * x + s * z, w[..., 1], -s * x + c * z), axis=-1)
-
-
-def half_diff_to_directions(theta_h, phi_h, theta_d, phi_d) -> tuple[np.ndarray, np.ndarray]:
-    """Rusinkiewicz (1998) half/difference angles to a pair of directions.
-
-    Parameters
-    ----------
-    theta_h, phi_h : array_like
-        Polar angle and azimuth of the half vector h = (wi + wo) / |wi + wo|, radians.
-    theta_d, phi_d : array_like
-        Polar angle and azimuth of the difference vector d, radians: wi expressed in the frame
-        where h is the pole.
-
-    Returns
-    -------
-    wi, wo : ndarray, shape (..., 3)
-        wi = R_z(phi_h) R_y(theta_h) d and wo = R_z(phi_h) R_y(theta_h) d', where d' is d
-        turned by 180 degrees about the pole (d'_x = -d_x, d'_y = -d_y), so that wi + wo is
-        parallel to h.
-
-    Notes
-    -----
-    This is the inverse of :func:`directions_to_half_diff`, which follows Rusinkiewicz:
-    d = R_y(-theta_h) R_z(-phi_h) wi (rotate by -phi_h about n, then by -theta_h about the
-    binormal), as in MERL's reference code ``std_coords_to_half_diff_coords`` (there d comes
-    from its first, "in", direction).
-
-    Examples
-    --------
-    >>> wi, wo = half_diff_to_directions(0.0, 0.0, np.pi / 4, 0.0)
-    >>> wi.round(6), wo.round(6)
-    (array([0.707107, 0.      , 0.707107]), array([-0.707107,  0.      ,  0.707107]))
-    """
-    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(
-        *(np.asarray(a, float) for a in (theta_h, phi_h, theta_d, phi_d)))
-    d = directions_from_angles(theta_d, phi_d)
-    dp = d * np.array([-1.0, -1.0, 1.0])
-    wi = rotate_z(_rotate_y(d, theta_h), phi_h)
-    wo = rotate_z(_rotate_y(dp, theta_h), phi_h)
-    return wi, wo
-
-
-def directions_to_half_diff(wi, wo) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Rusinkiewicz (1998) half/difference angles of direction pairs.
-
-    Parameters
-    ----------
-    wi, wo : array_like, shape (..., 3)
-        Directions (normalized here).
-
-    Returns
-    -------
-    theta_h, phi_h, theta_d, phi_d : ndarray
-        Radians; theta in [0, pi], phi in (-pi, pi]. Where theta_h = 0, phi_h = 0 and phi_d
-        carries the azimuth; where theta_d = 0, phi_d is 0.
-
-    Notes
-    -----
-    h = (wi + wo) / |wi + wo|; d = R_y(-theta_h) R_z(-phi_h) wi.
-
-    Examples
-    --------
-    >>> wi, wo = half_diff_to_directions(0.3, 1.0, 0.5, -2.0)
-    >>> np.round(directions_to_half_diff(wi, wo), 12).tolist()
-    [0.3, 1.0, 0.5, -2.0]
-    """
-    wi = np.asarray(wi, float)
-    wo = np.asarray(wo, float)
-    wi = wi / np.linalg.norm(wi, axis=-1, keepdims=True)
-    wo = wo / np.linalg.norm(wo, axis=-1, keepdims=True)
-    h = wi + wo
-    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
-    theta_h, phi_h = angles_from_directions(h)
-    phi_h = np.where(np.hypot(h[..., 0], h[..., 1]) < 1e-12, 0.0, phi_h)
-    d = _rotate_y(rotate_z(wi, -phi_h), -theta_h)
-    theta_d, phi_d = angles_from_directions(d)
-    phi_d = np.where(np.hypot(d[..., 0], d[..., 1]) < 1e-12, 0.0, phi_d)
-    return theta_h, phi_h, theta_d, phi_d
-
-
-def plane_to_directions(theta_i, theta_o, azimuth=0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Signed in-plane angles to directions, for a plane of incidence at ``azimuth``.
-
-    Parameters
-    ----------
-    theta_i, theta_o : array_like
-        Signed polar angles, radians, in (-pi/2, pi/2). theta_i > 0 puts wi at azimuth
-        ``azimuth``; theta_o > 0 puts wo on the opposite side (azimuth + pi, the specular
-        side), so theta_o = theta_i is the mirror direction and theta_o = -theta_i is
-        back-scatter (wo = wi).
-    azimuth : float or array_like
-        Azimuth of the plane, radians (0: along the warp, pi/2: along the weft).
-
-    Returns
-    -------
-    wi, wo : ndarray, shape (..., 3)
-
-    Examples
-    --------
-    >>> wi, wo = plane_to_directions(np.pi / 4, np.pi / 4)
-    >>> wi.round(6), wo.round(6)
-    (array([0.707107, 0.      , 0.707107]), array([-0.707107,  0.      ,  0.707107]))
-    """
-    wi = directions_from_angles(theta_i, azimuth)
-    wo = directions_from_angles(theta_o, np.asarray(azimuth, float) + np.pi)
-    return wi, wo
-
-
-def directions_to_plane(wi, wo, azimuth=0.0, *, atol=1e-9) -> tuple[np.ndarray, np.ndarray]:
-    """Signed in-plane angles (radians) of direction pairs lying in a plane of incidence.
-
-    The inverse of :func:`plane_to_directions`.
-
-    Raises
-    ------
-    ValueError
-        If a direction lies off the plane by more than ``atol`` (sine of the angle).
-
-    Examples
-    --------
-    >>> wi, wo = plane_to_directions(0.2, -0.7, np.pi / 2)
-    >>> np.round(directions_to_plane(wi, wo, np.pi / 2), 12).tolist()
-    [0.2, -0.7]
-    """
-    p = np.stack(np.broadcast_arrays(np.cos(azimuth), np.sin(azimuth), 0.0 * np.asarray(azimuth)),
-                 axis=-1)
-    q = rotate_z(p, np.pi / 2)
-    out = []
-    for name, w, sign in (("wi", wi, 1.0), ("wo", wo, -1.0)):
-        w = np.asarray(w, float)
-        w = w / np.linalg.norm(w, axis=-1, keepdims=True)
-        off = np.abs(np.sum(w * q, axis=-1))
-        if np.any(off > atol):
-            raise ValueError(f"{name} lies off the plane at azimuth {np.degrees(azimuth)} deg "
-                             f"(largest |sin| off the plane: {float(np.max(off)):.3g})")
-        out.append(np.arctan2(sign * np.sum(w * p, axis=-1), w[..., 2]))
-    return out[0], out[1]
 
 
 # ----------------------------------------------------------------------------- the class
@@ -481,8 +292,8 @@ class Geometry:
                                                   atol=1e-5)))
         else:
             kind = kind if kind in ("full", "pairs") else "pairs"
-            ti, pi_ = angles_from_directions(wi)
-            to, po = angles_from_directions(wo)
+            ti, pi_ = to_angles(wi)
+            to, po = to_angles(wo)
             coords = {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}
         index = None
         if kind == "merl":
@@ -582,8 +393,8 @@ def full_grid(theta_step: float = 10.0, phi_step: float | None = None, *,
     PI = np.repeat(pi_, to.size)
     TO = np.tile(to, ti.size)
     PO = np.tile(po, ti.size)
-    wi = directions_from_angles(TI, PI)
-    wo = directions_from_angles(TO, PO)
+    wi = from_angles(TI, PI)
+    wo = from_angles(TO, PO)
     params = {"theta_i_step": ti_s, "phi_i_step": pi_s, "theta_o_step": to_s, "phi_o_step": po_s}
     return _build("full", params, wi, wo,
                   {"theta_i": TI, "phi_i": PI, "theta_o": TO, "phi_o": PO}, rotation)
@@ -773,8 +584,8 @@ def pairs(wi, wo, *, rotation: float = 0.0, params: dict | None = None) -> Geome
     if not (np.all(np.isfinite(ni) & (ni > 0)) and np.all(np.isfinite(no) & (no > 0))):
         raise ValueError("wi and wo must hold finite, non-zero directions")
     wi, wo = wi / ni, wo / no
-    ti, pi_ = angles_from_directions(wi)
-    to, po = angles_from_directions(wo)
+    ti, pi_ = to_angles(wi)
+    to, po = to_angles(wo)
     return _build("pairs", dict(params or {}), wi, wo,
                   {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}, rotation)
 
@@ -815,8 +626,8 @@ def pairs_from_angles(theta_i, phi_i, theta_o, phi_o, *, degrees: bool = True,
     if degrees:
         arrs = [np.radians(a) for a in arrs]
     ti, pi_, to, po = arrs
-    wi = directions_from_angles(ti, pi_)
-    wo = directions_from_angles(to, po)
+    wi = from_angles(ti, pi_)
+    wo = from_angles(to, po)
     return _build("pairs", dict(params or {}), wi, wo,
                   {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}, rotation)
 

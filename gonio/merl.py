@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf.frames import from_angles, rotate_y, rotate_z
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing
@@ -35,15 +36,6 @@ SHAPE = (90, 90, 180)
 N = 90 * 90 * 180
 SCALE = np.array([1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0])
 FILE_SIZE = 12 + 3 * 8 * N
-
-
-def _rot(v, axis, angle):
-    """Rotate vectors v (..., 3) about the z (axis=2) or y (axis=1) axis by angle (...)."""
-    c, s = np.cos(angle), np.sin(angle)
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    if axis == 2:
-        return np.stack([c * x - s * y, s * x + c * y, z], axis=-1)
-    return np.stack([c * x + s * z, y, -s * x + c * z], axis=-1)
 
 
 def half_diff(wi, wo):
@@ -66,7 +58,7 @@ def half_diff(wi, wo):
     h = h / np.linalg.norm(h, axis=-1, keepdims=True)
     theta_h = np.arccos(np.clip(h[..., 2], -1.0, 1.0))
     phi_h = np.arctan2(h[..., 1], h[..., 0])
-    d = _rot(_rot(wi, 2, -phi_h), 1, -theta_h)
+    d = rotate_y(rotate_z(wi, -phi_h), -theta_h)
     theta_d = np.arccos(np.clip(d[..., 2], -1.0, 1.0))
     phi_d = np.arctan2(d[..., 1], d[..., 0])
     return theta_h, phi_h, theta_d, phi_d
@@ -103,11 +95,9 @@ def merl_directions(i, j, k, phi_h=0.0):
     phi_d = np.radians(np.asarray(k, np.float64) + 0.5)
     theta_h, theta_d, phi_d, phi_h = np.broadcast_arrays(theta_h, theta_d, phi_d,
                                                          np.asarray(phi_h, np.float64))
-    sd = np.sin(theta_d)
-    d = np.stack([sd * np.cos(phi_d), sd * np.sin(phi_d), np.cos(theta_d)], axis=-1)
-    wi = _rot(_rot(d, 1, theta_h), 2, phi_h)
-    h = np.stack([np.sin(theta_h) * np.cos(phi_h), np.sin(theta_h) * np.sin(phi_h),
-                  np.cos(theta_h)], axis=-1)
+    d = from_angles(theta_d, phi_d)
+    wi = rotate_z(rotate_y(d, theta_h), phi_h)
+    h = from_angles(theta_h, phi_h)
     wo = 2.0 * np.sum(wi * h, axis=-1, keepdims=True) * h - wi
     return wi, wo
 

@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from brdf.frames import to_angles
+
 __all__ = ["Table"]
 
 
@@ -82,10 +84,8 @@ class Table:
 
         theta is the polar angle from n = +z; phi the azimuth from +x toward +y, in (-pi, pi].
         """
-        def tp(w):
-            return np.arccos(np.clip(w[:, 2], -1.0, 1.0)), np.arctan2(w[:, 1], w[:, 0])
-        ti, pi_ = tp(self.wi)
-        to, po = tp(self.wo)
+        ti, pi_ = to_angles(self.wi)
+        to, po = to_angles(self.wo)
         return np.stack([ti, pi_, to, po], axis=1)
 
     def replace(self, **changes) -> "Table":

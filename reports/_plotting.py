@@ -10,12 +10,12 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf.frames import half_diff_to_directions
 from gonio.atomic import atomic_write
 from reports.colour import CHANNEL_COLOURS, luminance
 
 __all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
-           "quantity_styles", "QUANTITIES", "check_quantity", "from_angles", "to_angles",
-           "half_diff_to_io", "check_angle"]
+           "quantity_styles", "QUANTITIES", "check_quantity", "half_diff_to_io", "check_angle"]
 
 #: What a plot can show of an RGB f_r: its Rec. 709 luminance, each channel, or one channel.
 QUANTITIES = ("luminance", "rgb", "r", "g", "b")
@@ -130,40 +130,7 @@ def quantity_styles(quantity: str, colour=None):
     return [(k, CHANNEL_COLOURS[k], " " + "RGB"[k])]
 
 
-def from_angles(theta, phi) -> np.ndarray:
-    """Unit vectors (..., 3) from polar angle ``theta`` (from +z) and azimuth ``phi`` (from +x
-    toward +y), both in radians."""
-    theta = np.asarray(theta, dtype=np.float64)
-    phi = np.asarray(phi, dtype=np.float64)
-    st = np.sin(theta)
-    return np.stack(np.broadcast_arrays(st * np.cos(phi), st * np.sin(phi), np.cos(theta)), -1)
-
-
-def to_angles(w):
-    """(theta, phi) in radians of unit vectors (..., 3)."""
-    w = np.asarray(w, dtype=np.float64)
-    return np.arccos(np.clip(w[..., 2], -1.0, 1.0)), np.arctan2(w[..., 1], w[..., 0])
-
-
 def half_diff_to_io(theta_h, theta_d, phi_d, phi_h=0.0):
-    """Rusinkiewicz half/difference angles (radians) -> (wi, wo), each (..., 3).
-
-    Notes
-    -----
-    h = from_angles(theta_h, phi_h); the difference vector d = from_angles(theta_d, phi_d) is
-    expressed in the frame that takes +z to h: wi = R_z(phi_h) R_y(theta_h) d, and wo is wi
-    mirrored about h, wo = 2 (wi . h) h - wi (Rusinkiewicz 1998).
-    """
-    theta_h, theta_d, phi_d, phi_h = np.broadcast_arrays(
-        *(np.asarray(a, dtype=np.float64) for a in (theta_h, theta_d, phi_d, phi_h)))
-    d = from_angles(theta_d, phi_d)
-    ct, st = np.cos(theta_h), np.sin(theta_h)
-    # R_y(theta_h)
-    x1 = ct * d[..., 0] + st * d[..., 2]
-    y1 = d[..., 1]
-    z1 = -st * d[..., 0] + ct * d[..., 2]
-    cp, sp = np.cos(phi_h), np.sin(phi_h)
-    wi = np.stack([cp * x1 - sp * y1, sp * x1 + cp * y1, z1], axis=-1)
-    h = from_angles(theta_h, phi_h)
-    wo = 2.0 * np.sum(wi * h, axis=-1, keepdims=True) * h - wi
-    return wi, wo
+    """Rusinkiewicz half/difference angles (radians) -> (wi, wo), each (..., 3):
+    :func:`brdf.frames.half_diff_to_directions` with the plots' argument order."""
+    return half_diff_to_directions(theta_h, phi_h, theta_d, phi_d)

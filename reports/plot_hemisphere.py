@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import check_angle, eval_brdf, finish, from_angles, new_axes
+from brdf.frames import from_angles
+from reports._plotting import check_angle, eval_brdf, finish, new_axes
 from reports.colour import luminance, to_srgb
 
 __all__ = ["equal_area_grid", "equal_area_xy", "hemisphere_image", "plot_hemisphere"]

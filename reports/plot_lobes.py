@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import (check_angle, eval_brdf, finish, from_angles, new_axes,
+from brdf.frames import from_angles
+from reports._plotting import (check_angle, eval_brdf, finish, new_axes,
                                quantity_styles, reduce_quantity)
 from reports.colour import line_colour, luminance
 

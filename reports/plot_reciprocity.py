@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from analysis.reciprocity import relative_asymmetry
-from reports._plotting import eval_brdf, finish, from_angles, new_axes
+from brdf.frames import from_angles
+from reports._plotting import eval_brdf, finish, new_axes
 
 __all__ = ["reciprocity_map", "plot_reciprocity_map"]
 

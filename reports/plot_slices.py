@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import (check_angle, eval_brdf, finish, from_angles, half_diff_to_io,
+from brdf.frames import from_angles
+from reports._plotting import (check_angle, eval_brdf, finish, half_diff_to_io,
                                new_axes, quantity_styles, reduce_quantity, check_quantity)
 from reports.colour import line_colour, luminance
 

@@ -365,7 +365,7 @@ def _sec_energy(p: _Page) -> str:
             res = curve_fn(p.fabric, theta, np.array(phis))
             value, error = np.asarray(res.value), np.asarray(res.error)       # (T, P, 3)
         else:
-            from reports._plotting import from_angles
+            from brdf.frames import from_angles
             T, P = np.meshgrid(np.radians(theta), np.radians(phis), indexing="ij")
             res = albedo_fn(p.fabric, from_angles(T, P))
             value, error = np.asarray(res.value), np.asarray(res.error)

@@ -15,7 +15,7 @@ import numpy as np
 
 from analysis import diagnostics
 
-__all__ = ["Criteria", "Diagnosis", "diagnose"]
+__all__ = ["Criteria", "Diagnosis", "diagnose", "finite_min", "finite_max"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,9 +81,23 @@ class Diagnosis:
                           f"{c.rhat_max:g}")
         stuck = ("; tau undefined for some parameter (a walker did not move)"
                  if np.any(~np.isfinite(self.tau)) else "")
-        return False, (f"min N/tau {np.nanmin(ratio):.1f} (need > {c.min_ratio:g}), tau change "
-                       f"{100 * dtau:.1f}% (need < {100 * c.tau_tol:g}%), max R-hat "
-                       f"{np.nanmax(self.rhat):.3f} (need < {c.rhat_max:g}){stuck}")
+        return False, (f"min N/tau {finite_min(ratio):.1f} (need > {c.min_ratio:g}), tau "
+                       f"change {100 * dtau:.1f}% (need < {100 * c.tau_tol:g}%), max R-hat "
+                       f"{finite_max(self.rhat):.3f} (need < {c.rhat_max:g}){stuck}")
+
+
+def finite_min(x) -> float:
+    """Smallest finite value of x, NaN when there is none (no warning)."""
+    x = np.asarray(x, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    return float(x.min()) if x.size else float("nan")
+
+
+def finite_max(x) -> float:
+    """Largest finite value of x, NaN when there is none (no warning)."""
+    x = np.asarray(x, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    return float(x.max()) if x.size else float("nan")
 
 
 def diagnose(chains, burn_fraction: float, last_refit: int = 0) -> Diagnosis:

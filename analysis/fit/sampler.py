@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from analysis.fit.convergence import Criteria, Diagnosis, diagnose
+from analysis.fit.convergence import Diagnosis, diagnose, finite_max, finite_min
 from analysis.fit.ensemble import Chain, EnsembleRunner
 from analysis.fit.moves import (EnsembleMoves, Proposal, initial_proposal, refit,
                                 refit_schedule)
@@ -197,8 +197,8 @@ class FitSampler:
                 self._last_check, dtau = diag.step, diag.tau_change(self.tau_prev)
                 self.tau_prev = diag.tau
                 if postfix is not None:
-                    postfix({"min N/tau": f"{diag.ratio.min():.1f}", "dtau": f"{dtau:.3f}",
-                             "max R-hat": f"{np.nanmax(diag.rhat):.3f}"})
+                    postfix({"min N/tau": f"{finite_min(diag.ratio):.1f}",
+                             "dtau": f"{dtau:.3f}", "max R-hat": f"{finite_max(diag.rhat):.3f}"})
                 if ok:
                     break
                 if diag.step >= o.max_steps:

@@ -10,7 +10,8 @@ import numpy as np
 
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
-from gonio.exr import _jsonable, count_missing, from_angles
+from gonio.exr import count_missing, from_angles
+from gonio.jsonplain import plain
 from gonio.table import Table
 
 __all__ = ["read_csv", "write_csv"]
@@ -67,7 +68,7 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
                 "comment lines start with #\n")
         for key, value in table.meta.items():
             if _KEY.match(f"{key}: x"):
-                f.write(f"# {key}: {json.dumps(value, default=_jsonable)}\n")
+                f.write(f"# {key}: {json.dumps(plain(value))}\n")
         f.write(",".join(cols) + "\n")
         for row in data:
             f.write(",".join(fmt % x if np.isfinite(x) else ("nan" if np.isnan(x) else

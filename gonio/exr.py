@@ -25,6 +25,7 @@ import numpy as np
 from brdf.frames import from_angles
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
+from gonio.jsonplain import plain
 from gonio.table import Table
 
 __all__ = ["read_exr", "write_exr", "from_angles", "meta_to_json"]
@@ -34,19 +35,9 @@ _MAGIC = b"\x76\x2f\x31\x01"
 ANGLE_CHANNELS = ("theta_i", "phi_i", "theta_o", "phi_o")
 
 
-def _jsonable(x):
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, (Path, os.PathLike)):
-        return os.fspath(x)
-    return str(x)
-
-
 def meta_to_json(meta: dict) -> str:
     """The meta dict as compact JSON (numpy scalars and arrays become numbers and lists)."""
-    return json.dumps(meta, default=_jsonable, sort_keys=True, allow_nan=True)
+    return json.dumps(plain(meta), sort_keys=True, allow_nan=True)
 
 
 def count_missing(values: np.ndarray) -> int:

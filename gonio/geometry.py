@@ -38,6 +38,7 @@ import numpy as np
 from brdf.frames import (directions_to_half_diff, directions_to_plane, from_angles,
                          half_diff_to_directions, plane_to_directions, rotate_z,
                          to_angles)
+from gonio.jsonplain import plain
 
 #: The frame helpers under the names gonio has always exported (:mod:`brdf.frames`).
 directions_from_angles = from_angles
@@ -74,19 +75,6 @@ _PLANE_NAMES = {"warp": 0.0, "weft": 90.0, "45": 45.0}
 
 
 # ----------------------------------------------------------------------------- the class
-
-def _jsonable(value):
-    """Convert numpy scalars/arrays and tuples in a params dict to plain Python."""
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Geometry:
@@ -158,10 +146,10 @@ class Geometry:
         object.__setattr__(self, "wi_lab", wi)
         object.__setattr__(self, "wo_lab", wo)
         object.__setattr__(self, "coords", coords)
-        object.__setattr__(self, "params", _jsonable(dict(self.params)))
+        object.__setattr__(self, "params", plain(dict(self.params)))
         object.__setattr__(self, "rotation", rotation)
         object.__setattr__(self, "index", index)
-        object.__setattr__(self, "info", _jsonable(info))
+        object.__setattr__(self, "info", plain(info))
 
     def __len__(self) -> int:
         return self.wi_lab.shape[0]

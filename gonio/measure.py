@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
-import math
 import sys
 from typing import Any
 
@@ -11,6 +9,7 @@ import numpy as np
 
 from gonio.geometry import Geometry, from_spec, rotate_z
 from gonio.instrument import Instrument, cone_directions
+from gonio.jsonplain import plain
 from gonio.table import Table
 
 __all__ = ["measure", "toolkit_version", "describe_brdf"]
@@ -40,28 +39,6 @@ def toolkit_version() -> str:
         return "unknown"
 
 
-def _plain(value, depth: int = 0):
-    """A JSON-serializable version of ``value`` (dataclasses, numpy, tuples become plain)."""
-    if depth > 6:
-        return repr(value)
-    if value is None or isinstance(value, (bool, int, str)):
-        return value
-    if isinstance(value, float):
-        return value if math.isfinite(value) else repr(value)
-    if isinstance(value, np.generic):
-        return _plain(value.item(), depth)
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist(), depth)
-    if isinstance(value, dict):
-        return {str(k): _plain(v, depth + 1) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v, depth + 1) for v in value]
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name), depth + 1)
-                for f in dataclasses.fields(value)}
-    return repr(value)
-
-
 def describe_brdf(brdf) -> dict[str, Any]:
     """What is being measured, as a JSON-serializable dict.
 
@@ -81,7 +58,7 @@ def describe_brdf(brdf) -> dict[str, Any]:
     for attr in ("name", "preset", "options", "threads", "params"):
         v = getattr(brdf, attr, None)
         if v is not None and not callable(v):
-            d[attr] = _plain(v)
+            d[attr] = plain(v, nonfinite="repr")
     return d
 
 

@@ -40,6 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from gonio.atomic import atomic_write, file_mode
+from gonio.jsonplain import plain
 
 __all__ = ["build_report", "SECTIONS", "QUALITIES", "Unavailable", "check_output_dir"]
 
@@ -101,25 +102,14 @@ def check_output_dir(out_dir) -> Path:
     return out
 
 
+def _plain(obj):
+    """Strict-JSON data of ``obj`` (NaN and infinities as null): :func:`gonio.jsonplain.plain`."""
+    return plain(obj, nonfinite="null")
+
+
 def _atomic_write(path: Path, data: bytes | str) -> None:
     with atomic_write(path, "w" if isinstance(data, str) else "wb") as fh:
         fh.write(data)
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, (np.floating, float)):
-        return float(obj) if np.isfinite(obj) else None
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.bool_,)):
-        return bool(obj)
-    return obj
 
 
 # --------------------------------------------------------------------------- page context
@@ -155,7 +145,7 @@ class _Page:
                 f'</figcaption></figure>')
 
     def json(self, filename: str, data) -> str:
-        _atomic_write(self.path(filename), json.dumps(_jsonable(data), indent=1))
+        _atomic_write(self.path(filename), json.dumps(_plain(data), indent=1))
         return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
 
     def csv(self, filename: str, header: list[str], rows) -> str:
@@ -214,8 +204,8 @@ _THREAD_FIELDS = ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area", "offsets"
 def _parameters(fab) -> dict:
     threads = []
     for t in getattr(fab, "threads", ()) or ():
-        threads.append({f: _jsonable(getattr(t, f, None)) for f in _THREAD_FIELDS})
-    return {"threads": threads, "options": _jsonable(dict(getattr(fab, "options", {}) or {}))}
+        threads.append({f: _plain(getattr(t, f, None)) for f in _THREAD_FIELDS})
+    return {"threads": threads, "options": _plain(dict(getattr(fab, "options", {}) or {}))}
 
 
 def _sec_parameters(p: _Page) -> str:
@@ -428,7 +418,7 @@ def _sec_reciprocity(p: _Page) -> str:
         out.append(f"<p>Statistics over random pairs: not available (analysis.reciprocity "
                    f"failed: {html.escape(type(exc).__name__)}: {html.escape(str(exc))}).</p>")
         return "".join(out)
-    stats = {k: _jsonable(getattr(res, k)) for k in ("median", "p95", "max")
+    stats = {k: _plain(getattr(res, k)) for k in ("median", "p95", "max")
              if hasattr(res, k)}
     p.summary["reciprocity"] = stats
     out.append("<p>Over random pairs (analysis.reciprocity): "
@@ -786,7 +776,7 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
                "fabrics": summaries, "seconds": round(time.perf_counter() - t_start, 2)}
         if measured_summary is not None:
             doc["measured"] = measured_summary
-        _atomic_write(tmp / "summary.json", json.dumps(_jsonable(doc), indent=1))
+        _atomic_write(tmp / "summary.json", json.dumps(_plain(doc), indent=1))
         _atomic_write(tmp / _MARKER, "microcyl report folder: replaced whole by the next run\n")
         _swap_into_place(tmp, out)
     except BaseException:

@@ -18,24 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from gonio import atomic_write
+from gonio.jsonplain import plain
 
-__all__ = ["FitFolder", "table_digest", "json_plain", "CONFIG_FILE", "CHECKPOINT_FILE"]
+__all__ = ["FitFolder", "table_digest", "CONFIG_FILE", "CHECKPOINT_FILE"]
 
 CONFIG_FILE = "fit_config.json"
 CHECKPOINT_FILE = "checkpoint.h5"
-
-
-def json_plain(o):
-    """``json.dumps`` default: numpy arrays and scalars as lists and numbers, else str."""
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
-        return o.item()
-    return str(o)
-
-
-def _plain(doc):
-    return json.loads(json.dumps(doc, default=json_plain))
 
 
 def table_digest(table) -> str:
@@ -80,7 +68,7 @@ class FitFolder:
         except (ValueError, KeyError, TypeError) as exc:
             raise ValueError(f"{self.config_path}: corrupt fit configuration ({exc}); delete "
                              f"the folder to start again") from None
-        config = _plain(config)
+        config = plain(config)
         if config != stored_cfg:
             diff = sorted(k for k in set(config) | set(stored_cfg)
                           if config.get(k) != stored_cfg.get(k))
@@ -95,7 +83,7 @@ class FitFolder:
         """Store the configuration and the point estimate."""
         doc = {"config": config, "best": best, "best_logp": best_logp, "cov": cov}
         with atomic_write(self.config_path, "w") as fh:
-            fh.write(json.dumps(doc, indent=1, default=json_plain) + "\n")
+            fh.write(json.dumps(plain(doc), indent=1) + "\n")
 
     def read_checkpoint(self) -> dict | None:
         """The checkpoint: ``{"progress": dict, "ensembles": [dict of arrays, ...]}``, or None.
@@ -128,7 +116,7 @@ class FitFolder:
         import h5py
         with atomic_write(self.checkpoint_path, "wb") as fh:
             with h5py.File(fh, "w") as f:
-                f.attrs["progress"] = json.dumps(progress, default=json_plain)
+                f.attrs["progress"] = json.dumps(plain(progress))
                 f.attrs["ensembles"] = len(ensembles)
                 for k, doc in enumerate(ensembles):
                     _write_node(f.create_group(f"ensemble_{k}"), doc)

@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from analysis import diagnostics
-from analysis.fit.checkpoint import json_plain
 from analysis.fit.quality import residuals
 from gonio import atomic_write
+from gonio.jsonplain import plain
 
 __all__ = ["FitResult", "write_results", "read_results", "summarize", "SCHEMA_VERSION", "SUMMARY_COLUMNS"]
 
@@ -128,7 +128,7 @@ class FitResult:
                              if self.spec is not None else {}),
                     "proposal": self.proposal},
             "quality": quality, "plots": dict(self.plots)}
-        return json.loads(json.dumps(doc, default=json_plain))
+        return plain(doc)
 
 
 def summarize(spec, diag) -> dict:

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from analysis.albedo import albedo_hemispherical, run_tasks
+from gonio.progress import progress_bar
 
 __all__ = [
     "VARIANTS",
@@ -348,11 +349,8 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
               * len(scan_theta_deg) * len(scan_phi_deg)) if furnace else 0
     total = len(presets) * len(variants) * len(modes) * dirs.shape[0] + n_scan \
         + (len(presets) * 60 if hemispherical else 0)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=total, unit="albedo", desc="energy", leave=False)
-    tick = bar.update if bar is not None else None
+    bar = progress_bar(total, desc="energy", unit="albedo", enabled=progress)
+    tick = bar.update if progress else None
     try:
         keys, tasks = [], []
         for p, v, m in itertools.product(presets, variants, modes):

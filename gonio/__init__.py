@@ -2,6 +2,7 @@
 
 from gonio.alta import read_alta, write_alta
 from gonio.atomic import atomic_write
+from gonio.progress import progress_bar
 from gonio.jsonplain import plain
 from gonio.csvtable import read_csv, write_csv
 from gonio.curet import load_curet
@@ -19,7 +20,7 @@ from gonio.table import Table
 __all__ = [
     "Table", "FormatError", "read", "write", "load_rgl", "load_merl", "load_curet",
     "read_exr", "write_exr", "read_csv", "write_csv", "read_alta", "write_alta",
-    "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain",
+    "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "progress_bar",
     "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",
     "pairs", "pairs_from_angles",
 ]

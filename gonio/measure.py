@@ -10,6 +10,7 @@ import numpy as np
 from gonio.geometry import Geometry, from_spec, rotate_z
 from gonio.instrument import Instrument, cone_directions
 from gonio.jsonplain import plain
+from gonio.progress import progress_bar
 from gonio.table import Table
 
 __all__ = ["measure", "toolkit_version", "describe_brdf"]
@@ -181,10 +182,7 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
     values = np.empty((n, 3))
     wgt = (ws[:, None] * wd[None, :]).reshape(-1)
     rot = geometry.rotation
-    bar = None
-    if progress and n:
-        from tqdm import tqdm
-        bar = tqdm(total=n, unit="pair", desc="measure", file=sys.stderr, leave=False)
+    bar = progress_bar(n, desc="measure", unit="pair", enabled=bool(progress and n))
     try:
         for a in range(0, n, step):
             b = min(n, a + step)

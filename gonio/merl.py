@@ -27,6 +27,7 @@ from brdf.frames import from_angles, rotate_y, rotate_z
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing
+from gonio.progress import progress_bar
 from gonio.table import Table
 
 __all__ = ["MerlBRDF", "load_merl", "write_merl", "merl_table", "half_diff", "merl_index",
@@ -255,31 +256,35 @@ def _brdf_to_grid(brdf, rotations: int, chunk_rows: int, progress: bool) -> np.n
     grid = np.empty((3, N))
     phis = 2 * np.pi * np.arange(rotations) / rotations
     rows = range(0, 90, chunk_rows)
-    if progress:
-        from tqdm import tqdm
-        rows = tqdm(rows, desc="MERL rows", unit="chunk")
+    bar = progress_bar(len(rows), desc="MERL rows", unit="chunk", enabled=progress)
     jk = np.arange(90 * 180)
     j, k = jk // 180, jk % 180
-    for i0 in rows:
-        i1 = min(i0 + chunk_rows, 90)
-        i = np.repeat(np.arange(i0, i1), 90 * 180)
-        jj, kk = np.tile(j, i1 - i0), np.tile(k, i1 - i0)
-        # the horizon does not depend on the rotation about z: evaluate only bins above it
-        wi, wo = merl_directions(i, jj, kk, 0.0)
-        above = np.flatnonzero((wi[:, 2] > 0) & (wo[:, 2] > 0))
-        i, jj, kk = i[above], jj[above], kk[above]
-        acc = np.zeros((above.size, 3))
-        bad = np.zeros(above.size, bool)
-        for phi in phis:
-            wi, wo = merl_directions(i, jj, kk, phi)
-            f = np.asarray(brdf.eval(wi, wo), np.float64)
-            finite = np.all(np.isfinite(f), axis=1)
-            bad |= ~finite
-            acc += np.where(finite[:, None], f, 0.0)
-        vals = np.full((16200 * (i1 - i0), 3), -1.0)
-        vals[above] = np.where(bad[:, None], -1.0, acc / rotations)
-        grid[:, i0 * 16200:i1 * 16200] = vals.T
+    with bar:
+        for i0 in rows:
+            _grid_rows(brdf, grid, i0, min(i0 + chunk_rows, 90), phis, j, k, rotations)
+            bar.update()
     return grid
+
+
+def _grid_rows(brdf, grid, i0, i1, phis, j, k, rotations):
+    """Fill the MERL grid's theta_h rows i0..i1 (averaged over the rotations ``phis``)."""
+    i = np.repeat(np.arange(i0, i1), 90 * 180)
+    jj, kk = np.tile(j, i1 - i0), np.tile(k, i1 - i0)
+    # the horizon does not depend on the rotation about z: evaluate only bins above it
+    wi, wo = merl_directions(i, jj, kk, 0.0)
+    above = np.flatnonzero((wi[:, 2] > 0) & (wo[:, 2] > 0))
+    i, jj, kk = i[above], jj[above], kk[above]
+    acc = np.zeros((above.size, 3))
+    bad = np.zeros(above.size, bool)
+    for phi in phis:
+        wi, wo = merl_directions(i, jj, kk, phi)
+        f = np.asarray(brdf.eval(wi, wo), np.float64)
+        finite = np.all(np.isfinite(f), axis=1)
+        bad |= ~finite
+        acc += np.where(finite[:, None], f, 0.0)
+    vals = np.full((16200 * (i1 - i0), 3), -1.0)
+    vals[above] = np.where(bad[:, None], -1.0, acc / rotations)
+    grid[:, i0 * 16200:i1 * 16200] = vals.T
 
 
 def time_write(brdf, path, rotations: int = 8) -> float:

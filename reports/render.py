@@ -28,6 +28,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
+from gonio.progress import progress_bar
 from reports.imageio import write_exr, write_png
 from reports.scenes import SCENES, Scene, make_scene
 
@@ -312,16 +313,14 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     if probe.shape != (1, 3):
         raise ValueError(f"fabric.eval returned shape {probe.shape} for one pair; (1, 3) expected")
 
-    from tqdm.auto import tqdm
-
     ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
            "spp": int(spp), "seed": int(seed)}
     tiles = _tiles(width, height, tile)
     image = np.zeros((height, width, 3), np.float32)
     workers = min(workers, len(tiles))
     def new_bar():
-        return tqdm(total=len(tiles), unit="tile", desc=f"render {scene.name or 'scene'}",
-                    disable=not progress, leave=False)
+        return progress_bar(len(tiles), desc=f"render {scene.name or 'scene'}", unit="tile",
+                            enabled=progress)
 
     if workers == 1:
         with new_bar() as bar:

@@ -41,6 +41,7 @@ import numpy as np
 
 from gonio.atomic import atomic_write, file_mode
 from gonio.jsonplain import plain
+from gonio.progress import progress_bar
 
 __all__ = ["build_report", "SECTIONS", "QUALITIES", "Unavailable", "check_output_dir"]
 
@@ -714,7 +715,6 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     q["fit_results"] = {str(k): v for k, v in dict(fit_results or {}).items()}
 
     import brdf
-    from tqdm.auto import tqdm
 
     try:
         tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
@@ -726,8 +726,8 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
         os.chmod(tmp, file_mode(0o777))
         fabs = {n: (f if f is not None else brdf.fabric(n)) for n, f in resolved.items()}
         summaries: dict[str, dict] = {}
-        bar = tqdm(total=len(fabs) * len(sections) + 1, disable=not progress, unit="section",
-                   desc="report")
+        bar = progress_bar(len(fabs) * len(sections) + 1, desc="report", unit="section",
+                           enabled=progress)
         names = list(fabs)
         for name, fab in fabs.items():
             summary: dict[str, Any] = {"sections": {}}

@@ -24,6 +24,7 @@ from analysis.fit.results import FitResult, summarize
 from analysis.fit.sampler import FitSampler
 from analysis.likelihood import Likelihood
 from analysis.params import ParamSpec
+from gonio.progress import progress_bar
 
 __all__ = ["fit", "FitOptions", "CONFIG_VERSION"]
 
@@ -126,8 +127,7 @@ def _progress(progress, total: int, initial: int):
     if not progress:
         yield None, None
         return
-    from tqdm.auto import tqdm
-    bar = tqdm(total=total, initial=initial, desc="emcee", unit="step", leave=False)
+    bar = progress_bar(total, desc="emcee", unit="step", initial=initial)
 
     def tick(steps):
         bar.n = steps

@@ -280,7 +280,9 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
              f"{result.steps} steps (this run {entry['wall_s']:.0f} s); residual rms "
              f"{entry['quality']['rms_residual']:.3f}"
              + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
-                if entry["albedo_delta_e2000"] is not None else ""))
+                if entry["albedo_delta_e2000"] is not None else "")
+             + (f"; resumed from step {result.timing['resumed_from']}"
+                if result.timing.get("resumed_from") else ""))
     return doc
 
 

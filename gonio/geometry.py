@@ -39,6 +39,7 @@ from brdf.frames import (directions_to_half_diff, directions_to_plane, from_angl
                          half_diff_to_directions, plane_to_directions, rotate_z,
                          to_angles)
 from gonio.jsonplain import plain
+from gonio.merl import merl_index
 
 #: The frame helpers under the names gonio has always exported (:mod:`brdf.frames`).
 directions_from_angles = from_angles
@@ -285,10 +286,7 @@ class Geometry:
             coords = {"theta_i": ti, "phi_i": pi_, "theta_o": to, "phi_o": po}
         index = None
         if kind == "merl":
-            th = np.rint(90 * np.sqrt(coords["theta_h"] / (np.pi / 2))).astype(np.int64)
-            td = np.floor(np.degrees(coords["theta_d"])).astype(np.int64)
-            pd = np.floor(np.degrees(np.mod(coords["phi_d"], np.pi))).astype(np.int64)
-            index = np.clip(pd, 0, 179) + 180 * (np.clip(td, 0, 89) + 90 * np.clip(th, 0, 89))
+            index = merl_index(coords["theta_h"], coords["theta_d"], coords["phi_d"])
         return cls(wi, wo, coords, kind=kind, params=params, rotation=rotation, index=index,
                    info={k: g[k] for k in ("n_layout", "dropped_below_horizon") if k in g})
 
@@ -511,9 +509,12 @@ def merl(stride: int = 1, *, rotation: float = 0.0) -> Geometry:
     MERL's reference code (``BRDFRead.cpp``) indexes by truncation:
     theta_h index = floor(sqrt(theta_h / 90 deg) * 90), theta_d index = floor(theta_d / 1 deg),
     phi_d index = floor(phi_d / 1 deg) for phi_d in [0, 180) (phi_d + 180 folds onto phi_d).
-    Entry (i, j, k) is placed at theta_h = (i / 90)^2 * 90 deg (the node of bin i, as the
-    data README states), theta_d = j + 1/2 deg and phi_d = k + 1/2 deg (the centres of their
-    uniform bins, so that a truncating lookup of the placed directions finds (j, k) again).
+    Entry (i, j, k) is placed at the centre of its bin, as :mod:`gonio.merl` reads and writes
+    MERL files: theta_h = ((i + 1/2) / 90)^2 * 90 deg (the centre in the square-root mapped
+    coordinate), theta_d = j + 1/2 deg and phi_d = k + 1/2 deg, so that a truncating lookup of
+    the placed directions finds (i, j, k) again. (The lower node (i / 90)^2 * 90 deg sits on
+    the bin's edge, where round-off sends the lookup to the bin below about a third of the
+    time.)
     Pairs with a direction below the horizon are dropped (``index`` keeps the others' places).
 
     Examples
@@ -521,8 +522,8 @@ def merl(stride: int = 1, *, rotation: float = 0.0) -> Geometry:
     >>> g = merl(30)
     >>> g.info["n_layout"], sorted(set(g.index.tolist()))[:3]
     (54, [0, 30, 60])
-    >>> np.degrees(g.coords["theta_h"][g.index == 30 * 180 * 90]).round(6).tolist()
-    [10.0]
+    >>> np.degrees(g.coords["theta_h"][g.index == 30 * 180 * 90]).round(6).tolist()   # 30.5^2/90
+    [10.336111]
     """
     if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or not 1 <= stride <= 90:
         raise ValueError(f"MERL stride must be an integer in [1, 90]; got {stride!r}")
@@ -530,7 +531,7 @@ def merl(stride: int = 1, *, rotation: float = 0.0) -> Geometry:
     j = np.arange(0, 90, stride)
     k = np.arange(0, 180, stride)
     I, J, K = (a.reshape(-1) for a in np.meshgrid(i, j, k, indexing="ij"))
-    TH = np.radians((I / 90.0) ** 2 * 90.0)
+    TH = np.radians(((I + 0.5) / 90.0) ** 2 * 90.0)
     TD = np.radians(J + 0.5)
     PD = np.radians(K + 0.5)
     PH = np.zeros_like(TH)

@@ -176,11 +176,13 @@ def test_merl_layout_matches_reference_index():
     pdm = np.where(pd < 0, pd + np.pi, pd)
     i_pd = np.floor(pdm / np.pi * 360 / 2).astype(int)
     i_th_exact = np.sqrt(th / (np.pi / 2) * 90 * 90)
+    i_th = np.floor(i_th_exact).astype(int)
     expect_th, rest = np.divmod(g.index, 90 * 180)
     expect_td, expect_pd = np.divmod(rest, 180)
     assert np.array_equal(i_td, expect_td) and np.array_equal(i_pd, expect_pd)
-    # theta_h sits on the node (i / 90)^2 * 90 deg: the exact index is an integer
-    assert np.allclose(i_th_exact, expect_th, atol=1e-6)
+    assert np.array_equal(i_th, expect_th)
+    # theta_h sits at the centre ((i + 1/2) / 90)^2 * 90 deg of its bin, not on its edge
+    assert np.allclose(i_th_exact, expect_th + 0.5, atol=1e-6)
 
 
 def test_merl_stride():

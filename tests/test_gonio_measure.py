@@ -362,3 +362,36 @@ def test_public_names():
     for name in ("measure", "Geometry", "Instrument", "full_grid", "plane", "rusinkiewicz",
                  "merl_grid", "pairs", "pairs_from_angles", "Table"):
         assert name in gonio.__all__ and hasattr(gonio, name)
+
+
+def test_measured_merl_file_agrees_with_the_fabric_written_at_bin_centres(tmp_path):
+    """``measure`` on the MERL layout (no noise, no cone) and ``gonio.write`` of the fabric
+    itself give the same file to round-off, read back here with the MERL layout computed
+    independently: int32 (90, 90, 180), then R, G, B float64 blocks scaled by 1/1500,
+    1.15/1500 and 1.66/1500, entry k + 180 (j + 90 i)."""
+    import brdf
+    import gonio
+    from gonio.merl import write_merl
+    fab = brdf.fabric("silk_crepe_de_chine")
+    table = gonio.measure(fab, "merl:6", gonio.Instrument(), seed=0, progress=False)
+    gonio.write(table, tmp_path / "measured.binary")
+    write_merl(fab, tmp_path / "fabric.binary", rotations=1)
+
+    def read(path):
+        raw = path.read_bytes()
+        assert np.frombuffer(raw[:12], "<i4").tolist() == [90, 90, 180]
+        v = np.frombuffer(raw[12:], "<f8").reshape(3, -1)
+        scale = np.array([1.0, 1.15, 1.66])[:, None] / 1500.0
+        return np.where(v >= 0, v * scale, -1.0)
+
+    got, want = read(tmp_path / "measured.binary"), read(tmp_path / "fabric.binary")
+    i, j, k = np.meshgrid(np.arange(0, 90, 6), np.arange(0, 90, 6), np.arange(0, 180, 6),
+                          indexing="ij")
+    flat = (k + 180 * (j + 90 * i)).ravel()
+    above = np.all(want[:, flat] >= 0, axis=0)           # bin centre above the horizon
+    assert above.mean() > 0.4
+    np.testing.assert_allclose(got[:, flat[above]], want[:, flat[above]], rtol=1e-12)
+    assert np.all(got[:, flat[~above]] == -1.0)
+    others = np.setdiff1d(np.arange(got.shape[1]), flat)
+    assert np.all(got[:, others] == -1.0)                # nothing lands outside its own bin
+    assert got.max() < 1e3

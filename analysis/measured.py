@@ -178,7 +178,7 @@ def load_measured(name, data_dir=None, rgl_step: float = 15.0):
                                   sigma=None if table.sigma is None else table.sigma[keep],
                                   meta=meta)
         return table
-    return gonio.load_curet(path.parent, d.sample)
+    return gonio.read_curet(path.parent, d.sample)
 
 
 def measured_spec(name, fab=None):

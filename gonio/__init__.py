@@ -1,11 +1,15 @@
-"""gonio: a virtual gonioreflectometer, and BRDF tables in the formats of the field."""
+"""gonio: a virtual gonioreflectometer, and BRDF tables in the formats of the field.
+
+Naming: ``read_*`` returns a :class:`Table`, ``load_*`` an evaluable BRDF (``eval(wi, wo)``).
+``load_curet`` and ``merl_table`` are deprecated aliases of ``read_curet`` and ``read_merl``.
+"""
 
 from gonio.alta import read_alta, write_alta
 from gonio.atomic import atomic_write
 from gonio.progress import progress_bar
 from gonio.jsonplain import plain
 from gonio.csvtable import read_csv, write_csv
-from gonio.curet import load_curet
+from gonio.curet import load_curet, read_curet
 from gonio.errors import FormatError
 from gonio.exr import read_exr, write_exr
 from gonio.geometry import Geometry, full_grid, pairs, pairs_from_angles, plane, rusinkiewicz
@@ -13,12 +17,13 @@ from gonio.geometry import merl as merl_grid
 from gonio.instrument import Instrument
 from gonio.io import read, write
 from gonio.measure import measure
-from gonio.merl import MerlBRDF, load_merl, merl_table, write_merl
+from gonio.merl import MerlBRDF, load_merl, merl_table, read_merl, write_merl
 from gonio.rgl import RGLBRDF, load_rgl
 from gonio.table import Table
 
 __all__ = [
-    "Table", "FormatError", "read", "write", "load_rgl", "load_merl", "load_curet",
+    "Table", "FormatError", "read", "write", "load_rgl", "load_merl", "read_curet",
+    "read_merl", "load_curet",
     "read_exr", "write_exr", "read_csv", "write_csv", "read_alta", "write_alta",
     "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "progress_bar",
     "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",

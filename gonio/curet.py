@@ -10,7 +10,7 @@ from gonio.errors import FormatError
 from gonio.exr import count_missing, from_angles
 from gonio.table import Table
 
-__all__ = ["load_curet", "N_SAMPLES", "N_CONFIGS"]
+__all__ = ["read_curet", "load_curet", "N_SAMPLES", "N_CONFIGS"]
 
 N_SAMPLES = 61
 N_CONFIGS = 205
@@ -36,7 +36,7 @@ def _read_numbers(path: Path, ncols: int, nrows: int, what: str) -> np.ndarray:
     return out
 
 
-def load_curet(folder, sample: int) -> Table:
+def read_curet(folder, sample: int) -> Table:
     """One CUReT sample's 205 BRDF measurements as a Table.
 
     Parameters
@@ -66,12 +66,12 @@ def load_curet(folder, sample: int) -> Table:
     Examples
     --------
     >>> from tests.conftest import SHARED_DATA  # doctest: +SKIP
-    >>> load_curet(SHARED_DATA / "curet", 44).meta["units"]  # doctest: +SKIP
+    >>> read_curet(SHARED_DATA / "curet", 44).meta["units"]  # doctest: +SKIP
     'relative'
     """
     if isinstance(sample, bool) or not isinstance(sample, (int, np.integer)) \
             or not 1 <= sample <= N_SAMPLES:
-        raise ValueError(f"load_curet: sample must be an integer in 1..{N_SAMPLES}; got {sample!r}")
+        raise ValueError(f"read_curet: sample must be an integer in 1..{N_SAMPLES}; got {sample!r}")
     folder = Path(folder)
     geometry = _read_numbers(folder / "table.txt", 5, N_CONFIGS, "index theta_v phi_v theta_i phi_i")
     if not np.array_equal(geometry[:, 0], np.arange(1, N_CONFIGS + 1)):
@@ -93,3 +93,11 @@ def load_curet(folder, sample: int) -> Table:
         "missing_values": count_missing(np.repeat(values[:, None], 3, axis=1)),
     }
     return Table(from_angles(theta_i, phi_i), from_angles(theta_v, phi_v), values, None, meta)
+
+
+def load_curet(folder, sample: int) -> Table:
+    """Deprecated name of :func:`read_curet` (``read_*`` gives a Table, ``load_*`` a BRDF)."""
+    import warnings
+    warnings.warn("gonio.load_curet is deprecated; use gonio.read_curet (it returns a Table)",
+                  DeprecationWarning, stacklevel=2)
+    return read_curet(folder, sample)

@@ -62,17 +62,17 @@ def read(path, **options) -> Table:
         from gonio.csvtable import read_csv
         return read_csv(path, **options)
     if kind == "merl":
-        from gonio.merl import merl_table
-        return merl_table(path, **options)
+        from gonio.merl import read_merl
+        return read_merl(path, **options)
     if kind == "alta":
         from gonio.alta import read_alta
         return read_alta(path, **options)
     if kind == "curet":
-        from gonio.curet import load_curet
+        from gonio.curet import read_curet
         if "sample" not in options:
             raise ValueError(f"{path}: a CUReT abrdf.dat holds 61 samples; give one: "
-                             "gonio.read(path, sample=N) or gonio.load_curet(folder, N)")
-        return load_curet(path.parent, options.pop("sample"), **options)
+                             "gonio.read(path, sample=N) or gonio.read_curet(folder, N)")
+        return read_curet(path.parent, options.pop("sample"), **options)
     return _rgl_table(path, **options)
 
 

@@ -30,8 +30,8 @@ from gonio.exr import count_missing
 from gonio.progress import progress_bar
 from gonio.table import Table
 
-__all__ = ["MerlBRDF", "load_merl", "write_merl", "merl_table", "half_diff", "merl_index",
-           "merl_directions", "SCALE", "SHAPE", "FILE_SIZE"]
+__all__ = ["MerlBRDF", "load_merl", "read_merl", "write_merl", "merl_table", "half_diff",
+           "merl_index", "merl_directions", "SCALE", "SHAPE", "FILE_SIZE"]
 
 SHAPE = (90, 90, 180)
 N = 90 * 90 * 180
@@ -165,7 +165,7 @@ def load_merl(path) -> MerlBRDF:
     return MerlBRDF(_read_raw(path), path)
 
 
-def merl_table(path, stride: int | tuple[int, int, int] = 1, keep_missing: bool = True) -> Table:
+def read_merl(path, stride: int | tuple[int, int, int] = 1, keep_missing: bool = True) -> Table:
     """A MERL file as a Table at the centres of its bins.
 
     Parameters
@@ -181,7 +181,7 @@ def merl_table(path, stride: int | tuple[int, int, int] = 1, keep_missing: bool 
     brdf = load_merl(path)
     s = (stride,) * 3 if np.ndim(stride) == 0 else tuple(stride)
     if len(s) != 3 or any(int(x) < 1 for x in s):
-        raise ValueError(f"merl_table: stride must be a positive int or three; got {stride!r}")
+        raise ValueError(f"read_merl: stride must be a positive int or three; got {stride!r}")
     i, j, k = np.meshgrid(*(np.arange(0, n, int(st)) for n, st in zip(SHAPE, s)), indexing="ij")
     i, j, k = i.ravel(), j.ravel(), k.ravel()
     values = brdf.data[:, k + 180 * (j + 90 * i)].T
@@ -194,6 +194,14 @@ def merl_table(path, stride: int | tuple[int, int, int] = 1, keep_missing: bool 
         wi, wo, values = wi[good], wo[good], values[good]
     meta["missing_values"] = count_missing(values)
     return Table(wi, wo, values, None, meta)
+
+
+def merl_table(path, stride=1, keep_missing: bool = True) -> Table:
+    """Deprecated name of :func:`read_merl` (``read_*`` gives a Table, ``load_*`` a BRDF)."""
+    import warnings
+    warnings.warn("gonio.merl_table is deprecated; use gonio.read_merl (it returns a Table)",
+                  DeprecationWarning, stacklevel=2)
+    return read_merl(path, stride, keep_missing)
 
 
 def _table_to_grid(table: Table) -> np.ndarray:

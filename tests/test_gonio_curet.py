@@ -13,7 +13,7 @@ def test_all_samples(shared_data):
     raw = np.loadtxt(folder / "abrdf.dat")
     assert geo.shape == (205, 5) and raw.shape == (61, 206)
     for sample in range(1, 62):
-        t = gonio.load_curet(folder, sample)
+        t = gonio.read_curet(folder, sample)
         assert len(t) == 205
         np.testing.assert_allclose(t.values, np.repeat(raw[sample - 1, 1:, None], 3, 1))
         assert t.meta["units"] == "relative" and t.meta["curet_sample"] == sample
@@ -38,14 +38,25 @@ def test_read_dispatch_and_bad_sample(shared_data, tmp_path):
         gonio.read(shared_data / "curet" / "abrdf.dat")
     for bad in (0, 62, 1.5):
         with pytest.raises(ValueError, match="1..61"):
-            gonio.load_curet(shared_data / "curet", bad)
+            gonio.read_curet(shared_data / "curet", bad)
     # a truncated abrdf.dat
     (tmp_path / "table.txt").write_text((shared_data / "curet" / "table.txt").read_text())
     lines = (shared_data / "curet" / "abrdf.dat").read_text().splitlines()
     (tmp_path / "abrdf.dat").write_text("\n".join(lines[:30]) + "\n")
     with pytest.raises(gonio.FormatError, match=r"abrdf.dat: wrong size: 30 rows"):
-        gonio.load_curet(tmp_path, 1)
+        gonio.read_curet(tmp_path, 1)
     lines[4] = lines[4][: len(lines[4]) // 2]
     (tmp_path / "abrdf.dat").write_text("\n".join(lines) + "\n")
     with pytest.raises(gonio.FormatError, match=r"abrdf.dat: line 5: expected 206"):
-        gonio.load_curet(tmp_path, 1)
+        gonio.read_curet(tmp_path, 1)
+
+
+def test_old_names_warn_and_give_the_same_table(shared_data):
+    import warnings
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        old = gonio.load_curet(shared_data / "curet", 7)
+    assert any(issubclass(x.category, DeprecationWarning) and "read_curet" in str(x.message)
+               for x in w)
+    new = gonio.read_curet(shared_data / "curet", 7)
+    np.testing.assert_array_equal(old.values, new.values)

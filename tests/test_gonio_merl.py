@@ -73,7 +73,7 @@ def test_table_round_trip(glossy_file, tmp_path):
     assert t.meta["missing_values"] == np.count_nonzero(~t.valid)
     p = tmp_path / "t.binary"
     gonio.write(t, p)
-    back = gonio.merl_table(p, stride=(9, 9, 18))
+    back = gonio.read_merl(p, stride=(9, 9, 18))
     np.testing.assert_allclose(back.values, t.values, rtol=1e-12)
     # bins the table did not cover are missing
     assert gonio.load_merl(p).missing_values >= 3 * (90 * 90 * 180 - len(t))

@@ -1,17 +1,19 @@
 """The native table format: OpenEXR, float32 channels, metadata in header attributes.
 
-Layout (format ``microcyl-table/1``): one part, a 1 x n scanline image (one pixel per row of
-the table; readers also accept any w x h image and keep the first ``microcyl_rows`` pixels in
-row-major order). Channels, all FLOAT (32-bit):
+Layout (format ``microcyl-table/1``): one part, a w x h scanline image whose first
+``microcyl_rows`` pixels in row-major order are the table's rows (:func:`image_layout`: one
+image row per incidence direction for a sweep, else a near-square block; the padding pixels
+hold NaN values). Files of the first writer, one 1 x n scanline with ``microcyl_rows`` as a
+string, read the same. Channels, all FLOAT (32-bit):
 
 - ``R``, ``G``, ``B``: f_r in 1/sr (a grey file may carry ``Y`` instead);
 - ``sigma.R``, ``sigma.G``, ``sigma.B``: standard deviations in 1/sr (optional);
 - ``theta_i``, ``phi_i``, ``theta_o``, ``phi_o``: angles in **radians** (theta from the normal,
   phi from the warp +x toward +y); wi points to the light, wo to the viewer.
 
-Header attributes (strings): ``microcyl_format`` = ``microcyl-table/1``, ``angle_unit`` =
-``radian``, ``value_unit`` = ``1/sr``, ``microcyl_rows`` = n, and ``microcyl_meta``, the table's
-``meta`` as a JSON object.
+Header attributes: ``microcyl_format`` = ``microcyl-table/1``, ``angle_unit`` = ``radian``,
+``value_unit`` = ``1/sr``, ``microcyl_rows`` = n (an int), ``microcyl_layout`` (the layout's
+name) and ``microcyl_meta``, the table's ``meta`` as a JSON object (strings).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from gonio.errors import FormatError
 from gonio.jsonplain import plain
 from gonio.table import Table
 
-__all__ = ["read_exr", "write_exr", "from_angles", "meta_to_json"]
+__all__ = ["read_exr", "write_exr", "image_layout", "from_angles", "meta_to_json"]
 
 FORMAT = "microcyl-table/1"
 _MAGIC = b"\x76\x2f\x31\x01"
@@ -43,6 +45,30 @@ def meta_to_json(meta: dict) -> str:
 def count_missing(values: np.ndarray) -> int:
     """Number of NaN or negative entries of an (n, 3) value array."""
     return int(np.count_nonzero(~(np.isfinite(values) & (values >= 0))))
+
+
+def image_layout(angles) -> tuple[int, int, str]:
+    """The image shape (height, width) of a table with angles (n, 4), and its layout's name.
+
+    ``"incidence rows"``: when the rows come in runs of one incidence direction, all of the
+    same length (a gonioreflectometer's sweep), one image row per incidence. Otherwise
+    ``"block"``: a near-square block, width ceil(sqrt(n)), the last row padded.
+
+    Examples
+    --------
+    >>> a = np.zeros((6, 4)); a[3:, 0] = 0.5            # two incidences, three views each
+    >>> image_layout(a), image_layout(np.arange(40.0).reshape(10, 4))
+    ((2, 3, 'incidence rows'), (3, 4, 'block'))
+    """
+    n = angles.shape[0]
+    inc = np.round(np.asarray(angles)[:, :2], 9)
+    starts = np.flatnonzero(np.r_[True, np.any(inc[1:] != inc[:-1], axis=1)])
+    runs = np.diff(np.r_[starts, n])
+    distinct = len(np.unique(inc, axis=0))
+    if 1 < len(runs) == distinct and np.all(runs == runs[0]) and runs[0] > 1:
+        return len(runs), int(runs[0]), "incidence rows"
+    w = int(np.ceil(np.sqrt(n)))
+    return int(np.ceil(n / w)), w, "block"
 
 
 def write_exr(table: Table, path) -> None:
@@ -70,19 +96,27 @@ def write_exr(table: Table, path) -> None:
     n = len(table)
     if n == 0:
         raise ValueError("write_exr: the table is empty; an OpenEXR image needs >= 1 pixel")
-    f32 = lambda a: np.ascontiguousarray(np.asarray(a, np.float32).reshape(1, n))  # noqa: E731
-    channels = {c: f32(table.values[:, k]) for k, c in enumerate("RGB")}
-    if table.sigma is not None:
-        channels.update({f"sigma.{c}": f32(table.sigma[:, k]) for k, c in enumerate("RGB")})
     angles = table.angles
-    channels.update({name: f32(angles[:, k]) for k, name in enumerate(ANGLE_CHANNELS)})
+    h, w, layout = image_layout(angles)
+
+    def f32(a, pad):
+        img = np.full(h * w, pad, np.float32)
+        img[:n] = np.asarray(a, np.float32)
+        return img.reshape(h, w)
+
+    channels = {c: f32(table.values[:, k], np.nan) for k, c in enumerate("RGB")}
+    if table.sigma is not None:
+        channels.update({f"sigma.{c}": f32(table.sigma[:, k], np.nan)
+                         for k, c in enumerate("RGB")})
+    channels.update({name: f32(angles[:, k], 0.0) for k, name in enumerate(ANGLE_CHANNELS)})
     header = {
         "compression": OpenEXR.ZIP_COMPRESSION,
         "type": OpenEXR.scanlineimage,
         "microcyl_format": FORMAT,
         "angle_unit": "radian",
         "value_unit": "1/sr",
-        "microcyl_rows": str(n),
+        "microcyl_rows": int(n),
+        "microcyl_layout": layout,
         "microcyl_meta": meta_to_json(table.meta),
     }
     with atomic_write(path, "wb") as f:

@@ -75,3 +75,44 @@ def test_empty_table_refused(tmp_path):
     with pytest.raises(ValueError, match="empty"):
         write_exr(t, tmp_path / "e.exr")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_tables_are_images_of_a_viewable_shape(tmp_path):
+    """A sweep is one image row per incidence; scattered pairs a near-square block; the row
+    count an int attribute; a file of the old 1 x n layout (rows as a string) still reads."""
+    import OpenEXR
+    import brdf
+    import gonio
+    fab = brdf.fabric("velvet")
+    sweep = gonio.measure(fab, "full:15", gonio.Instrument(), progress=False)
+    gonio.write(sweep, tmp_path / "sweep.exr")
+    n_inc = len(np.unique(np.round(sweep.angles[:, :2], 9), axis=0))
+    with OpenEXR.File(str(tmp_path / "sweep.exr"), separate_channels=True) as f:
+        h, w = f.channels()["R"].pixels.shape
+        assert f.header()["microcyl_rows"] == len(sweep)
+        assert f.header()["microcyl_layout"] == "incidence rows"
+    assert (h, w) == (n_inc, len(sweep) // n_inc)
+    rng = np.random.default_rng(0)
+    wi = brdf.frames.from_angles(rng.uniform(0, 1.4, 1000), rng.uniform(-3, 3, 1000))
+    wo = brdf.frames.from_angles(rng.uniform(0, 1.4, 1000), rng.uniform(-3, 3, 1000))
+    scattered = gonio.Table(wi, wo, fab.eval(wi, wo))
+    gonio.write(scattered, tmp_path / "pairs.exr")
+    with OpenEXR.File(str(tmp_path / "pairs.exr"), separate_channels=True) as f:
+        assert f.channels()["R"].pixels.shape == (32, 32)       # ceil(sqrt(1000)) = 32
+    for name, t in (("sweep.exr", sweep), ("pairs.exr", scattered)):
+        back = gonio.read(tmp_path / name)
+        np.testing.assert_allclose(back.values, t.values.astype(np.float32), rtol=0)
+        np.testing.assert_allclose(back.wi, t.wi, atol=1e-6)
+    # the first writer's layout: one scanline, rows as a string
+    a = scattered.angles.astype(np.float32)
+    chans = {c: np.ascontiguousarray(scattered.values[:, k].astype(np.float32)[None])
+             for k, c in enumerate("RGB")}
+    chans.update({c: np.ascontiguousarray(a[:, k][None])
+                  for k, c in enumerate(("theta_i", "phi_i", "theta_o", "phi_o"))})
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
+              "microcyl_format": "microcyl-table/1", "angle_unit": "radian",
+              "microcyl_rows": "1000", "microcyl_meta": "{}"}
+    with OpenEXR.File(header, chans) as f:
+        f.write(str(tmp_path / "old.exr"))
+    old = gonio.read(tmp_path / "old.exr")
+    np.testing.assert_array_equal(old.values, gonio.read(tmp_path / "pairs.exr").values)

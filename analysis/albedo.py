@@ -49,6 +49,8 @@ import pickle
 from typing import Any
 
 import numpy as np
+
+from brdf.protocols import BRDF, ThreadedBRDF
 from scipy import stats
 from scipy.stats import qmc
 
@@ -244,7 +246,7 @@ def thread_axes(brdf) -> tuple[float, ...] | None:
     >>> thread_axes(object()) is None
     True
     """
-    if not hasattr(brdf, "eval_threads"):
+    if not isinstance(brdf, ThreadedBRDF):
         return None
     opts = getattr(brdf, "options", None) or {}
     rot = float(opts.get("rotation", 0.0))
@@ -442,7 +444,7 @@ def albedo(brdf, wo, *, swap: bool = False, method: str = "auto", tol: float = 5
         raise ValueError(f"need -1 <= min_level <= max_level; got {min_level}, {max_level}")
     if not (rtol >= 0):
         raise ValueError(f"rtol must be >= 0; got {rtol}")
-    if not hasattr(brdf, "eval"):
+    if not isinstance(brdf, BRDF):
         raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
     fixed = _check_dirs("wo" if not swap else "wi", wo)
     shape = fixed.shape[:-1]

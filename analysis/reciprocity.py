@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from brdf.frames import to_angles
+from brdf.protocols import BRDF
 
 __all__ = ["ReciprocityResult", "reciprocity", "reciprocity_report", "random_pairs", "LUMINANCE",
            "relative_asymmetry"]
@@ -178,7 +179,7 @@ def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance"
     """
     if channel not in _CHANNELS:
         raise ValueError(f"channel must be 'luminance', 'r', 'g' or 'b'; got {channel!r}")
-    if not hasattr(brdf, "eval"):
+    if not isinstance(brdf, BRDF):
         raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
     if weight not in ("none", "cos_i"):
         raise ValueError(f"weight must be 'none' or 'cos_i'; got {weight!r}")

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from brdf.frames import from_angles, to_angles
+from brdf.protocols import BRDF
 
 __all__ = ["SanityResult", "sanity_scan", "edge_pairs"]
 
@@ -247,7 +248,7 @@ def sanity_scan(obj, *, parameters: bool | None = None, n_examples: int = 3) -> 
         if obj not in brdf.PRESETS:
             raise ValueError(f"unknown fabric {obj!r}; presets: {', '.join(brdf.PRESETS)}")
         obj = brdf.fabric(obj)
-    if not hasattr(obj, "eval"):
+    if not isinstance(obj, BRDF):
         raise ValueError(f"need a BRDF with eval(wi, wo); got {type(obj).__name__}")
     is_fabric = hasattr(obj, "threads") and hasattr(obj, "replace")
     parameters = is_fabric if parameters is None else bool(parameters)

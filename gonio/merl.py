@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from brdf.frames import from_angles, rotate_y, rotate_z
+from brdf.protocols import BRDF
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing
@@ -246,7 +247,7 @@ def write_merl(obj, path, rotations: int = 8, chunk_rows: int = 2, progress: boo
     if isinstance(obj, Table):
         grid = _table_to_grid(obj)
     else:
-        if not hasattr(obj, "eval"):
+        if not isinstance(obj, BRDF):
             raise ValueError(f"write_merl: need a Table or an object with eval(wi, wo); "
                              f"got {type(obj).__name__}")
         if int(rotations) < 1:

@@ -33,7 +33,8 @@ def read(path, **options) -> Table:
     ----------
     path : str or os.PathLike
         ``.exr`` (native), ``.csv``, ``.binary`` (MERL: the full grid at bin centres, or
-        ``stride=`` for a sample), ``.alta`` (1-D slice), ``.bsdf`` (RGL: sampled through
+        ``stride=`` for a sample), ``.alta`` (ALTA text: COS_TH, SPHERICAL_TL_PL_TV_PV, RUSIN_TH_PH_TD_PD,
+        RUSIN_TH_TD_PD or CARTESIAN), ``.bsdf`` (RGL: sampled through
         :func:`gonio.load_rgl` at its theta_i nodes below 90 deg, phi_i = 0, and wo every
         ``step`` degrees, default 5), or a CUReT ``abrdf.dat`` (needs ``sample=N``; its
         ``table.txt`` must be beside it).
@@ -106,9 +107,10 @@ def write(obj, path, **options) -> None:
     obj : Table, or an object with ``eval(wi, wo)`` for ``.binary``
     path : str or os.PathLike
         ``.exr`` (native, default choice), ``.csv``, ``.binary`` (MERL), ``.alta``
-        (back-scatter rows only).
+        (ALTA text; ``param=`` picks the ``#PARAM_IN``, see :func:`gonio.write_alta`).
     **options
-        Passed to the writer (``digits`` for CSV/ALTA, ``rotations`` for MERL).
+        Passed to the writer (``digits`` for CSV/ALTA, ``param`` for ALTA, ``rotations`` for
+        MERL).
 
     Raises
     ------

@@ -13,6 +13,10 @@ def register(sub):
                                    "abrdf.dat with --sample).")
     p.add_argument("input", metavar="IN")
     p.add_argument("output", metavar="OUT")
+    p.add_argument("--alta-param", metavar="NAME",
+                   help="ALTA #PARAM_IN for an .alta OUT: COS_TH, SPHERICAL_TL_PL_TV_PV, "
+                        "RUSIN_TH_PH_TD_PD, RUSIN_TH_TD_PD or CARTESIAN (default: COS_TH for "
+                        "back-scatter rows, else SPHERICAL_TL_PL_TV_PV)")
     _reader_options(p)
     p.set_defaults(func=run_convert)
     q = sub.add_parser("info", help="what a BRDF table holds",
@@ -41,7 +45,12 @@ def run_convert(args):
     import gonio
 
     table = _read(args, args.input)
-    gonio.write(table, args.output)
+    options = {}
+    if getattr(args, "alta_param", None):
+        if not str(args.output).lower().endswith(".alta"):
+            raise ValueError("--alta-param applies to an .alta output only")
+        options["param"] = args.alta_param
+    gonio.write(table, args.output, **options)
     print(f"wrote {len(table)} rows to {args.output}")
     return 0
 

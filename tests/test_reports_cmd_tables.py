@@ -37,3 +37,14 @@ def test_errors_are_one_line(tmp_path, capsys):
     assert not (tmp_path / "out.exr").exists()
     assert main(["info", str(tmp_path / "x.unknown")]) == 1
     assert "known: .exr" in capsys.readouterr().err
+
+
+def test_convert_alta_param(tmp_path, capsys):
+    src = tmp_path / "t.exr"
+    gonio.write(random_table(0), src)
+    out = tmp_path / "t.alta"
+    assert main(["convert", str(src), str(out), "--alta-param", "RUSIN_TH_PH_TD_PD"]) == 0
+    assert "#PARAM_IN RUSIN_TH_PH_TD_PD" in out.read_text()
+    assert gonio.read(out).meta["alta_param"] == "RUSIN_TH_PH_TD_PD"
+    assert main(["convert", str(src), str(out), "--alta-param", "NOPE"]) == 1
+    assert "param 'NOPE' is not supported" in capsys.readouterr().err

@@ -80,7 +80,7 @@ def _check_json_target(path):
 
 
 def register(sub):
-    """Add ``energy`` and ``reciprocity`` to the ``microcyl`` sub-parsers."""
+    """Add ``energy``, ``reciprocity`` and ``sanity`` to the ``microcyl`` sub-parsers."""
     p = sub.add_parser(
         "energy", help="albedo curves, white furnace: does the model create energy?",
         description="Directional albedo of each preset and variant (furnace: integral over wi "
@@ -124,6 +124,16 @@ def register(sub):
     p.add_argument("--no-felts", action="store_true", help="skip the measured felts")
     p.add_argument("--json", metavar="PATH", help="write the full results as JSON")
     p.set_defaults(func=run_reciprocity)
+
+    p = sub.add_parser(
+        "sanity", help="finite, non-negative f_r at the edges of the domain?",
+        description="Evaluate each preset on direction sets built for its edge cases (grazing, "
+                    "retro and mirror pairs, along the threads, below the horizon) and at edge "
+                    "parameter sets; report every NaN, infinite or negative value and every "
+                    "RuntimeWarning. Exits 1 when one is found.")
+    p.add_argument("fabric", metavar="FABRIC|all", help=f"one of {', '.join(brdf.PRESETS)}, or all")
+    p.add_argument("--json", metavar="PATH", help="write every check as JSON")
+    p.set_defaults(func=run_sanity)
 
 
 def format_energy(rep) -> str:
@@ -257,3 +267,30 @@ def run_reciprocity(args) -> int:
         write_json(target, rep)
         print(f"wrote {target}")
     return 0
+
+
+def format_sanity(name: str, result) -> list[str]:
+    """One line for a fabric's sanity scan, and one per check that found something."""
+    evals = sum(c["n"] for c in result.checks)
+    bad = result.violations
+    lines = [f"{name}: {'ok' if result.ok else 'VIOLATIONS'} ({len(result.checks)} checks, "
+             f"{evals} evaluations{'' if result.ok else f', {len(bad)} failing'})"]
+    for c in bad:
+        lines.append(f"   {c['params']} / {c['directions']}: {c['n_nonfinite']} non-finite, "
+                     f"{c['n_negative']} negative, {len(c['warnings'])} warnings"
+                     + (f"; e.g. {c['examples'][0]}" if c["examples"] else ""))
+    return lines
+
+
+def run_sanity(args) -> int:
+    """``microcyl sanity``: :func:`analysis.sanity_scan` of each preset."""
+    from analysis.sanity import sanity_scan
+    presets = _presets(args.fabric)
+    target = _check_json_target(args.json)
+    results = {name: sanity_scan(name) for name in presets}
+    for name, r in results.items():
+        print("\n".join(format_sanity(name, r)))
+    if target is not None:
+        write_json(target, {name: r.to_dict() for name, r in results.items()})
+        print(f"wrote {target}")
+    return 0 if all(r.ok for r in results.values()) else 1

@@ -50,3 +50,42 @@ def test_json_folder_missing(tmp_path, capsys):
                "--json", str(tmp_path / "no" / "r.json")])
     assert rc == 1
     assert "does not exist" in capsys.readouterr().err
+
+
+def test_sanity_all_presets_as_a_user_runs_it(tmp_path):
+    """``microcyl sanity all --json`` in a subprocess: every preset of the paper is finite and
+    non-negative at the edges, the JSON holds each check, the exit status says so."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    repo = Path(__file__).resolve().parents[1]
+    out = tmp_path / "sanity.json"
+    p = subprocess.run([sys.executable, "-m", "reports", "sanity", "all", "--json", str(out)],
+                       cwd=repo, env=dict(os.environ, PYTHONPATH=str(repo)), capture_output=True,
+                       text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    doc = json.loads(out.read_text())
+    assert set(doc) == set(brdf.PRESETS) and all(d["ok"] for d in doc.values())
+    assert all(len(d["checks"]) > 100 for d in doc.values())
+    assert p.stdout.count(": ok (") == len(brdf.PRESETS)
+
+
+def test_sanity_reports_a_broken_fabric(monkeypatch, capsys):
+    """A fabric whose eval returns a NaN at grazing incidence is caught, and the exit is 1."""
+    import numpy as np
+    import analysis.sanity
+
+    class Broken:
+        def eval(self, wi, wo):
+            wi = np.asarray(wi)
+            f = np.full(np.broadcast_shapes(wi.shape, np.shape(wo)), 0.1)
+            f[wi[..., 2] < 1e-3] = np.nan
+            return f
+
+    real = analysis.sanity.sanity_scan
+    monkeypatch.setattr(analysis.sanity, "sanity_scan",
+                        lambda name, **kw: real(Broken(), **kw) if name == "velvet" else real(name))
+    assert main(["sanity", "velvet"]) == 1
+    out = capsys.readouterr().out
+    assert "velvet: VIOLATIONS" in out and "non-finite" in out

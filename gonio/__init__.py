@@ -14,6 +14,7 @@ from gonio.errors import FormatError
 from gonio.exr import read_exr, write_exr
 from gonio.geometry import Geometry, full_grid, pairs, pairs_from_angles, plane, rusinkiewicz
 from gonio.geometry import merl as merl_grid
+from gonio.geomspec import from_spec
 from gonio.instrument import Instrument
 from gonio.io import read, write
 from gonio.measure import measure
@@ -27,5 +28,5 @@ __all__ = [
     "read_exr", "write_exr", "read_csv", "write_csv", "read_alta", "write_alta",
     "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "progress_bar",
     "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",
-    "pairs", "pairs_from_angles",
+    "pairs", "pairs_from_angles", "from_spec",
 ]

@@ -7,7 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from gonio.geometry import Geometry, from_spec, rotate_z
+from gonio.geometry import Geometry, rotate_z
+from gonio.geomspec import from_spec
 from gonio.instrument import Instrument, cone_directions
 from gonio.jsonplain import plain
 from gonio.progress import progress_bar

@@ -117,7 +117,7 @@ def _writer():
 def run(args) -> int:
     """Measure and write; every check on the input happens before the measurement."""
     from gonio import Instrument, measure
-    from gonio.geometry import from_spec
+    from gonio.geomspec import from_spec
 
     out = Path(args.output)
     if not out.parent.is_dir():

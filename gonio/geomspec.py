@@ -1,0 +1,122 @@
+"""The geometry spec mini-language (``full:10``, ``plane:warp:5``, ``merl:3``, ...) and the
+``pairs:FILE.csv`` reader: strings to :class:`gonio.geometry.Geometry` objects."""
+
+from __future__ import annotations
+
+import csv
+import re
+from pathlib import Path
+
+import numpy as np
+
+from gonio.geometry import (_PLANE_NAMES, SPEC_HELP, Geometry, full_grid, merl,
+                            pairs_from_angles, plane, rusinkiewicz)
+
+__all__ = ["from_spec", "read_pairs_csv", "SPEC_HELP"]
+
+
+def read_pairs_csv(path) -> Geometry:
+    """Read theta_i,phi_i,theta_o,phi_o (degrees) from a CSV; '#' lines are comments."""
+    path = Path(path)
+    need = ("theta_i", "phi_i", "theta_o", "phi_o")
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot read pairs file: {exc.strerror}", str(path)) from None
+    rows, header, cols = [], None, None
+    for lineno, line in enumerate(text.splitlines(), 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        fields = [f.strip() for f in next(csv.reader([line]))]
+        if header is None:
+            header = fields
+            missing = [c for c in need if c not in header]
+            if missing:
+                raise ValueError(f"{path}: line {lineno}: header lacks column(s) "
+                                 f"{', '.join(missing)}; need {','.join(need)} (degrees)")
+            cols = [header.index(c) for c in need]
+            continue
+        if len(fields) != len(header):
+            raise ValueError(f"{path}: line {lineno}: {len(fields)} fields, header has "
+                             f"{len(header)}")
+        try:
+            rows.append([float(fields[c]) for c in cols])
+        except ValueError:
+            raise ValueError(f"{path}: line {lineno}: not a number in "
+                             f"{','.join(fields[c] for c in cols)!r}") from None
+    if not rows:
+        raise ValueError(f"{path}: no pairs (need a header {','.join(need)} and rows)")
+    a = np.asarray(rows)
+    return pairs_from_angles(*a.T, degrees=True, params={"file": str(path)})
+
+
+def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
+    """Build a geometry from a compact string; see :meth:`Geometry.from_spec`.
+
+    Examples
+    --------
+    >>> from_spec("full:30").spec
+    'full:30:30:30:30'
+    >>> from_spec("plane:45:45:0").spec
+    'plane:45:45:0'
+    """
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"geometry spec must be a non-empty string; got {spec!r}; use {SPEC_HELP}")
+    s = spec.strip()
+    kind, _, rest = s.partition(":")
+    kind = kind.lower()
+    args = rest.split(":") if rest else []
+
+    def bad(why):
+        return ValueError(f"geometry spec {spec!r}: {why}; use {SPEC_HELP}")
+
+    def num(x, what):
+        try:
+            return float(x)
+        except ValueError:
+            raise bad(f"{what} {x!r} is not a number") from None
+
+    try:
+        if kind == "full":
+            if len(args) not in (1, 2, 4):
+                raise bad("full takes 1, 2 or 4 steps")
+            v = [num(a, "step") for a in args]
+            if len(v) == 1:
+                return full_grid(v[0], rotation=rotation)
+            if len(v) == 2:
+                return full_grid(v[0], v[1], rotation=rotation)
+            return full_grid(v[0], v[1], theta_o_step=v[2], phi_o_step=v[3], rotation=rotation)
+        if kind == "plane":
+            if len(args) not in (2, 3):
+                raise bad("plane takes WHICH:STEP[:THETA_I,...]")
+            which = args[0].lower()
+            if which not in _PLANE_NAMES and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
+                raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
+            step = num(args[1], "step")
+            if len(args) == 3:
+                ti = [num(t, "theta_i") for t in args[2].split(",") if t.strip()]
+                return plane(which, step, ti, rotation=rotation)
+            return plane(which, step, rotation=rotation)
+        if kind in ("rusinkiewicz", "rus"):
+            if len(args) not in (1, 4):
+                raise bad("rusinkiewicz takes 1 or 4 steps")
+            v = [num(a, "step") for a in args]
+            return rusinkiewicz(*v, rotation=rotation) if len(v) == 4 else \
+                rusinkiewicz(v[0], rotation=rotation)
+        if kind == "merl":
+            if len(args) > 1:
+                raise bad("merl takes at most a stride")
+            if args:
+                if not re.fullmatch(r"\d+", args[0]):
+                    raise bad(f"stride {args[0]!r} is not a positive integer")
+                return merl(int(args[0]), rotation=rotation)
+            return merl(rotation=rotation)
+        if kind == "pairs":
+            if not rest:
+                raise bad("pairs needs a file name")
+            return read_pairs_csv(rest)
+    except ValueError as exc:
+        if str(exc).startswith("geometry spec"):
+            raise
+        raise ValueError(f"geometry spec {spec!r}: {exc}; use {SPEC_HELP}") from None
+    raise bad(f"unknown kind {kind!r}")

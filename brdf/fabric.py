@@ -3,15 +3,15 @@ r"""A fabric: two threads woven at right angles, with the options of MODEL.md.""
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from brdf import validate
 from brdf.curve import SAMPLING_METHODS
-from brdf.directions import as_directions, normalize
-from brdf.kernel import SHADE_BLOCK, thread_geometry, thread_shade
+from brdf.frames import flat_pairs
+from brdf.kernel import thread_geometry, thread_shade
+from brdf.prepared import Prepared
 from brdf.thread import Thread
 
 __all__ = ["Fabric", "Prepared", "OPTIONS", "TRANSMISSION_METHODS", "GAP_METHODS"]
@@ -198,7 +198,7 @@ class Fabric:
         return self._evaluate(wi, wo, split=True)
 
     def _evaluate(self, wi, wo, split):
-        wi, wo, shape, bad, below = _pairs(wi, wo)
+        wi, wo, shape, bad, below = flat_pairs(wi, wo)
         n = wi.shape[0]
         out = np.zeros((n, 2, 3) if split else (n, 3))
         ok = ~(bad | below)
@@ -276,149 +276,3 @@ class Fabric:
             Call ``.eval(eta=..., albedo=..., kd=..., gamma_s=..., gamma_v=..., area=...)``.
         """
         return Prepared(self, wi, wo)
-
-
-class Prepared:
-    """Direction-dependent work of a Fabric done once for n fixed pairs.
-
-    ``eval`` shades the pairs for batches of optical parameters; tangent curves and options
-    are those of the fabric it was prepared from.
-
-    Attributes
-    ----------
-    block_elements : int or None
-        (Parameter set, pair, sample) elements shaded per block; None (the default) takes
-        :data:`brdf.kernel.SHADE_BLOCK`. Only the speed and the rounding of the
-        weighted sums over samples depend on it.
-
-    Examples
-    --------
-    >>> import brdf
-    >>> fab = brdf.fabric("silk_crepe_de_chine")
-    >>> wi = brdf.directions.from_angles(np.radians([10, 40]), 0.3)
-    >>> wo = brdf.directions.from_angles(np.radians([20, 60]), 2.0)
-    >>> prep = fab.prepare(wi, wo)
-    >>> np.allclose(prep.eval(), fab.eval(wi, wo), rtol=1e-13, atol=0)
-    True
-    >>> prep.eval(eta=np.full((5, 2), 1.4)).shape
-    (5, 2, 3)
-    """
-
-    block_elements: int | None = None
-
-    def __init__(self, fabric: Fabric, wi, wo):
-        wi, wo, shape, bad, below = _pairs(wi, wo)
-        self.fabric = fabric
-        self.shape = shape
-        self._bad = bad
-        self._ok = ~(bad | below)
-        wi_ok, wo_ok = wi[self._ok], wo[self._ok]
-        sides = fabric._frames(wi_ok, wo_ok)
-        self._geoms = [fabric._geometry(j, sides[j]) for j in range(2)]
-        self._zi = wi_ok[:, 2]
-        self._zo = wo_ok[:, 2]
-
-    def eval(self, *, eta=None, albedo=None, kd=None, gamma_s=None, gamma_v=None,
-             area=None) -> np.ndarray:
-        r"""f_r (1/sr) of the prepared pairs for a batch of parameter sets.
-
-        Parameters
-        ----------
-        eta, kd, gamma_s, gamma_v, area : array_like, shape (B..., 2), optional
-            Per thread; gamma in degrees. Omitted ones take the fabric's values.
-        albedo : array_like, shape (B..., 2, 3), optional
-
-        Returns
-        -------
-        ndarray, shape (B..., n..., 3)
-            (B... is the broadcast batch shape; absent when every parameter is omitted or
-            has shape (2,).)
-
-        Raises
-        ------
-        ValueError
-            If a parameter's last axis is not 2 (per thread).
-        """
-        fab = self.fabric
-        th = fab.threads
-
-        def param(name, value, default):
-            if value is None:
-                return np.asarray(default, dtype=np.float64)
-            v = np.asarray(value, dtype=np.float64)
-            want = np.shape(default)
-            if v.shape[v.ndim - len(want):] != want:
-                raise ValueError(f"{name} must have shape (..., {', '.join(map(str, want))}); "
-                                 f"got {v.shape}")
-            return v
-
-        eta = param("eta", eta, [t.eta for t in th])
-        kd = param("kd", kd, [t.kd for t in th])
-        gs = np.radians(param("gamma_s", gamma_s, [t.gamma_s for t in th]))
-        gv = np.radians(param("gamma_v", gamma_v, [t.gamma_v for t in th]))
-        area = param("area", area, [t.area for t in th])
-        alb = param("albedo", albedo, [t.albedo for t in th])
-        batch = np.broadcast_shapes(eta.shape[:-1], kd.shape[:-1], gs.shape[:-1],
-                                    gv.shape[:-1], area.shape[:-1], alb.shape[:-2])
-        nb = math.prod(batch)
-
-        def flat(x, k):  # (B..., *tail) with k tail axes -> (nb, *tail)
-            tail = x.shape[x.ndim - k:]
-            return np.broadcast_to(x, batch + tail).reshape((nb,) + tail)
-
-        eta, kd, gs, gv, area = (flat(x, 1) for x in (eta, kd, gs, gv, area))
-        shades = np.empty((2, 2, nb, self._zi.size))     # thread, (surf, vol), set, pair
-        for j, (g, c) in enumerate(zip(self._geoms, fab._const)):
-            thread_shade(g, c.weight, eta[:, j], kd[:, j], gs[:, j], gv[:, j],
-                         fab.options["transmission"], out=tuple(shades[j]),
-                         block=self.block_elements)
-        out = np.zeros((nb, self._ok.size, 3))
-        vals = out if self._ok.all() else np.empty((nb, self._zi.size, 3))
-        self._combine_into(shades, area, flat(alb, 2), vals)
-        if vals is not out:
-            out[:, self._ok] = vals
-        out[:, self._bad] = np.nan
-        return out.reshape(batch + self.shape + (3,))
-
-    def _combine_into(self, shades, area, alb, vals):
-        """f_r = (a_1 S_1 + a_2 S_2) / (Q n.wi) into ``vals`` (nb, C, 3), in blocks of pairs.
-
-        ``shades`` (2, 2, nb, C): per thread the surface and volume sums; ``area`` (nb, 2),
-        ``alb`` (nb, 2, 3).
-        """
-        nb, nc = shades.shape[2:]
-        step = max(1, (self.block_elements or SHADE_BLOCK) // (3 * max(nb, 1)))
-        a1, a2 = area[:, 0, None], area[:, 1, None]
-        for c0 in range(0, nc, step):
-            sl = slice(c0, c0 + step)
-            pmeans = [None if g.pmean is None else g.pmean[sl] for g in self._geoms]
-            q = self.fabric._q(pmeans, a1, a2, self._zi[sl], self._zo[sl])
-            denom = q * self._zi[sl]
-            inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
-            parts = [area[:, j, None, None] * (shades[j, 0, :, sl, None]
-                                               + alb[:, None, j, :] * shades[j, 1, :, sl, None])
-                     for j in range(2)]
-            parts[0] += parts[1]
-            np.multiply(parts[0], inv[..., None], out=vals[:, sl])
-
-
-def _pairs(wi, wo):
-    """Validate, broadcast, flatten and normalize direction pairs.
-
-    Returns wi, wo (n, 3) unit (bad entries replaced), the leading shape, and the masks of
-    bad (zero or non-finite) pairs and of pairs at or below the horizon.
-    """
-    wi = as_directions("wi", wi)
-    wo = as_directions("wo", wo)
-    try:
-        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
-    except ValueError:
-        raise ValueError(f"wi and wo must broadcast; got shapes {wi.shape} and {wo.shape}") \
-            from None
-    wi = np.broadcast_to(wi, shape + (3,)).reshape(-1, 3)
-    wo = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
-    wi, bad_i = normalize(wi)
-    wo, bad_o = normalize(wo)
-    bad = bad_i | bad_o
-    below = ~bad & ((wi[:, 2] <= 0.0) | (wo[:, 2] <= 0.0))
-    return wi, wo, shape, bad, below

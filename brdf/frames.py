@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["from_angles", "to_angles", "as_directions", "normalize", "rotate_z", "rotate_y",
+__all__ = ["from_angles", "to_angles", "as_directions", "normalize", "flat_pairs", "rotate_z", "rotate_y",
            "half_diff_to_directions", "directions_to_half_diff", "plane_to_directions",
            "directions_to_plane"]
 
@@ -274,3 +274,25 @@ def directions_to_plane(wi, wo, azimuth=0.0, *, atol=1e-9) -> tuple[np.ndarray, 
                              f"(largest |sin| off the plane: {float(np.max(off)):.3g})")
         out.append(np.arctan2(sign * np.sum(w * p, axis=-1), w[..., 2]))
     return out[0], out[1]
+
+
+def flat_pairs(wi, wo):
+    """Validate, broadcast, flatten and normalize direction pairs.
+
+    Returns wi, wo (n, 3) unit (bad entries replaced), the leading shape, and the masks of
+    bad (zero or non-finite) pairs and of pairs at or below the horizon.
+    """
+    wi = as_directions("wi", wi)
+    wo = as_directions("wo", wo)
+    try:
+        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+    except ValueError:
+        raise ValueError(f"wi and wo must broadcast; got shapes {wi.shape} and {wo.shape}") \
+            from None
+    wi = np.broadcast_to(wi, shape + (3,)).reshape(-1, 3)
+    wo = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
+    wi, bad_i = normalize(wi)
+    wo, bad_o = normalize(wo)
+    bad = bad_i | bad_o
+    below = ~bad & ((wi[:, 2] <= 0.0) | (wo[:, 2] <= 0.0))
+    return wi, wo, shape, bad, below

@@ -64,7 +64,7 @@ def image_layout(angles) -> tuple[int, int, str]:
     inc = np.round(np.asarray(angles)[:, :2], 9)
     starts = np.flatnonzero(np.r_[True, np.any(inc[1:] != inc[:-1], axis=1)])
     runs = np.diff(np.r_[starts, n])
-    distinct = len(np.unique(inc, axis=0))
+    distinct = len(np.unique(inc[starts], axis=0))    # the runs are maximal: no need for all
     if 1 < len(runs) == distinct and np.all(runs == runs[0]) and runs[0] > 1:
         return len(runs), int(runs[0]), "incidence rows"
     w = int(np.ceil(np.sqrt(n)))

@@ -75,7 +75,10 @@ class LogPosterior:
     def predict(self, theta) -> np.ndarray:
         """Model f_r (B, n, 3) for internal theta (B, ndim), scale included."""
         theta = np.atleast_2d(np.asarray(theta, dtype=np.float64))
-        v = self.spec.values(theta)
+        return self._predict(self.spec.values(theta))
+
+    def _predict(self, v) -> np.ndarray:
+        """Model f_r (B, n, 3) from the natural values ``v`` of :meth:`ParamSpec.values`."""
         kw = self.spec.model_kwargs(v)
         if self.use_tangent:
             kw["tangent_scale"] = np.stack([v["tangent_scale1"], v["tangent_scale2"]], -1)
@@ -93,7 +96,7 @@ class LogPosterior:
             th = theta[ok]
             v = self.spec.values(th)
             with np.errstate(all="ignore"):
-                pred = self.predict(th)
+                pred = self._predict(v)
                 ll = self.lik(pred, log_noise=v["log_noise"] if self.use_noise else None)
             out[ok] = lp[ok] + ll
             with self._lock:

@@ -4,7 +4,7 @@
 mixture of multivariate Student-t components, first the Laplace approximation at the point
 estimate, later mixtures fitted to the chain (:meth:`LaplaceMove.from_samples`) in coordinates
 warped per parameter towards a normal marginal (:func:`warp`, :func:`choose_warps`).
-:func:`proposal_quality` and :func:`proposal_share` judge a proposal and give its share of the
+:func:`proposal_quality` judges a proposal and :func:`share_from_quality` gives its share of the
 moves. Used by :mod:`analysis.fit.moves`.
 """
 
@@ -16,7 +16,7 @@ import scipy.linalg
 import scipy.special
 
 __all__ = ["LaplaceMove", "warp", "unwarp", "choose_warps", "proposal_quality",
-           "proposal_share", "share_from_quality", "draw_log_weights", "ess_fraction",
+           "share_from_quality", "draw_log_weights", "ess_fraction",
            "expected_acceptance", "WARPS", "MIXTURE_COMPONENTS"]
 
 
@@ -161,12 +161,6 @@ class LaplaceMove(emcee.moves.MHMove):
         self._logw = np.log(weights) - np.log(np.diagonal(chols, axis1=1, axis2=2)).sum(axis=1)
         # inverse factors: each log q is then one small matrix product per component
         self._inv = np.linalg.inv(chols)
-
-    def copy_from(self, other: "LaplaceMove"):
-        """Take over another proposal's components (the move object itself stays in place)."""
-        self.df = other.df
-        self.warps = other.warps
-        self._set(other.means, other.chols, other.weights)
 
     @property
     def n_components(self) -> int:
@@ -355,23 +349,6 @@ def expected_acceptance(move: "LaplaceMove", lw_draws, chain, chain_logp) -> flo
     if lwx.size == 0:
         return 0.0
     return float(np.mean(np.exp(np.minimum(0.0, lw[None, :] - lwx[:, None]))))
-
-
-def proposal_share(logpost, move: "LaplaceMove", laplace_move: float, rng, chain=None,
-                   chain_logp=None) -> tuple[float, float]:
-    """Share of the independence move among the moves, and the proposal's quality.
-
-    A poor approximation (non-Gaussian posterior, parameters at bounds) would waste the move's
-    evaluations, so it gets little: the share is ``laplace_move`` scaled by the quality of
-    :func:`proposal_quality` (same parameters) over 0.2, at most ``laplace_move`` and at least
-    0.05.
-
-    Returns
-    -------
-    share, quality : float
-    """
-    frac = proposal_quality(logpost, move, rng, chain=chain, chain_logp=chain_logp)
-    return share_from_quality(frac, laplace_move), frac
 
 
 def share_from_quality(frac: float, laplace_move: float) -> float:

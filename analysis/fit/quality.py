@@ -11,8 +11,10 @@ from analysis.likelihood import is_grey
 __all__ = ["residuals", "albedo_colours", "albedo_delta_e", "fit_quality"]
 
 
-def residuals(result) -> dict:
+def residuals(result, prediction=None) -> dict:
     """Residuals of a :class:`~analysis.fit.results.FitResult` at its posterior median.
+
+    ``prediction`` (n, 3), the model f_r (1/sr) at the median, is computed when not given.
 
     Returns
     -------
@@ -25,7 +27,9 @@ def residuals(result) -> dict:
     """
     med = result.median_internal()
     lik = result.logpost.lik
-    r = lik.y - lik.transform(result.logpost.predict(med[None]))[0]
+    if prediction is None:
+        prediction = result.logpost.predict(med[None])[0]
+    r = lik.y - lik.transform(prediction[None])[0]
     s2 = np.zeros_like(r) if lik.sigma_y2 is None else lik.sigma_y2
     if "log_noise" in result.names:
         s2 = s2 + np.exp(2 * result.spec.to_natural(med)[result.names.index("log_noise")])
@@ -87,8 +91,8 @@ def fit_quality(result, table) -> dict:
     """The quality figures of ``results.json``: residual rms (likelihood space and normalized),
     the number of values, and the measured and predicted albedo colours with their CIEDE2000
     difference, all at the posterior median (JSON-ready)."""
-    q = residuals(result)
     pred = result.logpost.predict(result.median_internal()[None])[0]
+    q = residuals(result, pred)
     meas, prd = albedo_colours(table, pred)
     return {"rms_residual": q["rms"], "rms_normalized": q["rms_normalized"],
             "values": int(q["residual"].size), "albedo_measured": meas.tolist(),

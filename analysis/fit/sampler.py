@@ -184,15 +184,16 @@ class FitSampler:
         t_s0, e0, r0 = time.perf_counter(), self.logpost.n_evals, self.refit_evals
         try:
             while True:
-                if not self.recheck:
+                rechecked, self.recheck = self.recheck, False
+                if not rechecked:
                     self.runner.run_to(self._next_target(), tick)
                     self._refit_due()
-                self.recheck = False
                 diag = diagnose(self.chains, c.burn_fraction,
                                 max(p.last_kept for p in self.proposals))
                 ok, why = diag.verdict(self.tau_prev, c)
                 before = None if self.tau_prev is None else self.tau_prev.tolist()
-                self._checkpoint(folder, diag.step, before, diag.tau.tolist())
+                if not rechecked:       # a recheck repeats the check the checkpoint holds
+                    self._checkpoint(folder, diag.step, before, diag.tau.tolist())
                 self._tau_before = before
                 self._last_check, dtau = diag.step, diag.tau_change(self.tau_prev)
                 self.tau_prev = diag.tau

@@ -62,9 +62,12 @@ def describe(table) -> str:
              f"format: {table.meta.get('file_format', 'unknown')}",
              f"rows: {len(table)}",
              f"units: {table.meta.get('units', '1/sr')}"]
-    for k, name in enumerate(("theta_i", "phi_i", "theta_o", "phi_o")):
-        lines.append(f"{name}: {ang[:, k].min():.4g} .. {ang[:, k].max():.4g} deg")
     valid = table.valid
+    data = valid.any(axis=1)          # a MERL file lists its empty bins below the horizon too
+    note = "" if data.all() else " (rows with data)"
+    sel = ang[data] if data.any() else ang
+    for k, name in enumerate(("theta_i", "phi_i", "theta_o", "phi_o")):
+        lines.append(f"{name}: {sel[:, k].min():.4g} .. {sel[:, k].max():.4g} deg{note}")
     for c, name in enumerate("RGB"):
         v = table.values[valid[:, c], c]
         rng = f"{v.min():.6g} .. {v.max():.6g}" if v.size else "none valid"

@@ -48,3 +48,16 @@ def test_convert_alta_param(tmp_path, capsys):
     assert gonio.read(out).meta["alta_param"] == "RUSIN_TH_PH_TD_PD"
     assert main(["convert", str(src), str(out), "--alta-param", "NOPE"]) == 1
     assert "param 'NOPE' is not supported" in capsys.readouterr().err
+
+
+def test_info_of_a_measured_merl_file_stays_above_the_horizon(tmp_path, capsys):
+    """A MERL file lists every bin, the empty ones below the horizon too; the angle ranges
+    that info prints are those of the bins that hold data: theta at most 90 degrees."""
+    out = tmp_path / "m.binary"
+    assert main(["measure", "velvet", "--geometry", "merl:6", "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    for name in ("theta_i", "theta_o"):
+        line = next(ln for ln in text.splitlines() if ln.startswith(name + ":"))
+        assert float(line.split("..")[1].split()[0]) <= 90.0 and "(rows with data)" in line

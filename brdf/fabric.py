@@ -10,7 +10,8 @@ import numpy as np
 from brdf import validate
 from brdf.curve import SAMPLING_METHODS
 from brdf.frames import flat_pairs
-from brdf.kernel import thread_geometry, thread_shade
+from brdf.kernel import thread_geometry
+from brdf.shading import combine_rgb, thread_shade
 from brdf.prepared import Prepared
 from brdf.thread import Thread
 
@@ -239,8 +240,8 @@ class Fabric:
     def _geometry(self, j, side):
         c = self._const[j]
         return thread_geometry(*side, c.ca, c.sa, c.weight,
-                               masking=self._options["masking"],
-                               reweighting=self._options["reweighting"],
+                               with_masking=self._options["masking"],
+                               with_reweighting=self._options["reweighting"],
                                keep_cos=self._options["transmission"] == "longitudinal")
 
     def _q(self, pmeans, area1, area2, zi, zo):
@@ -255,12 +256,17 @@ class Fabric:
         t1, t2 = self._threads
         q = self._q([g.pmean for g in geoms], t1.area, t2.area, zi, zo)
         denom = q * zi
-        parts = [t.area * (s[0][:, None] + np.asarray(t.albedo) * s[1][:, None])
-                 for t, s in zip(self._threads, shades)]
-        inv = np.divide(1.0, denom, out=np.zeros_like(zi), where=denom > 0)[:, None]
+        inv = np.divide(1.0, denom, out=np.zeros_like(zi), where=denom > 0)
         if split:
-            return np.stack([p * inv for p in parts], axis=1)
-        return (parts[0] + parts[1]) * inv
+            parts = [t.area * (s[0][:, None] + np.asarray(t.albedo) * s[1][:, None])
+                     for t, s in zip(self._threads, shades)]
+            return np.stack([p * inv[:, None] for p in parts], axis=1)
+        area = np.array([[t1.area, t2.area]])
+        albedo = np.array([[t1.albedo, t2.albedo]], dtype=np.float64)
+        out = np.empty((1, zi.size, 3))
+        combine_rgb([s[0][None] for s in shades], [s[1][None] for s in shades], area,
+                    albedo, inv[None], out)
+        return out[0]
 
     def prepare(self, wi, wo) -> "Prepared":
         """Precompute the geometry of fixed pairs for repeated shading (fits).

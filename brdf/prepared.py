@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from brdf.frames import flat_pairs
-from brdf.kernel import SHADE_BLOCK, thread_shade
+from brdf.shading import SHADE_BLOCK, combine_rgb, thread_shade
 
 if TYPE_CHECKING:                    # brdf.fabric imports this module
     from brdf.fabric import Fabric
@@ -26,7 +26,7 @@ class Prepared:
     ----------
     block_elements : int or None
         (Parameter set, pair, sample) elements shaded per block; None (the default) takes
-        :data:`brdf.kernel.SHADE_BLOCK`. Only the speed and the rounding of the
+        :data:`brdf.shading.SHADE_BLOCK`. Only the speed and the rounding of the
         weighted sums over samples depend on it.
 
     Examples
@@ -125,7 +125,7 @@ class Prepared:
         ``alb`` (nb, 2, 3).
         """
         nb, nc = shades.shape[2:]
-        step = max(1, (self.block_elements or SHADE_BLOCK) // (3 * max(nb, 1)))
+        step = max(1, (self.block_elements or SHADE_BLOCK) // (4 * max(nb, 1)))
         a1, a2 = area[:, 0, None], area[:, 1, None]
         for c0 in range(0, nc, step):
             sl = slice(c0, c0 + step)
@@ -133,8 +133,5 @@ class Prepared:
             q = self.fabric._q(pmeans, a1, a2, self._zi[sl], self._zo[sl])
             denom = q * self._zi[sl]
             inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
-            parts = [area[:, j, None, None] * (shades[j, 0, :, sl, None]
-                                               + alb[:, None, j, :] * shades[j, 1, :, sl, None])
-                     for j in range(2)]
-            parts[0] += parts[1]
-            np.multiply(parts[0], inv[..., None], out=vals[:, sl])
+            combine_rgb(shades[:, 0, :, sl], shades[:, 1, :, sl], area, alb, inv,
+                        vals[:, sl])

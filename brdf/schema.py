@@ -126,8 +126,8 @@ class ParamInfo:
     def text(self, value) -> str:
         """``value`` as short text: ``1.46``, ``0.06, 0.24, 0.3`` (RGB), ``[-25, 25]``."""
         if self.kind == "scalar":
-            return f"{float(value):.4g}"
-        items = ", ".join(f"{float(v):.4g}" for v in np.atleast_1d(value))
+            return f"{float(value):g}"
+        items = ", ".join(f"{float(v):g}" for v in np.atleast_1d(value))
         return items if self.kind == "rgb" else f"[{items}]"
 
 

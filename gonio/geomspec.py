@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gonio.geometry import (_PLANE_NAMES, SPEC_HELP, Geometry, full_grid, merl,
-                            pairs_from_angles, plane, rusinkiewicz)
+from gonio.geometry import SPEC_HELP, Geometry
+from gonio.layouts import PLANE_AZIMUTHS, full_grid, merl, pairs_from_angles, plane, rusinkiewicz
 
 __all__ = ["from_spec", "read_pairs_csv", "SPEC_HELP"]
 
@@ -90,7 +90,7 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
             if len(args) not in (2, 3):
                 raise bad("plane takes WHICH:STEP[:THETA_I,...]")
             which = args[0].lower()
-            if which not in _PLANE_NAMES and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
+            if which not in PLANE_AZIMUTHS and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
                 raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
             step = num(args[1], "step")
             if len(args) == 3:

@@ -132,7 +132,7 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
 
     Examples
     --------
-    >>> from gonio.geometry import plane
+    >>> from gonio.layouts import plane
     >>> class Lambert:
     ...     def eval(self, wi, wo):
     ...         up = (wi[..., 2] > 0) & (wo[..., 2] > 0)

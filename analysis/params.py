@@ -1,11 +1,7 @@
-"""Parameter specification for fitting the microcylinder model: names, bounds, priors, ties.
+"""Parameter specification for fitting the microcylinder model: bounds, priors, ties.
 
-Model parameters are named by quantity and thread number: ``eta1``, ``kd1``, ``gamma_s1``,
-``gamma_v1``, ``area1``, ``albedo1_r``, ``albedo1_g``, ``albedo1_b`` and the same with ``2``.
-Extra parameters: ``tangent_scale1``/``tangent_scale2`` (a factor on a thread's tangent offsets),
-``scale`` (a nuisance overall factor on f_r, for relative data such as CUReT) and ``log_noise``
-(natural log of the noise standard deviation in the likelihood's residual space, for tables
-without sigma).
+The names, their bounds, units and priors, and the parsing of ``--free``/``--tie`` strings are
+in :mod:`analysis.paramnames` (derived from :mod:`brdf.schema`); this module re-exports them.
 
 Each parameter is free (sampled), fixed (at its default, normally the preset's value) or tied to
 another one (``eta2=eta1``: eta2 takes eta1's value; ``area2=1-area1``: the complement).
@@ -24,12 +20,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
+import tomllib
 from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
 import scipy.special
+
+from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_PARAM_NAMES,
+                                 PARAM_NAMES, defaults_from_fabric, entry, parse_free,
+                                 parse_ties, unknown)
+from brdf import schema
 
 __all__ = ["Param", "ParamSpec", "INTERNAL_LIMIT", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
            "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric", "parse_free", "parse_ties"]
@@ -116,141 +117,6 @@ class Param:
         return (-INTERNAL_LIMIT, INTERNAL_LIMIT)
 
 
-#: Base quantities: (lo, hi, prior, unit, fallback default), per thread.
-BASE_PARAMS: dict[str, tuple[float, float, str, str, float]] = {
-    "eta": (1.01, 3.0, "uniform", "1", 1.46),
-    "kd": (0.0, 1.0, "uniform", "1", 0.3),
-    "gamma_s": (0.3, 60.0, "log-uniform", "deg", 10.0),
-    "gamma_v": (0.3, 90.0, "log-uniform", "deg", 20.0),
-    "area": (0.0, 1.0, "uniform", "1", 0.5),
-    "albedo_r": (0.0, 1.0, "uniform", "1", 0.2),
-    "albedo_g": (0.0, 1.0, "uniform", "1", 0.2),
-    "albedo_b": (0.0, 1.0, "uniform", "1", 0.2),
-    "tangent_scale": (0.25, 2.0, "uniform", "1", 1.0),
-}
-_EXTRA = {
-    "scale": (1e-4, 1e4, "log-uniform", "1", 1.0),
-    "log_noise": (-12.0, 3.0, "uniform", "ln(residual unit)", -3.0),
-}
-
-
-def _thread_name(base: str, j: int) -> str:
-    if base.startswith("albedo_"):
-        return f"albedo{j}_{base[-1]}"
-    return f"{base}{j}"
-
-
-#: Names of the model parameters proper (what ``prepare(...).eval`` takes), both threads.
-MODEL_PARAM_NAMES: tuple[str, ...] = tuple(
-    _thread_name(b, j) for j in (1, 2) for b in BASE_PARAMS if b != "tangent_scale")
-#: Every parameter name a spec knows.
-PARAM_NAMES: tuple[str, ...] = MODEL_PARAM_NAMES + ("tangent_scale1", "tangent_scale2") \
-    + tuple(_EXTRA)
-#: Group aliases accepted by ``--free``.
-_ALIASES = {f"albedo{j}": tuple(f"albedo{j}_{c}" for c in "rgb") for j in (1, 2)}
-
-#: The default free set (8 parameters) and ties: one eta for both threads, area2 = 1 - area1.
-DEFAULT_FREE = ("eta1", "kd1", "kd2", "gamma_s1", "gamma_v1", "gamma_s2", "gamma_v2", "area1")
-DEFAULT_TIES = ("eta2=eta1", "area2=1-area1")
-
-
-def _base_of(name: str) -> tuple[str, int | None]:
-    m = re.fullmatch(r"albedo([12])_([rgb])", name)
-    if m:
-        return f"albedo_{m.group(2)}", int(m.group(1))
-    m = re.fullmatch(r"([a-z_]+?)([12])", name)
-    if m and m.group(1) in BASE_PARAMS:
-        return m.group(1), int(m.group(2))
-    return name, None
-
-
-def _unknown(name: str, what: str = "parameter") -> ValueError:
-    return ValueError(f"unknown {what} {name!r}; valid names: {', '.join(PARAM_NAMES)} "
-                      f"(aliases: {', '.join(_ALIASES)})")
-
-
-def parse_free(free) -> tuple[str, ...]:
-    """Parse ``"eta1,kd1,albedo1"`` (or a sequence) into full names, aliases expanded.
-
-    Raises
-    ------
-    ValueError
-        A name that is not a parameter (the message lists the valid ones) or an empty list.
-
-    Examples
-    --------
-    >>> parse_free("eta1, albedo2")
-    ('eta1', 'albedo2_r', 'albedo2_g', 'albedo2_b')
-    """
-    items = [s.strip() for s in free.split(",")] if isinstance(free, str) else list(free)
-    out: list[str] = []
-    for s in items:
-        if not s:
-            continue
-        for name in _ALIASES.get(s, (s,)):
-            if name not in PARAM_NAMES:
-                raise _unknown(name, "free parameter")
-            if name not in out:
-                out.append(name)
-    if not out:
-        raise ValueError(f"free parameters: none given ({free!r}); valid names: "
-                         f"{', '.join(PARAM_NAMES)}")
-    return tuple(out)
-
-
-def parse_ties(ties) -> dict[str, tuple[str, str]]:
-    """Parse ties ``"eta2=eta1"`` or ``"area2=1-area1"`` into {target: (source, kind)}.
-
-    ``a=b`` makes a follow b (a is the target). :class:`ParamSpec` swaps the two when only the
-    target is listed free, so ``--free eta1 --tie eta1=eta2`` samples eta1 and sets eta2 equal.
-    ``kind`` is ``"equal"`` or ``"complement"`` (target = 1 - source).
-
-    Examples
-    --------
-    >>> parse_ties(["eta2=eta1", "area2=1-area1"])
-    {'eta2': ('eta1', 'equal'), 'area2': ('area1', 'complement')}
-    """
-    if isinstance(ties, str):
-        ties = [t for t in ties.split(",")]
-    out: dict[str, tuple[str, str]] = {}
-    for t in ties or ():
-        t = t.replace(" ", "")
-        if not t:
-            continue
-        m = re.fullmatch(r"([a-z0-9_]+)=(1-)?([a-z0-9_]+)", t)
-        if not m:
-            raise ValueError(f"tie {t!r}: expected 'a=b' or 'a=1-b' with parameter names")
-        target, comp, source = m.group(1), m.group(2), m.group(3)
-        for name in (target, source):
-            if name not in PARAM_NAMES:
-                raise _unknown(name, "tied parameter")
-        if target == source:
-            raise ValueError(f"tie {t!r}: a parameter cannot be tied to itself")
-        out[target] = (source, "complement" if comp else "equal")
-    return out
-
-
-def defaults_from_fabric(fab) -> dict[str, float]:
-    """Default values of every model parameter from a fabric's threads (natural units).
-
-    Parameters
-    ----------
-    fab : object with ``threads``
-        Two threads with ``eta``, ``albedo`` (3), ``kd``, ``gamma_s``, ``gamma_v`` (degrees)
-        and ``area``.
-    """
-    out: dict[str, float] = {}
-    for j, th in enumerate(fab.threads, start=1):
-        out[f"eta{j}"] = float(th.eta)
-        out[f"kd{j}"] = float(th.kd)
-        out[f"gamma_s{j}"] = float(th.gamma_s)
-        out[f"gamma_v{j}"] = float(th.gamma_v)
-        out[f"area{j}"] = float(th.area)
-        for c, a in zip("rgb", np.broadcast_to(np.asarray(th.albedo, float), (3,))):
-            out[f"albedo{j}_{c}"] = float(a)
-    return out
-
-
 class ParamSpec:
     """Which parameters are free, fixed or tied, and their bounds, priors and defaults.
 
@@ -292,7 +158,7 @@ class ParamSpec:
         defaults = dict(defaults or {})
         for name in list(defaults) + list(bounds or {}) + list(priors or {}):
             if name not in PARAM_NAMES:
-                raise _unknown(name)
+                raise unknown(name)
         ties = parse_ties(ties) if not isinstance(ties, Mapping) else dict(ties)
         free = list(parse_free(free))
         self.ties = {}
@@ -307,8 +173,7 @@ class ParamSpec:
                                  f"to the same free parameter")
         self.params: dict[str, Param] = {}
         for name in PARAM_NAMES:
-            base, _ = _base_of(name)
-            lo, hi, prior, unit, fallback = BASE_PARAMS.get(base) or _EXTRA[name]
+            lo, hi, prior, unit, fallback = entry(name)
             if bounds and name in bounds:
                 b = tuple(float(x) for x in bounds[name])
                 if len(b) != 2:
@@ -348,7 +213,6 @@ class ParamSpec:
         ValueError
             The file is not valid TOML or holds unknown keys (the message names the file).
         """
-        import tomllib
         path = Path(path)
         try:
             with open(path, "rb") as fh:
@@ -394,7 +258,7 @@ class ParamSpec:
         new.params = dict(self.params)
         for k, v in values.items():
             if k not in new.params:
-                raise _unknown(k)
+                raise unknown(k)
             new.params[k] = dataclasses.replace(new.params[k], default=float(v))
         return new
 
@@ -445,7 +309,7 @@ class ParamSpec:
             jac = -(np.logaddexp(0.0, theta) + np.logaddexp(0.0, -theta)).sum(axis=-1)
         if self.ties or any(n.startswith("area") for n in self.free):
             v = self.values(theta)
-            ok &= v["area1"] + v["area2"] <= 1.0 + 1e-12
+            ok &= v["area1"] + v["area2"] <= schema.AREA_SUM_MAX + 1e-12
             for target in self.ties:
                 p = self.params[target]
                 ok &= (v[target] >= p.lo) & (v[target] <= p.hi)
@@ -454,11 +318,11 @@ class ParamSpec:
     def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Keyword arguments of ``prepare(...).eval``: each (B..., 2), albedo (B..., 2, 3)."""
         kw = {}
-        for q in ("eta", "kd", "gamma_s", "gamma_v", "area"):
+        for q in schema.SCALAR_PARAMS:
             kw[q] = np.stack([values[f"{q}1"], values[f"{q}2"]], axis=-1)
-        kw["albedo"] = np.stack(
-            [np.stack([values[f"albedo{j}_{c}"] for c in "rgb"], axis=-1) for j in (1, 2)],
-            axis=-2)
+        for q in (p.name for p in schema.THREAD_PARAMS if p.kind == "rgb"):
+            kw[q] = np.stack([np.stack([values[f"{q}{j}_{c}"] for c in schema.RGB_CHANNELS],
+                                       axis=-1) for j in (1, 2)], axis=-2)
         return kw
 
     def describe(self) -> dict:

@@ -4,7 +4,7 @@ The model as ``../shared/spec/MODEL.md`` specifies it: threads with tangent curv
 of two threads, the paper's six presets, and every variant. NumPy and SciPy only.
 """
 
-from brdf import directions, frames, terms
+from brdf import directions, frames, schema, terms
 from brdf.curve import SAMPLING_METHODS, TangentCurve
 from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
 from brdf.presets import PRESETS, fabric, preset_threads
@@ -14,5 +14,5 @@ from brdf.thread import Thread
 __all__ = [
     "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
-    "terms", "BRDF", "ThreadedBRDF",
+    "schema", "terms", "BRDF", "ThreadedBRDF",
 ]

@@ -6,9 +6,11 @@ import dataclasses
 
 import numpy as np
 
-from brdf import validate
+from brdf import schema, validate
 
 __all__ = ["TangentCurve", "SAMPLING_METHODS"]
+
+_OFFSETS, _LENGTHS = schema.THREAD["offsets"], schema.THREAD["lengths"]
 
 #: Names accepted by ``tangent_sampling``.
 SAMPLING_METHODS = ("midpoint", "control_points")
@@ -52,12 +54,12 @@ class TangentCurve:
             raise ValueError(f"offsets must have exactly one more entry than lengths; got "
                              f"{len(offsets)} offsets and {len(lengths)} lengths")
         for a in offsets:
-            if not (np.isfinite(a) and -90.0 <= a <= 90.0):
-                raise ValueError(f"offsets must lie in [-90, 90] degrees; got {a!r} in "
-                                 f"{offsets}")
+            if not _OFFSETS.contains(a):
+                raise ValueError(f"offsets must lie in {_OFFSETS.allowed} degrees; got {a!r} "
+                                 f"in {offsets}")
         for l in lengths:
-            if not (np.isfinite(l) and l >= 0.0):
-                raise ValueError(f"lengths must be finite and >= 0; got {l!r} in {lengths}")
+            if not _LENGTHS.contains(l):
+                raise ValueError(f"lengths must be {_LENGTHS.what}; got {l!r} in {lengths}")
         if lengths and sum(lengths) <= 0.0:
             raise ValueError(f"lengths must sum to more than 0; got {lengths}")
         if not lengths and len(offsets) != 1:  # pragma: no cover - guarded above

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from brdf import validate
+from brdf import schema, validate
 from brdf.curve import SAMPLING_METHODS
 from brdf.frames import flat_pairs
 from brdf.kernel import thread_geometry
@@ -53,7 +53,8 @@ class Fabric:
     Parameters
     ----------
     threads : sequence of two Thread
-        Thread 1 (the warp, along +x) and thread 2 (the weft, along +y).
+        Thread 1 (the warp, along +x) and thread 2 (the weft, along +y); their areas sum to
+        at most 1 (:func:`brdf.schema.check_areas`).
     masking : bool, default True
         Shadowing and masking M; off means M = 1.
     reweighting : bool, default True
@@ -65,7 +66,7 @@ class Fabric:
     gap : {"incident", "outgoing"}, default "incident"
         Gap term c_gap of Q: n . wi or n . wo.
     rotation : float, default 0
-        Rotation of both threads about n, radians.
+        Rotation of both threads about n, radians (:data:`brdf.schema.FABRIC`).
     name : str, optional
         A label (preset name).
 
@@ -98,10 +99,7 @@ class Fabric:
         if len(threads) != 2 or not all(isinstance(t, Thread) for t in threads):
             raise ValueError(f"threads must be two brdf.Thread objects (warp, weft); got "
                              f"{len(threads)} item(s)")
-        total = threads[0].area + threads[1].area
-        if total > 1.0 + 1e-12:
-            raise ValueError(f"area: the threads' areas must sum to at most 1; got "
-                             f"{threads[0].area} + {threads[1].area} = {total:g}")
+        schema.check_areas(threads[0].area, threads[1].area)
         unknown = set(options) - set(OPTIONS)
         if unknown:
             raise ValueError(f"unknown option(s) {', '.join(sorted(map(repr, unknown)))}; "
@@ -114,8 +112,7 @@ class Fabric:
         validate.choice("tangent_sampling", opts["tangent_sampling"], SAMPLING_METHODS)
         validate.choice("transmission", opts["transmission"], TRANSMISSION_METHODS)
         validate.choice("gap", opts["gap"], GAP_METHODS)
-        opts["rotation"] = validate.real("rotation", opts["rotation"],
-                                         what="a finite angle in radians")
+        opts["rotation"] = schema.FABRIC["rotation"].check(opts["rotation"])
         self._threads = threads
         self._options = opts
         self.name = name

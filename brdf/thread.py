@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from brdf import validate
+from brdf import schema
 from brdf.curve import TangentCurve
 
 __all__ = ["Thread"]
@@ -14,20 +14,9 @@ __all__ = ["Thread"]
 
 @dataclasses.dataclass(frozen=True)
 class Thread:
-    r"""A thread's parameters, in the units of the paper's Table II.
+    r"""A thread's parameters, in the units of the paper's Table II (:mod:`brdf.schema`).
 
-    ==========  ===========================================  ===============
-    parameter   meaning                                      unit / range
-    ==========  ===========================================  ===============
-    eta         index of refraction of the fibre             > 1
-    albedo      volume albedo A (R, G, B)                    >= 0 each
-    kd          isotropic share of volume scattering         [0, 1]
-    gamma_s     width of the surface-reflection lobe         degrees, > 0
-    gamma_v     width of the volume-scattering lobe          degrees, > 0
-    area        share a_j of the cloth covered by the thread [0, 1]
-    offsets     tangent offsets alpha_0..alpha_K             degrees, [-90, 90]
-    lengths     segment lengths l_1..l_K                     >= 0, sum > 0
-    ==========  ===========================================  ===============
+{parameter_table}
 
     Raises
     ------
@@ -52,19 +41,9 @@ class Thread:
 
     def __post_init__(self):
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
-        set_("eta", validate.real("eta", self.eta, lo=1.0, lo_open=True))
-        set_("kd", validate.real("kd", self.kd, lo=0.0, hi=1.0))
-        set_("gamma_s", validate.real("gamma_s", self.gamma_s, lo=0.0, lo_open=True,
-                                      what="a finite angle > 0 degrees"))
-        set_("gamma_v", validate.real("gamma_v", self.gamma_v, lo=0.0, lo_open=True,
-                                      what="a finite angle > 0 degrees"))
-        set_("area", validate.real("area", self.area, lo=0.0, hi=1.0))
-        alb = np.asarray(self.albedo, dtype=np.float64) if _numeric(self.albedo) else None
-        if alb is None or alb.shape not in ((), (3,)) or not np.all(np.isfinite(alb)) \
-                or np.any(alb < 0):
-            raise ValueError(f"albedo must be one or three finite numbers >= 0 (R, G, B); "
-                             f"got {self.albedo!r}")
-        set_("albedo", tuple(float(a) for a in np.broadcast_to(alb, (3,))))
+        for name in schema.SCALAR_PARAMS:
+            set_(name, schema.THREAD[name].check(getattr(self, name)))
+        set_("albedo", _rgb(schema.THREAD["albedo"], self.albedo))
         curve = TangentCurve(self.offsets, self.lengths)
         set_("offsets", curve.offsets)
         set_("lengths", curve.lengths)
@@ -84,9 +63,17 @@ class Thread:
                 for f in dataclasses.fields(self)}
 
 
-def _numeric(x) -> bool:
+Thread.__doc__ = Thread.__doc__.replace("{parameter_table}", "\n".join(
+    "    " + line for line in schema.parameter_table().splitlines()))
+
+
+def _rgb(info: schema.ParamInfo, value) -> tuple[float, float, float]:
+    """One or three numbers in ``info``'s range as an (R, G, B) tuple, or ValueError."""
     try:
-        np.asarray(x, dtype=np.float64)
-        return True
+        arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        return False
+        arr = None
+    if arr is None or arr.shape not in ((), (3,)) \
+            or not all(info.contains(a) for a in arr.ravel()):
+        raise ValueError(f"{info.name} must be {info.what}; got {value!r}")
+    return tuple(float(a) for a in np.broadcast_to(arr, (3,)))

@@ -12,8 +12,9 @@ from gonio.csvtable import read_csv, write_csv
 from gonio.curet import load_curet, read_curet
 from gonio.errors import FormatError
 from gonio.exr import read_exr, write_exr
-from gonio.geometry import Geometry, full_grid, pairs, pairs_from_angles, plane, rusinkiewicz
-from gonio.geometry import merl as merl_grid
+from gonio.geometry import Geometry
+from gonio.layouts import full_grid, pairs, pairs_from_angles, plane, rusinkiewicz
+from gonio.layouts import merl as merl_grid
 from gonio.geomspec import from_spec
 from gonio.instrument import Instrument
 from gonio.io import read, write

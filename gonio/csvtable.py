@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -14,7 +15,7 @@ from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
 from gonio.table import Table
 
-__all__ = ["read_csv", "write_csv"]
+__all__ = ["read_csv", "write_csv", "read_rows", "CsvRows", "ANGLES"]
 
 ANGLES = ("theta_i", "phi_i", "theta_o", "phi_o")
 _KEY = re.compile(r"^([A-Za-z_][\w.\-]*)\s*:\s?(.*)$")
@@ -81,6 +82,80 @@ def _parse_float(text: str) -> float:
     return float("nan") if text == "" else float(text)
 
 
+@dataclasses.dataclass(frozen=True)
+class CsvRows:
+    """The text of a CSV file with ``#`` comments, split but not yet interpreted.
+
+    Attributes
+    ----------
+    meta : dict
+        The ``# key: value`` comments (JSON values decoded when they parse).
+    header : list of str or None
+        The first non-comment row (column names), None if there is none.
+    header_line : int
+        Its line number (0 without a header).
+    rows : list of (int, list of str)
+        Each data row's line number and fields (stripped).
+    """
+
+    meta: dict
+    header: list[str] | None
+    header_line: int
+    rows: list[tuple[int, list[str]]]
+
+
+def read_rows(path) -> CsvRows:
+    r"""Split a CSV file into comments, header and data rows (the layer under :func:`read_csv`
+    and the ``pairs:FILE.csv`` geometry reader).
+
+    Raises
+    ------
+    OSError
+        The file cannot be read.
+    FormatError
+        Not UTF-8 text, or a data row with another number of fields than the header (its
+        line number is given).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "p.csv"
+    >>> _ = p.write_text("# source: \"doc\"\ntheta_i,phi_i\n30, 0\n")
+    >>> r = read_rows(p)
+    >>> r.meta, r.header, r.rows
+    ({'source': 'doc'}, ['theta_i', 'phi_i'], [(3, ['30', '0'])])
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
+    meta: dict = {}
+    header, header_line, rows = None, 0, []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            m = _KEY.match(stripped[1:].strip())
+            if m:
+                key, raw = m.group(1), m.group(2).strip()
+                try:
+                    meta[key] = json.loads(raw)
+                except json.JSONDecodeError:
+                    meta[key] = raw
+            continue
+        fields = [c.strip() for c in stripped.split(",")]
+        if header is None:
+            header, header_line = fields, lineno
+            continue
+        if len(fields) != len(header):
+            raise FormatError(path, f"line {lineno}: expected {len(header)} columns "
+                                    f"({','.join(header)}), got {len(fields)}")
+        rows.append((lineno, fields))
+    return CsvRows(meta, header, header_line, rows)
+
+
 def read_csv(path) -> Table:
     """Read a CSV BRDF table.
 
@@ -101,34 +176,13 @@ def read_csv(path) -> Table:
         No header, unknown or missing columns, or a bad row (its line number is given).
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
-    meta: dict = {}
-    header = None
+    text = read_rows(path)
+    meta, header = text.meta, text.header
+    if header is None:
+        raise FormatError(path, "no header row (expected theta_i,phi_i,theta_o,phi_o,r,g,b)")
+    _check_header(path, text.header_line, header)
     rows = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            m = _KEY.match(stripped[1:].strip())
-            if m:
-                key, raw = m.group(1), m.group(2).strip()
-                try:
-                    meta[key] = json.loads(raw)
-                except json.JSONDecodeError:
-                    meta[key] = raw
-            continue
-        fields = [c.strip() for c in stripped.split(",")]
-        if header is None:
-            header = fields
-            _check_header(path, lineno, header)
-            continue
-        if len(fields) != len(header):
-            raise FormatError(path, f"line {lineno}: expected {len(header)} columns "
-                                    f"({','.join(header)}), got {len(fields)}")
+    for lineno, fields in text.rows:
         try:
             row = [_parse_float(x) for x in fields]
         except ValueError:
@@ -137,8 +191,6 @@ def read_csv(path) -> Table:
         if not all(np.isfinite(row[header.index(a)]) for a in ANGLES):
             raise FormatError(path, f"line {lineno}: angles must be finite numbers")
         rows.append(row)
-    if header is None:
-        raise FormatError(path, "no header row (expected theta_i,phi_i,theta_o,phi_o,r,g,b)")
     if not rows:
         raise FormatError(path, "no data rows after the header")
     data = np.array(rows, dtype=np.float64)

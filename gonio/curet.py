@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -97,7 +98,6 @@ def read_curet(folder, sample: int) -> Table:
 
 def load_curet(folder, sample: int) -> Table:
     """Deprecated name of :func:`read_curet` (``read_*`` gives a Table, ``load_*`` a BRDF)."""
-    import warnings
     warnings.warn("gonio.load_curet is deprecated; use gonio.read_curet (it returns a Table)",
                   DeprecationWarning, stacklevel=2)
     return read_curet(folder, sample)

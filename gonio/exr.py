@@ -19,10 +19,10 @@ name) and ``microcyl_meta``, the table's ``meta`` as a JSON object (strings).
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
+import OpenEXR
 
 from brdf.frames import from_angles
 from gonio.atomic import atomic_write
@@ -91,8 +91,6 @@ def write_exr(table: Table, path) -> None:
     >>> back.values.astype("f4").tolist(), back.meta["source"]
     ([[0.1, 0.2, 0.3]], 'doc')
     """
-    import OpenEXR
-
     n = len(table)
     if n == 0:
         raise ValueError("write_exr: the table is empty; an OpenEXR image needs >= 1 pixel")
@@ -146,9 +144,32 @@ def read_exr(path) -> Table:
         Not an OpenEXR file (wrong magic), unreadable or truncated, a missing channel, or a
         ``microcyl_rows`` larger than the image.
     """
-    import OpenEXR
-
     path = Path(path)
+    header, chans = _read_channels(path)
+    has_sigma = _check_channels(path, chans)
+    n = _row_count(path, header, next(iter(chans.values())).size)
+    flat = lambda name: chans[name].astype(np.float64).ravel()[:n]  # noqa: E731
+    if "R" in chans:
+        values = np.stack([flat(c) for c in "RGB"], axis=1)
+    else:
+        values = np.repeat(flat("Y")[:, None], 3, axis=1)
+    sigma = None
+    if has_sigma:
+        sigma = (np.stack([flat(f"sigma.{c}") for c in "RGB"], axis=1) if "sigma.R" in chans
+                 else np.repeat(flat("sigma.Y")[:, None], 3, axis=1))
+    ti, pi_, to, po = (flat(c) for c in ANGLE_CHANNELS)
+    if str(header.get("angle_unit", "radian")).startswith("deg"):
+        ti, pi_, to, po = (np.radians(a) for a in (ti, pi_, to, po))
+    if not all(np.all(np.isfinite(a)) for a in (ti, pi_, to, po)):
+        raise FormatError(path, "non-finite angle in the angle channels")
+    meta = _header_meta(path, header)
+    meta["missing_values"] = count_missing(values)
+    meta.setdefault("file_format", "exr")
+    return Table(from_angles(ti, pi_), from_angles(to, po), values, sigma, meta)
+
+
+def _read_channels(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
+    """The header attributes and the channels (name -> pixel array) of an OpenEXR file."""
     with open(path, "rb") as fh:
         head = fh.read(4)
     if head != _MAGIC:
@@ -159,6 +180,12 @@ def read_exr(path) -> Table:
             chans = {k: np.array(v.pixels) for k, v in exr.channels().items()}
     except (RuntimeError, OSError, ValueError) as exc:
         raise FormatError(path, f"unreadable OpenEXR (truncated or corrupt): {exc}") from None
+    return header, chans
+
+
+def _check_channels(path: Path, chans: dict) -> bool:
+    """FormatError unless the angle and value channels (and all sigma ones, if any) are there;
+    returns whether sigma is."""
     need = list(ANGLE_CHANNELS)
     if not ("Y" in chans and not any(c in chans for c in "RGB")):
         need += ["R", "G", "B"]
@@ -171,38 +198,31 @@ def read_exr(path) -> Table:
     if has_sigma and "sigma.Y" not in chans and not all(s in chans for s in sig_names):
         raise FormatError(path, "missing channel(s) " +
                           ", ".join(s for s in sig_names if s not in chans))
-    size = next(iter(chans.values())).size
-    n = size
-    if "microcyl_rows" in header:
-        try:
-            n = int(str(header["microcyl_rows"]))
-        except ValueError:
-            raise FormatError(path, f"bad microcyl_rows attribute {header['microcyl_rows']!r}")
-        if not 0 < n <= size:
-            raise FormatError(path, f"wrong size: microcyl_rows = {n} but the image has "
-                                    f"{size} pixels")
-    flat = lambda name: chans[name].astype(np.float64).ravel()[:n]  # noqa: E731
-    if "R" in chans:
-        values = np.stack([flat(c) for c in "RGB"], axis=1)
-    else:
-        values = np.repeat(flat("Y")[:, None], 3, axis=1)
-    sigma = None
-    if has_sigma:
-        sigma = (np.stack([flat(s) for s in sig_names], axis=1) if "sigma.R" in chans
-                 else np.repeat(flat("sigma.Y")[:, None], 3, axis=1))
-    ti, pi_, to, po = (flat(c) for c in ANGLE_CHANNELS)
-    if str(header.get("angle_unit", "radian")).startswith("deg"):
-        ti, pi_, to, po = (np.radians(a) for a in (ti, pi_, to, po))
-    if not all(np.all(np.isfinite(a)) for a in (ti, pi_, to, po)):
-        raise FormatError(path, "non-finite angle in the angle channels")
-    meta = {}
-    if "microcyl_meta" in header:
-        try:
-            meta = json.loads(str(header["microcyl_meta"]))
-        except json.JSONDecodeError as exc:
-            raise FormatError(path, f"microcyl_meta attribute is not JSON: {exc}") from None
-        if not isinstance(meta, dict):
-            raise FormatError(path, "microcyl_meta attribute is not a JSON object")
-    meta["missing_values"] = count_missing(values)
-    meta.setdefault("file_format", "exr")
-    return Table(from_angles(ti, pi_), from_angles(to, po), values, sigma, meta)
+    return has_sigma
+
+
+def _row_count(path: Path, header: dict, size: int) -> int:
+    """The table's rows: ``microcyl_rows`` (checked against the image size), else ``size``."""
+    if "microcyl_rows" not in header:
+        return size
+    try:
+        n = int(str(header["microcyl_rows"]))
+    except ValueError:
+        raise FormatError(path, f"bad microcyl_rows attribute {header['microcyl_rows']!r}")
+    if not 0 < n <= size:
+        raise FormatError(path, f"wrong size: microcyl_rows = {n} but the image has "
+                                f"{size} pixels")
+    return n
+
+
+def _header_meta(path: Path, header: dict) -> dict:
+    """The table's ``meta`` from the ``microcyl_meta`` attribute ({} without one)."""
+    if "microcyl_meta" not in header:
+        return {}
+    try:
+        meta = json.loads(str(header["microcyl_meta"]))
+    except json.JSONDecodeError as exc:
+        raise FormatError(path, f"microcyl_meta attribute is not JSON: {exc}") from None
+    if not isinstance(meta, dict):
+        raise FormatError(path, "microcyl_meta attribute is not a JSON object")
+    return meta

@@ -3,49 +3,52 @@
 
 from __future__ import annotations
 
-import csv
 import re
 from pathlib import Path
 
 import numpy as np
 
-from gonio.geometry import (_PLANE_NAMES, SPEC_HELP, Geometry, full_grid, merl,
-                            pairs_from_angles, plane, rusinkiewicz)
+from gonio.csvtable import ANGLES, read_rows
+from gonio.errors import FormatError
+from gonio.geometry import SPEC_HELP, Geometry
+from gonio.layouts import PLANE_AZIMUTHS, full_grid, merl, pairs_from_angles, plane, rusinkiewicz
 
 __all__ = ["from_spec", "read_pairs_csv", "SPEC_HELP"]
 
 
 def read_pairs_csv(path) -> Geometry:
-    """Read theta_i,phi_i,theta_o,phi_o (degrees) from a CSV; '#' lines are comments."""
+    """Read theta_i,phi_i,theta_o,phi_o (degrees) from a CSV; '#' lines are comments.
+
+    The file is split by :func:`gonio.csvtable.read_rows`, the reader of CSV tables; other
+    columns are allowed and ignored.
+
+    Raises
+    ------
+    OSError
+        The file cannot be read.
+    ValueError
+        No header, a header without the four angle columns, or a bad row (with its line
+        number): a :class:`gonio.FormatError` naming the file.
+    """
     path = Path(path)
-    need = ("theta_i", "phi_i", "theta_o", "phi_o")
     try:
-        text = path.read_text()
+        text = read_rows(path)
     except OSError as exc:
         raise OSError(exc.errno, f"cannot read pairs file: {exc.strerror}", str(path)) from None
-    rows, header, cols = [], None, None
-    for lineno, line in enumerate(text.splitlines(), 1):
-        if not line.strip() or line.lstrip().startswith("#"):
-            continue
-        fields = [f.strip() for f in next(csv.reader([line]))]
-        if header is None:
-            header = fields
-            missing = [c for c in need if c not in header]
-            if missing:
-                raise ValueError(f"{path}: line {lineno}: header lacks column(s) "
-                                 f"{', '.join(missing)}; need {','.join(need)} (degrees)")
-            cols = [header.index(c) for c in need]
-            continue
-        if len(fields) != len(header):
-            raise ValueError(f"{path}: line {lineno}: {len(fields)} fields, header has "
-                             f"{len(header)}")
+    if text.header is None or not text.rows:
+        raise FormatError(path, f"no pairs (need a header {','.join(ANGLES)} and rows)")
+    missing = [c for c in ANGLES if c not in text.header]
+    if missing:
+        raise FormatError(path, f"line {text.header_line}: header lacks column(s) "
+                                f"{', '.join(missing)}; need {','.join(ANGLES)} (degrees)")
+    cols = [text.header.index(c) for c in ANGLES]
+    rows = []
+    for lineno, fields in text.rows:
         try:
             rows.append([float(fields[c]) for c in cols])
         except ValueError:
-            raise ValueError(f"{path}: line {lineno}: not a number in "
-                             f"{','.join(fields[c] for c in cols)!r}") from None
-    if not rows:
-        raise ValueError(f"{path}: no pairs (need a header {','.join(need)} and rows)")
+            raise FormatError(path, f"line {lineno}: not a number in "
+                                    f"{','.join(fields[c] for c in cols)!r}") from None
     a = np.asarray(rows)
     return pairs_from_angles(*a.T, degrees=True, params={"file": str(path)})
 
@@ -90,7 +93,7 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
             if len(args) not in (2, 3):
                 raise bad("plane takes WHICH:STEP[:THETA_I,...]")
             which = args[0].lower()
-            if which not in _PLANE_NAMES and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
+            if which not in PLANE_AZIMUTHS and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
                 raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
             step = num(args[1], "step")
             if len(args) == 3:

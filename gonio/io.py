@@ -6,6 +6,12 @@ from pathlib import Path
 
 import numpy as np
 
+from gonio.alta import read_alta, write_alta
+from gonio.csvtable import read_csv, write_csv
+from gonio.curet import read_curet
+from gonio.exr import count_missing, from_angles, read_exr, write_exr
+from gonio.merl import read_merl, write_merl
+from gonio.rgl import load_rgl, read_tensor_file
 from gonio.table import Table
 
 __all__ = ["read", "write", "READ_SUFFIXES", "WRITE_SUFFIXES"]
@@ -57,19 +63,14 @@ def read(path, **options) -> Table:
     if not path.exists():
         raise FileNotFoundError(2, "No such file", str(path))
     if kind == "exr":
-        from gonio.exr import read_exr
         return read_exr(path, **options)
     if kind == "csv":
-        from gonio.csvtable import read_csv
         return read_csv(path, **options)
     if kind == "merl":
-        from gonio.merl import read_merl
         return read_merl(path, **options)
     if kind == "alta":
-        from gonio.alta import read_alta
         return read_alta(path, **options)
     if kind == "curet":
-        from gonio.curet import read_curet
         if "sample" not in options:
             raise ValueError(f"{path}: a CUReT abrdf.dat holds 61 samples; give one: "
                              "gonio.read(path, sample=N) or gonio.read_curet(folder, N)")
@@ -78,9 +79,6 @@ def read(path, **options) -> Table:
 
 
 def _rgl_table(path: Path, step: float = 5.0) -> Table:
-    from gonio.exr import count_missing, from_angles
-    from gonio.rgl import load_rgl, read_tensor_file
-
     fields = read_tensor_file(path)
     brdf = load_rgl(path)
     theta_i = np.asarray(fields["theta_i"], np.float64)
@@ -121,16 +119,12 @@ def write(obj, path, **options) -> None:
     path = Path(path)
     kind = _kind(path, WRITE_SUFFIXES)
     if kind == "merl":
-        from gonio.merl import write_merl
         return write_merl(obj, path, **options)
     if not isinstance(obj, Table):
         raise ValueError(f"write: {path.suffix} holds a Table, got {type(obj).__name__} "
                          "(measure a BRDF first, or write it to .binary)")
     if kind == "exr":
-        from gonio.exr import write_exr
         return write_exr(obj, path, **options)
     if kind == "csv":
-        from gonio.csvtable import write_csv
         return write_csv(obj, path, **options)
-    from gonio.alta import write_alta
     return write_alta(obj, path, **options)

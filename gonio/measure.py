@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,6 @@ def toolkit_version() -> str:
     True
     """
     try:
-        from importlib.metadata import PackageNotFoundError, version
         return version("microcyl")
     except PackageNotFoundError:
         return "unknown"
@@ -132,7 +132,7 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
 
     Examples
     --------
-    >>> from gonio.geometry import plane
+    >>> from gonio.layouts import plane
     >>> class Lambert:
     ...     def eval(self, wi, wo):
     ...         up = (wi[..., 2] > 0) & (wo[..., 2] > 0)
@@ -146,77 +146,19 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
     """
     if not callable(getattr(brdf, "eval", None)):
         raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
-    if isinstance(geometry, str):
-        geometry = from_spec(geometry)
-    if not isinstance(geometry, Geometry):
-        raise ValueError(f"geometry must be a gonio.Geometry or a spec string; "
-                         f"got {type(geometry).__name__}")
-    if instrument is None:
-        instrument = Instrument()
-    if not isinstance(instrument, Instrument):
-        raise ValueError(f"instrument must be a gonio.Instrument or None; "
-                         f"got {type(instrument).__name__}")
-    if chunk is None:
-        chunk = CHUNK_EVALUATIONS
-    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
-        raise ValueError(f"chunk must be a positive integer; got {chunk!r}")
-    if isinstance(seed, np.random.Generator):
-        rng, seed_meta = seed, "numpy.random.Generator (state not recorded)"
-    elif seed is None or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)
-                          and seed >= 0):
-        rng = np.random.default_rng(seed)
-        seed_meta = None if seed is None else int(seed)
-    else:
-        raise ValueError(f"seed must be a non-negative integer, a numpy Generator or None; "
-                         f"got {seed!r}")
-
-    n = len(geometry)
-    ps, ws = instrument.source_rule
-    pd, wd = instrument.detector_rule
-    ks, kd = len(ws), len(wd)
-    per_pair = ks * kd
-    step = max(1, int(chunk) // per_pair)
-    total = n * per_pair
-    if progress is None:
-        progress = total >= PROGRESS_MIN_EVALUATIONS and sys.stderr.isatty()
-
-    values = np.empty((n, 3))
-    wgt = (ws[:, None] * wd[None, :]).reshape(-1)
-    rot = geometry.rotation
-    bar = progress_bar(n, desc="measure", unit="pair", enabled=bool(progress and n))
-    try:
-        for a in range(0, n, step):
-            b = min(n, a + step)
-            wi_lab = geometry.wi_lab[a:b]
-            wo_lab = geometry.wo_lab[a:b]
-            si = wi_lab[:, None, :] if ks == 1 else cone_directions(wi_lab, ps)   # (c, ks, 3)
-            so = wo_lab[:, None, :] if kd == 1 else cone_directions(wo_lab, pd)   # (c, kd, 3)
-            if rot:
-                si = rotate_z(si, -rot)
-                so = rotate_z(so, -rot)
-            c = b - a
-            wi_all = np.broadcast_to(si[:, :, None, :], (c, ks, kd, 3)).reshape(-1, 3)
-            wo_all = np.broadcast_to(so[:, None, :, :], (c, ks, kd, 3)).reshape(-1, 3)
-            f = _evaluate(brdf, wi_all, wo_all).reshape(c, ks, kd, 3)
-            if per_pair == 1:
-                values[a:b] = f[:, 0, 0]
-            else:
-                # an explicitly ordered sum (numpy's reductions pick pairwise or sequential
-                # order by memory layout)
-                f = f.reshape(c, per_pair, 3)
-                acc = f[:, 0] * wgt[0]
-                for q in range(1, per_pair):
-                    acc += f[:, q] * wgt[q]
-                values[a:b] = acc
-            if bar is not None:
-                bar.update(c)
-    finally:
-        if bar is not None:
-            bar.close()
-
+    geometry, instrument = _geometry_of(geometry), _instrument_of(instrument)
+    rng, seed_meta = _rng_of(seed)
+    values = _cone_averages(brdf, geometry, instrument, _chunk_of(chunk), progress)
     sigma = instrument.sigma(values)
     noisy = instrument.add_noise(values, rng)
-    meta = {
+    meta = _meta(brdf, geometry, instrument, seed_meta)
+    # copies: Table normalizes its direction arrays in place
+    return Table(np.array(geometry.wi), np.array(geometry.wo), noisy, sigma, meta)
+
+
+def _meta(brdf, geometry: Geometry, instrument: Instrument, seed_meta) -> dict[str, Any]:
+    """The table's ``meta``: what was measured, on what, through what, with which seed."""
+    return {
         "quantity": "f_r",
         "units": "1/sr",
         "source": describe_brdf(brdf),
@@ -226,5 +168,96 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
         "software": "microcyl gonio.measure",
         "version": toolkit_version(),
     }
-    # copies: Table normalizes its direction arrays in place
-    return Table(np.array(geometry.wi), np.array(geometry.wo), noisy, sigma, meta)
+
+
+def _geometry_of(geometry) -> Geometry:
+    """A Geometry, or one built from a spec string; ValueError otherwise."""
+    if isinstance(geometry, str):
+        geometry = from_spec(geometry)
+    if not isinstance(geometry, Geometry):
+        raise ValueError(f"geometry must be a gonio.Geometry or a spec string; "
+                         f"got {type(geometry).__name__}")
+    return geometry
+
+
+def _instrument_of(instrument) -> Instrument:
+    """The instrument, a noiseless point instrument for None; ValueError otherwise."""
+    if instrument is None:
+        return Instrument()
+    if not isinstance(instrument, Instrument):
+        raise ValueError(f"instrument must be a gonio.Instrument or None; "
+                         f"got {type(instrument).__name__}")
+    return instrument
+
+
+def _chunk_of(chunk) -> int:
+    """BRDF evaluations per chunk: ``CHUNK_EVALUATIONS`` for None; ValueError unless >= 1."""
+    if chunk is None:
+        return CHUNK_EVALUATIONS
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise ValueError(f"chunk must be a positive integer; got {chunk!r}")
+    return int(chunk)
+
+
+def _rng_of(seed) -> tuple[np.random.Generator, Any]:
+    """The noise generator of ``seed`` and what ``meta["seed"]`` records of it."""
+    if isinstance(seed, np.random.Generator):
+        return seed, "numpy.random.Generator (state not recorded)"
+    if seed is None or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)
+                        and seed >= 0):
+        return np.random.default_rng(seed), None if seed is None else int(seed)
+    raise ValueError(f"seed must be a non-negative integer, a numpy Generator or None; "
+                     f"got {seed!r}")
+
+
+def _cone_averages(brdf, geometry: Geometry, instrument: Instrument, chunk: int,
+                   progress: bool | None) -> np.ndarray:
+    """Noiseless cone averages of f_r, (n, 3), chunk by chunk with an optional progress bar."""
+    n = len(geometry)
+    per_pair = len(instrument.source_rule[1]) * len(instrument.detector_rule[1])
+    step = max(1, chunk // per_pair)
+    if progress is None:
+        progress = n * per_pair >= PROGRESS_MIN_EVALUATIONS and sys.stderr.isatty()
+    values = np.empty((n, 3))
+    bar = progress_bar(n, desc="measure", unit="pair", enabled=bool(progress and n))
+    try:
+        for a in range(0, n, step):
+            b = min(n, a + step)
+            values[a:b] = _chunk_average(brdf, geometry.wi_lab[a:b], geometry.wo_lab[a:b],
+                                         geometry.rotation, instrument)
+            if bar is not None:
+                bar.update(b - a)
+    finally:
+        if bar is not None:
+            bar.close()
+    return values
+
+
+def _chunk_average(brdf, wi_lab: np.ndarray, wo_lab: np.ndarray, rot: float,
+                   instrument: Instrument) -> np.ndarray:
+    """Cone averages of f_r for c pairs of lab directions (c, 3) -> (c, 3).
+
+    Each source point (ks of them about wi) is paired with each detector point (kd about wo),
+    turned into the sample frame by -rot about n, evaluated, and summed with the weights
+    a_k b_l in a fixed order.
+    """
+    ps, ws = instrument.source_rule
+    pd, wd = instrument.detector_rule
+    ks, kd, c = len(ws), len(wd), wi_lab.shape[0]
+    si = wi_lab[:, None, :] if ks == 1 else cone_directions(wi_lab, ps)   # (c, ks, 3)
+    so = wo_lab[:, None, :] if kd == 1 else cone_directions(wo_lab, pd)   # (c, kd, 3)
+    if rot:
+        si = rotate_z(si, -rot)
+        so = rotate_z(so, -rot)
+    wi_all = np.broadcast_to(si[:, :, None, :], (c, ks, kd, 3)).reshape(-1, 3)
+    wo_all = np.broadcast_to(so[:, None, :, :], (c, ks, kd, 3)).reshape(-1, 3)
+    f = _evaluate(brdf, wi_all, wo_all).reshape(c, ks * kd, 3)
+    if ks * kd == 1:
+        return f[:, 0]
+    # an explicitly ordered sum (numpy's reductions pick pairwise or sequential order by
+    # memory layout)
+    wgt = (ws[:, None] * wd[None, :]).reshape(-1)
+    acc = f[:, 0] * wgt[0]
+    for q in range(1, ks * kd):
+        acc += f[:, q] * wgt[q]
+    return acc

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -199,7 +200,6 @@ def read_merl(path, stride: int | tuple[int, int, int] = 1, keep_missing: bool =
 
 def merl_table(path, stride=1, keep_missing: bool = True) -> Table:
     """Deprecated name of :func:`read_merl` (``read_*`` gives a Table, ``load_*`` a BRDF)."""
-    import warnings
     warnings.warn("gonio.merl_table is deprecated; use gonio.read_merl (it returns a Table)",
                   DeprecationWarning, stacklevel=2)
     return read_merl(path, stride, keep_missing)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+import tqdm.auto
+
 __all__ = ["progress_bar"]
 
 
@@ -27,6 +29,6 @@ def progress_bar(total: int, *, desc: str, unit: str, enabled: bool = True, init
     >>> with progress_bar(3, desc="demo", unit="item", enabled=False) as bar:
     ...     bar.update(3)
     """
-    from tqdm.auto import tqdm     # imported on use: tqdm starts a monitor thread
-    return tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=False,
-                file=sys.stderr, disable=not enabled)
+    # looked up on each call (not bound at import), so a patched tqdm.auto.tqdm is used
+    return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=False,
+                          file=sys.stderr, disable=not enabled)

@@ -56,18 +56,20 @@ def _check_fabric(name: str) -> None:
 
 
 def format_fabrics_table(names=brdf.PRESETS) -> str:
-    """The presets' parameters as a text table (gamma and offsets in degrees)."""
-    head = (f"{'fabric':31s} {'thr':3s} {'eta':>6s} {'albedo (R, G, B)':>24s} {'kd':>4s} "
-            f"{'g_s':>5s} {'g_v':>5s} {'area':>5s}  offsets / lengths")
-    lines = [head, "-" * len(head)]
+    """The presets' parameters as a text table: one row a thread, one column a parameter of
+    :data:`brdf.schema.THREAD_PARAMS` (headed with its unit: gamma and offsets in degrees)."""
+    params = brdf.schema.THREAD_PARAMS
+    rows = [["fabric", "thr"] + [p.heading for p in params]]
     for name in names:
         for j, t in enumerate(brdf.preset_threads(name), 1):
-            alb = ", ".join(f"{a:.4g}" for a in t.albedo)
-            off = ", ".join(f"{o:g}" for o in t.offsets)
-            lng = ", ".join(f"{x:g}" for x in t.lengths)
-            lines.append(f"{name if j == 1 else '':31s} T{j:<2d} {t.eta:6.3f} {alb:>24s} "
-                         f"{t.kd:4.2f} {t.gamma_s:5.1f} {t.gamma_v:5.1f} {t.area:5.2f}  "
-                         f"[{off}] / [{lng}]")
+            rows.append([name if j == 1 else "", f"T{j}"]
+                        + [p.text(getattr(t, p.name)) for p in params])
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    # Text columns (fabric, thread, sequences) to the left, numbers to the right.
+    left = [True, True] + [p.kind == "sequence" for p in params]
+    lines = ["  ".join(c.ljust(w) if lft else c.rjust(w)
+                       for c, w, lft in zip(r, widths, left)).rstrip() for r in rows]
+    lines.insert(1, "-" * max(len(line) for line in lines))
     return "\n".join(lines)
 
 

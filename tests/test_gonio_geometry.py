@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from gonio import geometry as G
+from gonio import layouts as L
 from gonio.geometry import Geometry
 
 
@@ -106,15 +107,15 @@ def test_plane_round_trip_and_signs():
 
 
 def test_plane_layouts():
-    g = G.plane("warp", 5)
+    g = L.plane("warp", 5)
     assert len(g) == 6 * 35 and g.info["dropped_below_horizon"] == 0
     to = np.degrees(g.coords["theta_o"])
     assert to.min() == pytest.approx(-85) and to.max() == pytest.approx(85)
     assert np.allclose(g.wi[:, 1], 0) and np.allclose(g.wo[:, 1], 0)   # all in the xz plane
-    w = G.plane("weft", 10, theta_i=[40])
+    w = L.plane("weft", 10, theta_i=[40])
     assert np.allclose(w.wi[:, 0], 0) and np.allclose(w.wo[:, 0], 0)
     assert np.allclose(w.wi[0], [0, math.sin(math.radians(40)), math.cos(math.radians(40))])
-    d = G.plane("45", 10, theta_i=[40])
+    d = L.plane("45", 10, theta_i=[40])
     assert np.allclose(d.wi[:, 0], d.wi[:, 1])
     # in standard angles, phi_o = phi_i + 180 on the specular side
     ti, pi_, to, po = G.angles_from_directions(d.wi) + G.angles_from_directions(d.wo)
@@ -125,7 +126,7 @@ def test_plane_layouts():
 # ------------------------------------------------------------------ full grid
 
 def test_full_grid_counts_and_ranges():
-    g = G.full_grid(10)
+    g = L.full_grid(10)
     per_side = 1 + 8 * 36                # theta 0..80, one direction at theta = 0
     assert len(g) == per_side ** 2 == 83521
     for side in ("i", "o"):
@@ -139,14 +140,14 @@ def test_full_grid_counts_and_ranges():
     assert len(side) == per_side
     # coordinates describe the directions
     assert np.allclose(g.wi, G.directions_from_angles(g.coords["theta_i"], g.coords["phi_i"]))
-    g2 = G.full_grid(30, 90, theta_o_step=45, phi_o_step=180)
+    g2 = L.full_grid(30, 90, theta_o_step=45, phi_o_step=180)
     assert len(g2) == (1 + 2 * 4) * (1 + 1 * 2)
 
 
 # ------------------------------------------------------------------ Rusinkiewicz and MERL grids
 
 def test_rusinkiewicz_grid_counts_and_horizon():
-    g = G.rusinkiewicz(30, 90, 30, 90)
+    g = L.rusinkiewicz(30, 90, 30, 90)
     th, ph, td, pd = np.meshgrid(np.radians([0, 30, 60]), np.radians([0, 90, 180, 270]),
                                  np.radians([0, 30, 60]), np.radians([0, 90, 180, 270]),
                                  indexing="ij")
@@ -165,7 +166,7 @@ def test_rusinkiewicz_grid_counts_and_horizon():
 
 
 def test_merl_layout_matches_reference_index():
-    g = G.merl()
+    g = L.merl()
     assert g.info["n_layout"] == 90 * 90 * 180
     assert len(g) + g.info["dropped_below_horizon"] == 1_458_000
     assert np.all(np.diff(g.index) > 0) and g.index.max() < 1_458_000  # unique, in order
@@ -186,13 +187,13 @@ def test_merl_layout_matches_reference_index():
 
 
 def test_merl_stride():
-    g = G.merl(3)
+    g = L.merl(3)
     assert g.info["n_layout"] == 30 * 30 * 60
     ith, rest = np.divmod(g.index, 90 * 180)
     itd, ipd = np.divmod(rest, 180)
     assert np.all(ith % 3 == 0) and np.all(itd % 3 == 0) and np.all(ipd % 3 == 0)
     with pytest.raises(ValueError, match="stride"):
-        G.merl(0)
+        L.merl(0)
 
 
 # ------------------------------------------------------------------ pairs, horizon, rotation
@@ -200,30 +201,30 @@ def test_merl_stride():
 def test_pairs_drop_below_horizon():
     wi = [[0, 0, 1], [1, 0, 0], [0, 0, -1], [1, 0, 1]]
     wo = [[0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 1, 1]]
-    g = G.pairs(wi, wo)
+    g = L.pairs(wi, wo)
     assert len(g) == 2 and g.info["dropped_below_horizon"] == 2
     assert g.index.tolist() == [0, 3]
     assert np.allclose(np.degrees(g.coords["theta_i"]), [0, 45])
     assert np.allclose(np.degrees(g.coords["phi_o"]), [0, 90])
     with pytest.raises(ValueError, match="shape"):
-        G.pairs([[0, 0, 1]], [[0, 0, 1], [0, 0, 1]])
+        L.pairs([[0, 0, 1]], [[0, 0, 1], [0, 0, 1]])
     with pytest.raises(ValueError, match="non-zero"):
-        G.pairs([[0, 0, 0]], [[0, 0, 1]])
+        L.pairs([[0, 0, 0]], [[0, 0, 1]])
 
 
 def test_pairs_from_angles_units():
-    a = G.pairs_from_angles([30], [45], [60], [200])
-    b = G.pairs_from_angles(np.radians([30]), np.radians([45]), np.radians([60]),
+    a = L.pairs_from_angles([30], [45], [60], [200])
+    b = L.pairs_from_angles(np.radians([30]), np.radians([45]), np.radians([60]),
                             np.radians([200]), degrees=False)
     assert np.allclose(a.wi, b.wi) and np.allclose(a.wo, b.wo)
     assert math.isclose(a.wi[0, 2], math.cos(math.radians(30)))
     with pytest.raises(ValueError, match="same length"):
-        G.pairs_from_angles([1, 2], [1, 2, 3], [1], [1])
+        L.pairs_from_angles([1, 2], [1, 2, 3], [1], [1])
 
 
 def test_rotation_turns_directions_by_minus_rotation():
-    g = G.plane("warp", 30, theta_i=[45])
-    r = G.plane("warp", 30, theta_i=[45], rotation=math.pi / 2)
+    g = L.plane("warp", 30, theta_i=[45])
+    r = L.plane("warp", 30, theta_i=[45], rotation=math.pi / 2)
     assert np.allclose(r.wi_lab, g.wi_lab)
     # the sample's warp points at lab azimuth 90 deg, so a lab direction along +x is along
     # the sample's -y
@@ -235,7 +236,7 @@ def test_rotation_turns_directions_by_minus_rotation():
 
 
 def test_subset_keeps_coordinates():
-    g = G.full_grid(45)
+    g = L.full_grid(45)
     s = g.subset(g.coords["theta_i"] > 0)
     assert len(s) == np.sum(g.coords["theta_i"] > 0)
     assert np.all(s.coords["theta_i"] > 0)
@@ -268,7 +269,7 @@ def test_from_spec_good(spec, kind, n):
 
 def test_from_spec_plane_azimuths():
     assert np.allclose(Geometry.from_spec("plane:weft:30:30").wi_lab,
-                       G.plane(90, 30, theta_i=[30]).wi_lab)
+                       L.plane(90, 30, theta_i=[30]).wi_lab)
 
 
 @pytest.mark.parametrize("spec, match", [
@@ -319,6 +320,6 @@ def test_from_spec_pairs_file(tmp_path):
 
 def test_describe_is_plain():
     import json
-    d = G.merl(45, rotation=0.5).describe()
+    d = L.merl(45, rotation=0.5).describe()
     assert json.loads(json.dumps(d)) == d
     assert d["rotation_deg"] == pytest.approx(math.degrees(0.5))

@@ -10,6 +10,7 @@ import pytest
 import gonio
 from gonio import Geometry, Instrument, measure
 from gonio import geometry as G
+from gonio import layouts as L
 
 
 # ------------------------------------------------------------------ analytic BRDFs of our own
@@ -81,14 +82,14 @@ class Ward:
 # ------------------------------------------------------------------ cone averages
 
 def test_point_instrument_is_the_brdf():
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     t = measure(Phong(), g)
     assert np.array_equal(t.values, Phong().eval(g.wi, g.wo))
     assert t.sigma is None and np.allclose(t.wi, g.wi, rtol=0, atol=1e-15)
 
 
 def test_lambertian_exact_under_cones():
-    g = G.full_grid(20)
+    g = L.full_grid(20)
     g = g.subset((g.wi[:, 2] > math.cos(math.radians(70))) & (g.wo[:, 2] > 0.4))
     t = measure(Lambert(), g, Instrument(cone_source=8, cone_detector=12))
     assert np.allclose(t.values, np.array([0.2, 0.5, 0.8]) / np.pi, rtol=1e-14, atol=0)
@@ -96,7 +97,7 @@ def test_lambertian_exact_under_cones():
 
 def test_affine_exact_under_cones():
     """Cone averages of wi and wo are (1 + cos a)/2 times the axes, by calculus."""
-    g = G.plane("45", 20, theta_i=[0, 40])
+    g = L.plane("45", 20, theta_i=[0, 40])
     ins = Instrument(cone_source=6.0, cone_detector=15.0, rings=1, azimuths=3)
     t = measure(Affine(), g, ins)
     cs = (1 + math.cos(math.radians(6))) / 2
@@ -108,7 +109,7 @@ def test_affine_exact_under_cones():
 def test_cone_average_converges_to_point_value():
     wi = G.directions_from_angles(math.radians(30), 0.0)[None]
     wo = G.directions_from_angles(math.radians(33), math.radians(182))[None]
-    g = G.pairs(wi, wo)
+    g = L.pairs(wi, wo)
     brdf = Phong(40)
     point = brdf.eval(wi, wo)[0, 0]
     errs = []
@@ -143,7 +144,7 @@ def test_cone_average_is_the_uniform_solid_angle_average():
 
     f = brdf.eval(cap_samples(wi, half_s), cap_samples(wo, half_d))[:, 0]
     ins = Instrument(cone_source=half_s, cone_detector=half_d, rings=5, azimuths=12)
-    v = measure(brdf, G.pairs(wi[None], wo[None]), ins).values[0, 0]
+    v = measure(brdf, L.pairs(wi[None], wo[None]), ins).values[0, 0]
     assert abs(v - f.mean()) < 5 * f.std() / math.sqrt(n)
     point = brdf.eval(wi, wo)[0]
     assert abs(point - f.mean()) > 10 * f.std() / math.sqrt(n)   # the cones do matter here
@@ -152,7 +153,7 @@ def test_cone_average_is_the_uniform_solid_angle_average():
 # ------------------------------------------------------------------ noise and seeds
 
 def test_noise_statistics_over_many_seeds():
-    g = G.plane("warp", 30, theta_i=[0, 60])
+    g = L.plane("warp", 30, theta_i=[0, 60])
     brdf = Phong(5)
     truth = measure(brdf, g).values
     ins = Instrument(snr=20, floor=0.003)
@@ -168,7 +169,7 @@ def test_noise_statistics_over_many_seeds():
 
 
 def test_same_seed_same_bytes_any_chunking():
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     ins = Instrument(cone_source=1, cone_detector=2, snr=30, floor=1e-3)
     a = measure(Poly(), g, ins, seed=5)
     a2 = measure(Poly(), g, ins, seed=5)
@@ -184,7 +185,7 @@ def test_same_seed_same_bytes_any_chunking():
 
 
 def test_measure_leaves_the_geometry_intact():
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     before = g.wi_lab.copy(), g.wo_lab.copy()
     t = measure(Poly(), g)
     assert np.array_equal(g.wi_lab, before[0]) and np.array_equal(g.wo_lab, before[1])
@@ -194,7 +195,7 @@ def test_measure_leaves_the_geometry_intact():
 
 
 def test_negative_values_kept_and_flagged():
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     t = measure(Lambert((0.001, 0.001, 0.001)), g, Instrument(floor=0.01), seed=2)
     neg = t.values < 0
     assert neg.any() and (~neg).any()
@@ -202,7 +203,7 @@ def test_negative_values_kept_and_flagged():
 
 
 def test_shot_noise_through_measure():
-    g = G.plane("warp", 30, theta_i=[30])
+    g = L.plane("warp", 30, theta_i=[30])
     ins = Instrument(snr=10, noise="shot", snr_reference=0.1)
     t = measure(Lambert(), g, ins, seed=0)
     k = 10 ** 2 / 0.1
@@ -214,7 +215,7 @@ def test_shot_noise_through_measure():
 
 @pytest.mark.parametrize("r", [0.3, -1.1, math.pi / 2])
 def test_geometry_rotation_equals_rotated_brdf(r):
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     ins = Instrument(cone_source=2, cone_detector=3)
     a = measure(Ward(rho=0.0), g.with_rotation(r), ins)
     b = measure(Ward(rho=r), g, ins)
@@ -222,9 +223,9 @@ def test_geometry_rotation_equals_rotated_brdf(r):
 
 
 def test_rotating_the_sample_90_deg_swaps_warp_and_weft_planes():
-    warp = measure(Ward(), G.plane("warp", 10))
-    weft_rot = measure(Ward(), G.plane("weft", 10, rotation=math.pi / 2))
-    weft = measure(Ward(), G.plane("weft", 10))
+    warp = measure(Ward(), L.plane("warp", 10))
+    weft_rot = measure(Ward(), L.plane("weft", 10, rotation=math.pi / 2))
+    weft = measure(Ward(), L.plane("weft", 10))
     assert np.allclose(warp.values, weft_rot.values, rtol=1e-12)
     assert not np.allclose(warp.values, weft.values, rtol=1e-3)       # it is anisotropic
     # the table's directions are in the sample frame: the rotated weft plane is the warp plane
@@ -236,7 +237,7 @@ def test_fabric_rotation_matches_geometry_rotation():
     if not hasattr(brdf, "fabric"):
         pytest.skip("brdf.fabric not available")
     fab = brdf.fabric("silk_shot", tangent_samples=8)
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     for r in (0.4, math.pi / 2):
         a = measure(fab, g.with_rotation(r))
         b = measure(fab.replace(rotation=r), g)
@@ -261,7 +262,7 @@ def test_meta_is_plain_and_complete():
         threads = (Thread(1.5, (-20.0, 20.0)), Thread(1.3, (0.0,)))
         options = {"masking": True, "tangent_samples": np.int64(8)}
 
-    g = G.merl(45, rotation=0.2)
+    g = L.merl(45, rotation=0.2)
     ins = Instrument(cone_detector=1.0, snr=50, floor=1e-4)
     t = measure(FabricLike(), g, ins, seed=3)
     m = t.meta
@@ -310,7 +311,7 @@ def test_chunks_bound_each_eval_call():
             sizes.append(wi.shape[0])
             return super().eval(wi, wo)
 
-    g = G.full_grid(30)
+    g = L.full_grid(30)
     ins = Instrument(cone_source=1, cone_detector=1)          # 144 evaluations per pair
     measure(Recorder(), g, ins, chunk=1000)
     assert max(sizes) <= 1000 and sum(sizes) == len(g) * 144
@@ -324,7 +325,7 @@ def test_progress_bar_and_grey_output(capsys):
         def eval(self, wi, wo):
             return np.full(wi.shape[:-1], 0.25)
 
-    t = measure(Grey(), G.full_grid(45), progress=True, chunk=5)
+    t = measure(Grey(), L.full_grid(45), progress=True, chunk=5)
     assert np.all(t.values == 0.25) and t.values.shape == (len(t), 3)
     assert "measure" in capsys.readouterr().err
 

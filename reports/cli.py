@@ -24,6 +24,7 @@ COMMAND_MODULES = (
     "reports.cmd_physics",
     "reports.cmd_fit",
     "reports.cmd_measured",
+    "reports.cmd_batch",
 )
 
 

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import brdf
 
-__all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir"]
+__all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir",
+           "add_fit_options", "fit_kwargs", "split_ties"]
 
 
 def _on_off(value: str) -> bool:
@@ -38,6 +39,45 @@ def add_fabric_options(parser: argparse.ArgumentParser) -> None:
                    help="gap term c_gap of Q (default incident)")
     g.add_argument("--rotation", type=float, default=0.0, metavar="DEG",
                    help="fabric rotation about the normal, degrees (default 0)")
+
+
+def add_fit_options(p: argparse.ArgumentParser) -> None:
+    """Add the options of a fit (``microcyl fit`` and ``fit-batch``): spec and sampler."""
+    from analysis.likelihood import KINDS
+    from analysis.params import DEFAULT_FREE, DEFAULT_TIES
+    p.add_argument("--free", default=None, metavar="NAMES",
+                   help="comma-separated free parameters, or a TOML file (default "
+                        f"{','.join(DEFAULT_FREE)})")
+    p.add_argument("--spec", default=None, metavar="TOML",
+                   help="TOML file with free, tie, [bounds], [prior], [start]")
+    p.add_argument("--tie", action="append", default=None, metavar="A=B",
+                   help="tie A to B (A=B or A=1-B); repeatable; 'none' for no tie (default "
+                        f"{','.join(DEFAULT_TIES)} when --free is not given)")
+    p.add_argument("--likelihood", choices=KINDS, default="gaussian")
+    p.add_argument("--nu", type=float, default=4.0, help="Student-t degrees of freedom")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--max-steps", type=int, default=20000, metavar="N",
+                   help="step limit per ensemble (default 20000)")
+    p.add_argument("--ensembles", type=int, default=4, metavar="K")
+    p.add_argument("--walkers", type=int, default=None, metavar="W",
+                   help="walkers per ensemble (default 2 x ndim + 2)")
+    p.add_argument("--check-every", type=int, default=50, metavar="N",
+                   help="steps between convergence checks (default 50)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS")
+
+
+def fit_kwargs(args: argparse.Namespace) -> dict:
+    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`."""
+    return {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
+            "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
+            "check_every": args.check_every, "time_limit": args.time_limit}
+
+
+def split_ties(ties):
+    """``--tie`` values (repeatable, each comma-separated; 'none' dropped), or None."""
+    if ties is None:
+        return None
+    return [t for item in ties for t in item.split(",") if t.strip().lower() != "none"]
 
 
 def fabric_from_args(name: str, args: argparse.Namespace) -> brdf.Fabric:

@@ -8,6 +8,7 @@ import numpy as np
 
 import brdf
 from reports import cliutil
+from reports.report_batch import write_batch_page
 from reports.standard import STANDARD_GEOMETRIES, standard_values
 
 
@@ -46,6 +47,9 @@ def register(sub):
                    help="show a fit's results.json in FABRIC's page (repeatable)")
     p.add_argument("--measured", default=None, metavar="DIR",
                    help="add the fits of `microcyl fit-measured -o DIR` (page measured.html)")
+    p.add_argument("--batch", default=None, metavar="DIR",
+                   help="write the page of `microcyl fit-batch -o DIR` (DIR/index.html) "
+                        "instead of the presets' report")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run_report)
 
@@ -91,6 +95,9 @@ def run_eval(args):
 def run_report(args):
     from reports.report import build_report
 
+    if args.batch is not None:
+        print(f"batch page: {write_batch_page(args.batch)}")
+        return 0
     names = tuple(dict.fromkeys(args.fabric)) if args.fabric else brdf.PRESETS
     fits = {}
     for item in args.fit or ():

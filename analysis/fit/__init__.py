@@ -66,9 +66,10 @@ from analysis.fit.proposal import LaplaceMove
 from analysis.fit.quality import albedo_colours, albedo_delta_e, fit_quality
 from analysis.fit.results import SCHEMA_VERSION, FitResult, write_results
 from analysis.fit.sampler import FitInterrupted
-from analysis.fit.workflow import fit_fabric
+from analysis.fit.workflow import fit_fabric, fit_spec
 
-__all__ = ["fit", "fit_fabric", "FitOptions", "FitResult", "FitInterrupted", "write_results",
+__all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInterrupted",
+           "write_results",
            "FabricModel", "LogPosterior", "point_estimate", "LockStep", "Chain",
            "EnsembleRunner", "EnsembleMoves", "LaplaceMove", "Criteria", "Diagnosis",
            "FitFolder", "fit_quality", "albedo_colours", "albedo_delta_e", "CONFIG_FILE",

@@ -9,8 +9,50 @@ from analysis.fit.driver import fit
 from analysis.fit.posterior import FabricModel
 from analysis.fit.quality import fit_quality
 from analysis.fit.results import FitResult, write_results
+from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
 
-__all__ = ["fit_fabric"]
+__all__ = ["fit_fabric", "fit_spec"]
+
+
+def fit_spec(fabric, free=None, ties=None, toml=None) -> ParamSpec:
+    """The parameter spec of a fit as ``microcyl fit`` builds it from its options.
+
+    Parameters
+    ----------
+    fabric : brdf.Fabric
+        Gives the defaults (fixed values and the start).
+    free : str or sequence of str, optional
+        Free parameters (comma-separated or a sequence); a name ending in ``.toml`` is a spec
+        file. Default :data:`analysis.params.DEFAULT_FREE`.
+    ties : sequence of str, optional
+        ``"a=b"`` / ``"a=1-b"`` ties (each item may hold several, comma-separated; ``"none"``
+        is dropped). Default :data:`analysis.params.DEFAULT_TIES` when neither ``free`` nor
+        ``toml`` is given, none otherwise.
+    toml : path, optional
+        A TOML spec (:meth:`ParamSpec.from_toml`); ``free`` and ``ties`` are added to it.
+
+    Returns
+    -------
+    ParamSpec
+
+    Examples
+    --------
+    >>> import brdf
+    >>> fit_spec(brdf.fabric("silk_crepe_de_chine"), "kd1,gamma_s1").free
+    ('kd1', 'gamma_s1')
+    """
+    defaults = defaults_from_fabric(fabric)
+    if ties is not None:
+        ties = [t for item in ties for t in str(item).split(",")
+                if t.strip() and t.strip().lower() != "none"]
+    if isinstance(free, str) and free.lower().endswith(".toml"):
+        toml, free = free, None
+    if ties is None and free is None and toml is None:
+        ties = list(DEFAULT_TIES)
+    if toml is not None:
+        return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties)
+    return ParamSpec(free if free is not None else DEFAULT_FREE, defaults=defaults,
+                     ties=ties or ())
 
 
 def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,

@@ -1,0 +1,31 @@
+"""Batch fits of many tables on Dask (``microcyl fit-batch``).
+
+One table, one fit, one folder ``DIR/<name>/`` (its checkpoints, results and plots), one Dask
+task. The parts:
+
+1. :mod:`~analysis.batch.jobs` -- what to fit: :class:`BatchJob` (a table, its preset, its free
+   parameters and fit options; plain data, sent to the workers) and :func:`jobs_from_inputs`
+   (files, globs, folders and CUReT samples; a ``NAME.toml`` beside a table overrides the
+   batch's spec for it).
+2. :mod:`~analysis.batch.worker` -- :func:`run_job`, what a worker runs: read the table there,
+   fit it into its folder (resuming from its checkpoint), return one summary row; a failure
+   becomes a row with its one-line error.
+3. :mod:`~analysis.batch.summary` -- :class:`BatchSummary`, the rows of ``summary.csv`` and
+   ``summary.json``, written atomically by the client alone.
+4. :mod:`~analysis.batch.engine` -- :func:`run_batch`: a ``LocalCluster`` (one process per
+   core, one thread each) or an existing scheduler; submits the jobs not already converged,
+   gathers the rows as the fits end, one progress bar over tables.
+
+Files: each fit writes only its own folder, from the one thread of its worker; the client
+alone writes the summaries. A worker that dies has its task rescheduled by Dask, and the fit
+resumes from the checkpoint it left. Workers must see the same file system as the client
+(trivially so on one machine; a shared folder on a cluster).
+"""
+
+from analysis.batch.engine import BatchInterrupted, run_batch
+from analysis.batch.jobs import BatchJob, jobs_from_inputs, parse_samples, read_job_table
+from analysis.batch.summary import SUMMARY_CSV, SUMMARY_JSON, BatchSummary
+from analysis.batch.worker import run_job
+
+__all__ = ["BatchJob", "jobs_from_inputs", "parse_samples", "read_job_table", "run_job", "run_batch",
+           "BatchSummary", "BatchInterrupted", "SUMMARY_CSV", "SUMMARY_JSON"]

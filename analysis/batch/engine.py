@@ -1,0 +1,161 @@
+"""The batch on Dask: :func:`run_batch` submits one task per table and gathers the rows.
+
+By default a ``distributed.LocalCluster`` of one worker process per core, one thread each;
+with ``scheduler`` the batch runs on an existing cluster (``dask scheduler`` and ``dask
+worker ADDRESS``). Dask reschedules the task of a worker that dies, and the fit resumes from
+the checkpoint in its folder; a task whose workers die three times (Dask's
+``allowed-failures``) becomes an error row. Only this client writes the summaries.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import signal
+import time
+import uuid
+from pathlib import Path
+from typing import Callable
+
+from analysis.batch.jobs import BatchJob
+from analysis.batch.summary import BatchSummary
+from analysis.batch.worker import error_row, run_job
+from gonio.progress import progress_bar
+
+__all__ = ["run_batch", "BatchInterrupted", "describe_row"]
+
+
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a batch, after the summaries were written; ``str()`` says how to resume."""
+
+
+@contextlib.contextmanager
+def _client(workers: int | None, scheduler: str | None):
+    """A Dask client: of a new LocalCluster, or connected to ``scheduler``."""
+    # distributed is imported on use: it takes most of a second, and every `microcyl` verb
+    # imports this package (for the batch page).
+    from distributed import Client, LocalCluster
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="20s")
+        except OSError as exc:
+            raise OSError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR)
+    try:
+        with Client(cluster) as client:
+            client.run(_ignore_sigint)
+            yield client
+    finally:
+        cluster.close()
+
+
+def _ignore_sigint():
+    """Run in each local worker process: Ctrl-C reaches the whole process group, and the
+    client, not the workers, handles it (the workers are closed with the cluster)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def describe_row(row: dict) -> str:
+    """One line for a finished table."""
+    if row["status"] == "error":
+        return f"{row['name']}: error: {row['error']}"
+    verdict = "converged" if row["status"] == "converged" else "NOT converged"
+    return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s)"
+
+
+def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
+              scheduler: str | None = None, progress: bool = True,
+              echo: Callable[[str], None] | None = print) -> BatchSummary:
+    """Fit every job on Dask into ``out_dir/<name>``, keeping the summaries up to date.
+
+    Jobs that converged before with the same inputs (:meth:`BatchSummary.done`) are not
+    submitted again; unfinished ones resume from their checkpoints.
+
+    Parameters
+    ----------
+    jobs : list of BatchJob
+        From :func:`~analysis.batch.jobs.jobs_from_inputs` (names unique).
+    out_dir : path
+        The batch's folder: ``summary.csv``, ``summary.json`` and one folder per table.
+    workers : int, optional
+        Worker processes of the local cluster (default: the cores).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (e.g. ``tcp://127.0.0.1:8786``) instead.
+    progress : bool
+        One bar over the tables (stderr).
+    echo : callable, optional
+        Receives one line per table as it ends (None: silent).
+
+    Returns
+    -------
+    BatchSummary
+
+    Raises
+    ------
+    BatchInterrupted
+        On Ctrl-C, after writing the summaries (every fit resumable from its checkpoint).
+    ValueError
+        Duplicate job names or a bad ``workers``.
+    """
+    names = [j.name for j in jobs]
+    if len(set(names)) != len(names):
+        raise ValueError("job names must be unique in a batch")
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be >= 1; got {workers}")
+    out = Path(out_dir).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    summary = BatchSummary(out)
+    todo = [j for j in jobs if not summary.done(j)]
+    with progress_bar(len(jobs), desc="fits", unit="table", enabled=progress,
+                      initial=len(jobs) - len(todo)) as bar:
+        say = (bar.write if progress else echo) if echo is not None else None
+        if todo:
+            with _client(workers, scheduler) as client:
+                _gather(client, todo, out, summary, names, bar, say)
+        summary.write(names)
+    return summary
+
+
+def _record(fut, job, summary, names, bar, say):
+    """The row of one finished future into the summaries (written at once)."""
+    try:
+        row = fut.result()
+    except Exception as exc:            # noqa: BLE001 - e.g. KilledWorker: record, go on
+        row = error_row(job, exc)
+    row["key"] = job.key()
+    summary.update(row)
+    summary.write(names)
+    bar.update(1)
+    if say is not None:
+        say(describe_row(row))
+
+
+def _gather(client, todo, out, summary, names, bar, say):
+    """Submit ``todo`` and record each row as its fit ends."""
+    from distributed import as_completed   # on use, as in _client
+    run = uuid.uuid4().hex[:8]
+    futures = {client.submit(run_job, job, str(out), key=f"microcyl-fit-{job.name}-{run}",
+                             pure=False): job for job in todo}
+    ready = as_completed(futures)
+    try:
+        while ready.count():
+            # Polled, not blocked on: Ctrl-C then lands in this loop, not inside Dask's wait.
+            for fut in ready.next_batch(block=False):
+                _record(fut, futures[fut], summary, names, bar, say)
+            time.sleep(0.1)
+    except KeyboardInterrupt:
+        for fut in futures:
+            fut.cancel()
+        summary.write(names)
+        done = sum(1 for n in names if n in summary.rows)
+        raise BatchInterrupted(f"interrupted with {done} of {len(names)} tables done; the "
+                               f"same command resumes the rest from their checkpoints in "
+                               f"{out}") from None

@@ -1,0 +1,247 @@
+"""What a batch fits: one :class:`BatchJob` per table, from the inputs a user names.
+
+Inputs are table files, globs or folders (the files directly inside a folder whose names
+:func:`gonio.read` knows), and CUReT's ``abrdf.dat`` with a sample selection (each sample a
+table). Every input is checked here, before any fit starts: a missing file, an unknown suffix
+or a CUReT file without samples is refused by name. A file ``NAME.toml`` beside a table (NAME
+the table's name in the batch) replaces the batch's ``--spec``/``--free``/``--tie`` for it,
+and its ``fabric`` key the batch's preset.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import glob
+import hashlib
+import json
+import tomllib
+from pathlib import Path
+from typing import Callable
+
+import brdf
+import gonio
+from gonio.io import READ_SUFFIXES
+from analysis.fit.workflow import fit_spec
+from gonio.curet import N_SAMPLES
+
+__all__ = ["BatchJob", "jobs_from_inputs", "read_job_table", "parse_samples"]
+
+
+@dataclasses.dataclass(frozen=True)
+class BatchJob:
+    """One table of a batch and how to fit it (plain data: it travels to a Dask worker).
+
+    Attributes
+    ----------
+    name : str
+        Unique in the batch; the fit's folder is ``DIR/<name>``.
+    path : str
+        The table file (read on the worker).
+    sample : int or None
+        CUReT sample number.
+    preset : str
+        Preset giving the fixed values and the start.
+    free, ties : tuple of str or None
+        As ``microcyl fit --free`` / ``--tie`` (None: the defaults).
+    spec : str or None
+        A TOML spec file (:meth:`analysis.params.ParamSpec.from_toml`).
+    fit : dict
+        Options of :func:`analysis.fit.fit` (likelihood, seed, max_steps, ...).
+    fabric_options : dict
+        Options of the preset's Fabric (MODEL.md's variants).
+    read_options : dict
+        Options of the table's reader (e.g. ``step`` for RGL files).
+    loader : callable, optional
+        ``loader() -> gonio.Table`` instead of reading ``path`` (a picklable function, e.g.
+        a :func:`functools.partial` of :func:`analysis.measured.load_measured`).
+    plots : callable, optional
+        Passed to :func:`analysis.fit.fit_fabric` (e.g. ``reports.fitplots.write_fit_plots``).
+    """
+
+    name: str
+    path: str
+    sample: int | None = None
+    preset: str = "linen_plain"
+    free: tuple[str, ...] | None = None
+    ties: tuple[str, ...] | None = None
+    spec: str | None = None
+    fit: dict = dataclasses.field(default_factory=dict)
+    fabric_options: dict = dataclasses.field(default_factory=dict)
+    read_options: dict = dataclasses.field(default_factory=dict)
+    loader: Callable | None = None
+    plots: Callable | None = None
+
+    def fabric(self) -> brdf.Fabric:
+        """The start fabric (preset and options)."""
+        return brdf.fabric(self.preset, **self.fabric_options)
+
+    def param_spec(self, fab=None):
+        """The :class:`~analysis.params.ParamSpec` of this fit (checks every name)."""
+        return fit_spec(fab if fab is not None else self.fabric(), self.free, self.ties,
+                        self.spec)
+
+    def key(self) -> str:
+        """A digest of everything that decides the fit: the job's fields and the size and
+        modification time of its files. A converged row with the same key is not redone."""
+        doc = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
+               if f.name not in ("plots",)}
+        doc["loader"] = repr(self.loader)
+        for what, p in (("table", self.path), ("spec_file", self.spec)):
+            if p is not None and Path(p).exists():
+                st = Path(p).stat()
+                doc[what] = [st.st_size, st.st_mtime_ns]
+        text = json.dumps(gonio.plain(doc, nonfinite="repr"), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def read_job_table(job: BatchJob):
+    """The job's table: ``job.loader()``, else :func:`gonio.read` of its path."""
+    if job.loader is not None:
+        return job.loader()
+    opts = dict(job.read_options)
+    if job.sample is not None:
+        opts["sample"] = job.sample
+    return gonio.read(job.path, **opts)
+
+
+def parse_samples(text) -> tuple[int, ...] | None:
+    """``"all"`` -> 1..61, ``"1,2,7"`` -> (1, 2, 7), None -> None (CUReT sample numbers).
+
+    Examples
+    --------
+    >>> parse_samples("2,7"), len(parse_samples("all"))
+    ((2, 7), 61)
+    """
+    if text is None:
+        return None
+    if isinstance(text, str) and text.strip().lower() == "all":
+        return tuple(range(1, N_SAMPLES + 1))
+    items = text.split(",") if isinstance(text, str) else list(text)
+    try:
+        out = tuple(int(str(s).strip()) for s in items if str(s).strip())
+    except ValueError:
+        raise ValueError(f"--sample must be 'all' or comma-separated integers in 1..{N_SAMPLES}"
+                         f"; got {text!r}") from None
+    bad = [s for s in out if not 1 <= s <= N_SAMPLES]
+    if bad or not out:
+        raise ValueError(f"--sample must be 'all' or integers in 1..{N_SAMPLES}; got {text!r}")
+    return out
+
+
+def _is_table(path: Path) -> bool:
+    name = path.name.lower()
+    return name == "abrdf.dat" or (path.suffix.lower() in READ_SUFFIXES)
+
+
+def _expand(item: str) -> list[Path]:
+    """Files named by one input: a glob, a folder (its table files) or a file."""
+    if any(ch in item for ch in "*?["):
+        found = sorted(Path(p) for p in glob.glob(item))
+        files = [p for p in found if p.is_file() and _is_table(p)]
+        if not files:
+            raise ValueError(f"input {item!r} matches no table file (known: "
+                             f"{', '.join(READ_SUFFIXES)})")
+        return files
+    path = Path(item)
+    if path.is_dir():
+        files = sorted(p for p in path.iterdir() if p.is_file() and _is_table(p))
+        if not files:
+            raise ValueError(f"input folder {item!r} holds no table file (known: "
+                             f"{', '.join(READ_SUFFIXES)})")
+        return files
+    if not path.exists():
+        raise ValueError(f"input {item!r}: no such file or folder")
+    if not _is_table(path):
+        raise ValueError(f"input {item!r}: not a table file gonio reads (known: "
+                         f"{', '.join(READ_SUFFIXES)})")
+    return [path]
+
+
+def _unique(name: str, taken: set) -> str:
+    out, k = name, 2
+    while out in taken:
+        out, k = f"{name}_{k}", k + 1
+    taken.add(out)
+    return out
+
+
+def _override(job: BatchJob, folder: Path) -> BatchJob:
+    """The job with ``NAME.toml`` beside its table, when there is one, as its spec."""
+    toml = folder / f"{job.name}.toml"
+    if not toml.is_file():
+        return job
+    try:
+        with open(toml, "rb") as fh:
+            doc = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{toml}: not valid TOML: {exc}") from None
+    preset = doc.get("fabric", job.preset)
+    return dataclasses.replace(job, spec=str(toml), free=None, ties=(), preset=preset)
+
+
+def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, samples=None,
+                     fit=None, fabric_options=None, read_options=None,
+                     plots=None) -> list[BatchJob]:
+    """The jobs of a batch, every input and every spec checked before any fit starts.
+
+    Parameters
+    ----------
+    inputs : sequence of str
+        Table files, globs or folders.
+    preset : str
+        Preset of every table (a ``NAME.toml`` beside a table may name another).
+    free, ties, spec
+        As ``microcyl fit``'s ``--free``, ``--tie``, ``--spec``.
+    samples : str or sequence of int, optional
+        CUReT samples (:func:`parse_samples`): needed when an input is ``abrdf.dat``.
+    fit, fabric_options, read_options : dict, optional
+        Fit options, Fabric options, reader options (see :class:`BatchJob`).
+    plots : callable, optional
+
+    Returns
+    -------
+    list of BatchJob
+        In input order (files of a folder or glob sorted), names unique.
+
+    Raises
+    ------
+    ValueError
+        A missing input, a file gonio cannot read, CUReT without samples, an unknown preset,
+        or a spec with unknown parameters (naming the table).
+    """
+    if preset not in brdf.PRESETS:
+        raise ValueError(f"unknown fabric {preset!r}; valid presets are {', '.join(brdf.PRESETS)}")
+    sample_list = parse_samples(samples)
+    base = dict(preset=preset, free=None if free is None else tuple(free),
+                ties=None if ties is None else tuple(ties), spec=spec, fit=dict(fit or {}),
+                fabric_options=dict(fabric_options or {}),
+                read_options=dict(read_options or {}), plots=plots)
+    jobs, taken = [], set()
+    for item in inputs:
+        for path in _expand(str(item)):
+            if path.name.lower() == "abrdf.dat":
+                if sample_list is None:
+                    raise ValueError(f"input {str(path)!r} is CUReT's abrdf.dat: name the "
+                                     f"samples with --sample all or --sample 1,2,7")
+                named = [(f"{path.resolve().parent.name}_{s:02d}", s) for s in sample_list]
+            else:
+                named = [(path.stem, None)]
+            for name, s in named:
+                job = BatchJob(_unique(name, taken), str(path), s, **base)
+                jobs.append(_override(job, path.parent))
+    if not jobs:
+        raise ValueError("no tables to fit: name at least one input")
+    for job in jobs:
+        _check(job)
+    return jobs
+
+
+def _check(job: BatchJob) -> None:
+    """The preset, its options and the spec of a job, or a ValueError naming the table."""
+    try:
+        if job.preset not in brdf.PRESETS:
+            raise ValueError(f"unknown fabric {job.preset!r}; valid presets are "
+                             f"{', '.join(brdf.PRESETS)}")
+        job.param_spec()
+    except ValueError as exc:
+        raise ValueError(f"table {job.name} ({job.path}): {exc}") from None

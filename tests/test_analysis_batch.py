@@ -1,0 +1,165 @@
+"""Batch fits on Dask (analysis.batch): real LocalClusters of worker processes, a corrupt
+table, a worker killed mid-fit, reruns that resume; and the inputs refused up front."""
+
+import json
+import os
+import signal
+import threading
+import time
+
+import pytest
+
+import brdf
+import gonio
+from analysis.batch import (BatchJob, BatchSummary, jobs_from_inputs, parse_samples,
+                            run_batch)
+from analysis.params import defaults_from_fabric
+
+distributed = pytest.importorskip("distributed")
+
+PRESET = "silk_crepe_de_chine"
+FREE = ("kd1", "gamma_s1")
+
+
+def _tables(folder, specs):
+    folder.mkdir(parents=True, exist_ok=True)
+    fab = brdf.fabric(PRESET)
+    for k, spec in enumerate(specs):
+        t = gonio.measure(fab, spec, gonio.Instrument(snr=20, floor=1e-4), seed=k,
+                          progress=False)
+        gonio.write(t, folder / f"t{k}.csv")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    d = _tables(tmp_path_factory.mktemp("tables"), ["full:30:45", "full:30", "full:20:45"])
+    (d / "corrupt.csv").write_text("theta_i,phi_i,theta_o,phi_o,r,g,b\n10,0,20,0,0.1\n")
+    return d
+
+
+@pytest.fixture(scope="module")
+def batch(inputs, tmp_path_factory):
+    """The four tables fitted once on a LocalCluster of 2 worker processes."""
+    out = tmp_path_factory.mktemp("batch")
+    jobs = jobs_from_inputs([str(inputs)], preset=PRESET, free=FREE, ties=(),
+                            fit={"max_steps": 3000})
+    lines = []
+    summary = run_batch(jobs, out, workers=2, progress=False, echo=lines.append)
+    return out, jobs, summary, lines
+
+
+def test_three_fits_and_one_error_naming_the_file(batch):
+    out, jobs, summary, lines = batch
+    assert [j.name for j in jobs] == ["corrupt", "t0", "t1", "t2"]
+    assert summary.counts() == {"error": 1, "converged": 3}
+    rows = {r["name"]: r for r in json.loads((out / "summary.json").read_text())["tables"]}
+    assert "corrupt.csv" in rows["corrupt"]["error"]
+    truth = defaults_from_fabric(brdf.fabric(PRESET))
+    for name in ("t0", "t1", "t2"):
+        r = rows[name]
+        assert r["steps"] > 0 and r["wall_s"] > 0
+        for p in FREE:     # the simulated tables' truth inside the 95% intervals
+            assert r[f"{p}_lo95"] <= truth[p] <= r[f"{p}_hi95"], (name, p)
+        assert (out / name / "results.json").exists()
+    csv_lines = (out / "summary.csv").read_text().splitlines()
+    assert csv_lines[0].startswith("name,status,error,steps,wall_s")
+    assert "kd1_median" in csv_lines[0] and len(csv_lines) == 5
+    assert len(lines) == 4 and any(line.startswith("corrupt: error") for line in lines)
+
+
+def test_a_rerun_does_not_redo_converged_fits(batch):
+    out, jobs, summary, _ = batch
+    stamps = {n: (out / n / "results.json").stat().st_mtime_ns for n in ("t0", "t1", "t2")}
+    lines = []
+    again = run_batch(jobs, out, workers=1, progress=False, echo=lines.append)
+    assert {n: (out / n / "results.json").stat().st_mtime_ns for n in stamps} == stamps
+    assert lines == ["corrupt: error: " + again.rows["corrupt"]["error"]]   # only it reruns
+    assert again.rows["t1"] == summary.rows["t1"]
+
+
+def test_a_changed_table_is_fitted_again(tmp_path):
+    d = _tables(tmp_path / "in", ["full:30:45"])
+    jobs = jobs_from_inputs([str(d / "t0.csv")], preset=PRESET, free=FREE, ties=())
+    run_batch(jobs, tmp_path / "out", workers=1, progress=False, echo=None)
+    _tables(d, ["full:30"])                       # same name, other pairs
+    jobs = jobs_from_inputs([str(d / "t0.csv")], preset=PRESET, free=FREE, ties=())
+    assert not BatchSummary(tmp_path / "out").done(jobs[0])
+
+
+def _kill_when_checkpointed(cluster, out, victim, state):
+    """Wait for ``victim``'s first checkpoint, then SIGKILL the worker process fitting it."""
+    with distributed.Client(cluster) as client:
+        deadline = time.time() + 120
+        while time.time() < deadline and not (out / victim / "checkpoint.h5").exists():
+            time.sleep(0.05)
+        for addr, keys in client.processing().items():
+            if any(victim in str(k) for k in keys):
+                pid = client.run(os.getpid, workers=[addr])[addr]
+                os.kill(pid, signal.SIGKILL)
+                state["killed"] = pid
+                return
+
+
+def test_a_killed_worker_has_its_table_rescheduled_and_resumed(tmp_path):
+    d = _tables(tmp_path / "in", ["full:20:45", "full:15:45"])
+    out = tmp_path / "out"
+    jobs = jobs_from_inputs([str(d)], preset=PRESET, free=FREE + ("gamma_v1",), ties=(),
+                            fit={"check_every": 25, "max_steps": 3000})
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, silence_logs=50) as cluster:
+        state = {}
+        killer = threading.Thread(target=_kill_when_checkpointed,
+                                  args=(cluster, out, "t1", state))
+        killer.start()
+        summary = run_batch(jobs, out, scheduler=cluster.scheduler_address, progress=False,
+                            echo=None)
+        killer.join()
+    assert state.get("killed"), "no worker was killed: the fit ended before its checkpoint"
+    assert summary.counts() == {"converged": 2}
+    assert summary.rows["t1"]["resumed_from"] > 0     # rescheduled, from the checkpoint
+
+
+# ----------------------------------------------------------------------------- inputs
+def test_inputs_are_checked_before_any_fit(tmp_path, inputs):
+    with pytest.raises(ValueError, match="no such file"):
+        jobs_from_inputs([str(tmp_path / "nope.csv")], preset=PRESET)
+    (tmp_path / "notes.txt").write_text("x")
+    with pytest.raises(ValueError, match="not a table file"):
+        jobs_from_inputs([str(tmp_path / "notes.txt")], preset=PRESET)
+    with pytest.raises(ValueError, match="matches no table"):
+        jobs_from_inputs([str(tmp_path / "*.bsdf")], preset=PRESET)
+    with pytest.raises(ValueError, match="t0.*kd9|kd9.*t0"):
+        jobs_from_inputs([str(inputs / "t0.csv")], preset=PRESET, free=("kd9",))
+    with pytest.raises(ValueError, match="unknown fabric"):
+        jobs_from_inputs([str(inputs)], preset="tweed")
+
+
+def test_curet_needs_samples_and_names_them(shared_data):
+    path = shared_data / "curet" / "abrdf.dat"
+    with pytest.raises(ValueError, match="--sample"):
+        jobs_from_inputs([str(path)], preset="velvet")
+    jobs = jobs_from_inputs([str(path)], preset="velvet", samples="7,42")
+    assert [(j.name, j.sample) for j in jobs] == [("curet_07", 7), ("curet_42", 42)]
+    assert len(jobs_from_inputs([str(path)], preset="velvet", samples="all")) == 61
+    with pytest.raises(ValueError, match="1..61"):
+        parse_samples("0,3")
+
+
+def test_globs_dedupe_names_and_the_per_table_toml(tmp_path, inputs):
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "t0.csv").write_bytes((inputs / "t0.csv").read_bytes())
+    jobs = jobs_from_inputs([str(inputs / "t*.csv"), str(tmp_path / "a")], preset=PRESET)
+    assert [j.name for j in jobs] == ["t0", "t1", "t2", "t0_2"]
+    (tmp_path / "a" / "t0.toml").write_text('fabric = "velvet"\nfree = ["kd1"]\n')
+    (job,) = jobs_from_inputs([str(tmp_path / "a" / "t0.csv")], preset=PRESET,
+                              free=("kd1", "gamma_s1"))
+    assert job.preset == "velvet" and job.param_spec().free == ("kd1",)
+
+
+def test_job_key_follows_its_inputs(tmp_path, inputs):
+    job = BatchJob("t0", str(inputs / "t0.csv"), preset=PRESET, free=FREE)
+    assert job.key() == BatchJob("t0", str(inputs / "t0.csv"), preset=PRESET,
+                                 free=FREE).key()
+    assert job.key() != BatchJob("t0", str(inputs / "t0.csv"), preset=PRESET,
+                                 free=("kd1",)).key()

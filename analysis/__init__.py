@@ -3,7 +3,9 @@
 from analysis.albedo import (AlbedoCurve, AlbedoResult, HemisphericalAlbedo, albedo,
                              albedo_curve, albedo_hemispherical)
 from analysis.energy import VARIANTS, EnergyReport, energy_report, white_furnace
-from analysis.reciprocity import ReciprocityResult, reciprocity, reciprocity_report
+from analysis.reciprocity import (ReciprocityReport, ReciprocityResult, reciprocity,
+                                  reciprocity_report)
+from analysis.colour import LUMINANCE_WEIGHTS, luminance
 from analysis.sanity import SanityResult, sanity_scan
 from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rhat
 from analysis.fit import FabricModel, FitResult, LogPosterior, fit_fabric, write_results
@@ -15,8 +17,8 @@ from analysis.params import (DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec,
 __all__ = []
 __all__ += ["albedo", "albedo_curve", "albedo_hemispherical", "AlbedoResult", "AlbedoCurve",
             "HemisphericalAlbedo", "energy_report", "white_furnace", "EnergyReport", "VARIANTS",
-            "reciprocity", "reciprocity_report", "ReciprocityResult", "sanity_scan",
-            "SanityResult"]
+            "reciprocity", "reciprocity_report", "ReciprocityResult", "ReciprocityReport",
+            "sanity_scan", "SanityResult", "luminance", "LUMINANCE_WEIGHTS"]
 __all__ += ["ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
             "Likelihood", "fit_fabric", "FitResult", "FabricModel", "LogPosterior", "write_results",
             "autocorr_time", "split_rhat", "ess", "interval_summary",

@@ -43,7 +43,13 @@ from pathlib import Path
 
 import numpy as np
 
+import analysis.fit
+from analysis.params import ParamSpec, defaults_from_fabric
+from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write
+from gonio.curet import read_curet
+from gonio.io import read
+from gonio.rgl import load_rgl
 
 __all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir",
            "fit_measured", "SUMMARY_FILE"]
@@ -154,7 +160,6 @@ def load_measured(name, data_dir=None, rgl_step: float = 15.0):
     FileNotFoundError
         The data file is missing.
     """
-    import gonio
     d = _dataset(name)
     if not (rgl_step > 0):
         raise ValueError(f"rgl_step must be > 0 degrees; got {rgl_step}")
@@ -164,8 +169,8 @@ def load_measured(name, data_dir=None, rgl_step: float = 15.0):
         raise FileNotFoundError(2, f"measured data for {d.name} not found (set --data or "
                                    f"MICROCYL_DATA)", str(path))
     if d.kind == "rgl":
-        table = gonio.read(path, step=float(rgl_step))
-        if gonio.load_rgl(path).isotropic:
+        table = read(path, step=float(rgl_step))
+        if load_rgl(path).isotropic:
             # one incidence azimuth (0) and a mirror-symmetric file: keep phi_o in [0, pi]
             keep = np.flatnonzero(table.wo[:, 1] >= -1e-9)
             # and each direction pair once (at theta_o = 0 every azimuth is the same pair)
@@ -178,7 +183,7 @@ def load_measured(name, data_dir=None, rgl_step: float = 15.0):
                                   sigma=None if table.sigma is None else table.sigma[keep],
                                   meta=meta)
         return table
-    return gonio.read_curet(path.parent, d.sample)
+    return read_curet(path.parent, d.sample)
 
 
 def measured_spec(name, fab=None):
@@ -196,10 +201,8 @@ def measured_spec(name, fab=None):
     >>> spec.free, fab.name
     (('eta1', 'kd1', 'gamma_s1', 'gamma_v1', 'area1'), 'velvet')
     """
-    import brdf
-    from analysis.params import ParamSpec, defaults_from_fabric
     d = _dataset(name)
-    fab = fab if fab is not None else brdf.fabric(d.preset)
+    fab = fab if fab is not None else preset_fabric(d.preset)
     return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties), fab
 
 
@@ -242,7 +245,6 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     FileNotFoundError
         A missing data file (before any fit).
     """
-    from analysis.fit import fit_fabric
     names = list(names) if names else list(MEASURED)
     bad = [n for n in names if n not in MEASURED]
     if bad:
@@ -252,38 +254,51 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     out.mkdir(parents=True, exist_ok=True)
     spath = out / SUMMARY_FILE
     for n in names:
-        d = MEASURED[n]
-        spec, fab = measured_spec(n)
-        t0 = time.perf_counter()
-        result = fit_fabric(
-            tables[n], fab, spec, out / n, plots=plots, seed=seed, max_steps=max_steps,
-            time_limit=time_limit, progress=progress,
-            config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
-        entry = {
-            "title": d.title, "preset": d.preset, "source": str(tables[n].meta.get("source", "")),
-            "pairs": len(tables[n]), "values_used": result.counts["used"],
-            "free": list(result.names), "ties": list(d.ties),
-            "converged": bool(result.converged), "reason": result.reason,
-            "steps": result.steps, "wall_s": round(time.perf_counter() - t0, 2),
-            "quality": result.quality,
-            "albedo_delta_e2000": result.quality.get("albedo_delta_e2000"),
-            "results": f"{n}/results.json",
-        }
+        entry, result = _fit_one(n, tables[n], out, plots=plots, seed=seed,
+                                 max_steps=max_steps, time_limit=time_limit,
+                                 progress=progress, rgl_step=rgl_step)
         # read just before writing: another fit-measured run may have added its datasets
         doc = _read_summary(spath)
         doc["datasets"][n] = entry
         with atomic_write(spath, "w") as fh:
             fh.write(json.dumps(doc, indent=2) + "\n")
-        if echo is None:
-            continue
-        echo(f"{n}: {'converged' if result.converged else 'NOT converged'} after "
-             f"{result.steps} steps (this run {entry['wall_s']:.0f} s); residual rms "
-             f"{entry['quality']['rms_residual']:.3f}"
-             + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
-                if entry["albedo_delta_e2000"] is not None else "")
-             + (f"; resumed from step {result.timing['resumed_from']}"
-                if result.timing.get("resumed_from") else ""))
+        if echo is not None:
+            echo(_echo_line(n, entry, result))
     return doc
+
+
+def _fit_one(n: str, table, out: Path, *, plots, seed, max_steps, time_limit, progress,
+             rgl_step) -> tuple[dict, object]:
+    """Fit dataset ``n`` into ``out/n``: its summary entry and the :class:`FitResult`."""
+    d = MEASURED[n]
+    spec, fab = measured_spec(n)
+    t0 = time.perf_counter()
+    result = analysis.fit.fit_fabric(  # looked up at call time: tests substitute it
+        table, fab, spec, out / n, plots=plots, seed=seed, max_steps=max_steps,
+        time_limit=time_limit, progress=progress,
+        config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
+    entry = {
+        "title": d.title, "preset": d.preset, "source": str(table.meta.get("source", "")),
+        "pairs": len(table), "values_used": result.counts["used"],
+        "free": list(result.names), "ties": list(d.ties),
+        "converged": bool(result.converged), "reason": result.reason,
+        "steps": result.steps, "wall_s": round(time.perf_counter() - t0, 2),
+        "quality": result.quality,
+        "albedo_delta_e2000": result.quality.get("albedo_delta_e2000"),
+        "results": f"{n}/results.json",
+    }
+    return entry, result
+
+
+def _echo_line(n: str, entry: dict, result) -> str:
+    """The line :func:`fit_measured` prints for a finished dataset."""
+    return (f"{n}: {'converged' if result.converged else 'NOT converged'} after "
+            f"{result.steps} steps (this run {entry['wall_s']:.0f} s); residual rms "
+            f"{entry['quality']['rms_residual']:.3f}"
+            + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
+               if entry["albedo_delta_e2000"] is not None else "")
+            + (f"; resumed from step {result.timing['resumed_from']}"
+               if result.timing.get("resumed_from") else ""))
 
 
 def _read_summary(path: Path) -> dict:

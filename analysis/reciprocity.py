@@ -5,27 +5,38 @@ For each direction pair the relative asymmetry is
     r(wi, wo) = |f(wi, wo) - f(wo, wi)| / max(f(wi, wo), f(wo, wi)),
 
 between 0 (reciprocal) and 1 (one of the two is 0), computed on the luminance
-Y = 0.2126 R + 0.7152 G + 0.0722 B of the RGB f_r (Rec. ITU-R BT.709 weights, the Y row of the
-linear-sRGB to XYZ matrix) unless a channel is asked for. Pairs where both values are 0 are
-excluded and counted; so are pairs where either value is not finite.
+Y = 0.2126 R + 0.7152 G + 0.0722 B of the RGB f_r (:func:`analysis.colour.luminance`) unless a
+channel is asked for. Pairs where both values are 0 are excluded and counted; so are pairs where
+either value is not finite. :func:`reciprocity_report` gathers the statistics of the presets,
+their variants and measured felts as a :class:`ReciprocityReport`; its plain-language findings
+are written by :func:`reports.prose.reciprocity_statements`.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from analysis.colour import LUMINANCE_WEIGHTS, luminance
+from analysis.variants import VARIANTS, check_names
 from brdf.frames import to_angles
+from brdf.presets import fabric as preset_fabric
 from brdf.protocols import BRDF
+from gonio.geometry import Geometry
+from gonio.rgl import load_rgl
+from gonio.table import Table
 
-__all__ = ["ReciprocityResult", "reciprocity", "reciprocity_report", "random_pairs", "LUMINANCE",
-           "relative_asymmetry"]
+__all__ = ["ReciprocityResult", "ReciprocityReport", "reciprocity", "reciprocity_report",
+           "random_pairs", "LUMINANCE", "relative_asymmetry"]
 
-#: Rec. ITU-R BT.709 luminance weights of linear RGB.
-LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+#: Rec. ITU-R BT.709 luminance weights of linear RGB (:data:`analysis.colour.LUMINANCE_WEIGHTS`).
+LUMINANCE = LUMINANCE_WEIGHTS
+
 
 def relative_asymmetry(a, b) -> np.ndarray:
     """The reciprocity error of microcyl, r = |a - b| / max(|a|, |b|), elementwise.
@@ -92,6 +103,32 @@ class ReciprocityResult:
         return d
 
 
+@dataclasses.dataclass(frozen=True, eq=False)
+class ReciprocityReport:
+    """Everything :func:`reciprocity_report` measured, as plain data.
+
+    Attributes
+    ----------
+    settings : dict
+        ``n``, ``seed``, ``channel``, ``presets``, ``variants`` (name -> options),
+        ``geometry`` (its kind or None), ``felts`` (paths) and ``metric`` (the definition).
+    rows : list of dict
+        One per BRDF: ``source`` ("model" or "measured"), ``name``, ``variant`` (None for a
+        measured one), ``random``, ``random_cos_i`` (the ``weight="cos_i"`` diagnostic) and
+        optionally ``geometry``, each :meth:`ReciprocityResult.to_dict`.
+    seconds : float
+        Wall time.
+    """
+
+    settings: dict
+    rows: list
+    seconds: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-serializable data."""
+        return dataclasses.asdict(self)
+
+
 def random_pairs(n: int, seed=0) -> tuple[np.ndarray, np.ndarray]:
     """n direction pairs drawn uniformly (in solid angle) on the upper hemisphere.
 
@@ -129,6 +166,66 @@ def _angles_deg(w):
     return np.degrees(theta), np.degrees(phi) % 360.0
 
 
+
+def _as_pairs(pairs, n: int, seed) -> tuple[np.ndarray, np.ndarray]:
+    """(wi, wo), each (m, 3): ``n`` random pairs when ``pairs`` is None, else those given."""
+    if pairs is None:
+        return random_pairs(n, seed)
+    wi, wo = (pairs.wi, pairs.wo) if isinstance(pairs, (Geometry, Table)) else pairs
+    wi = np.asarray(wi, dtype=np.float64).reshape(-1, 3)
+    wo = np.asarray(wo, dtype=np.float64).reshape(-1, 3)
+    if wi.shape != wo.shape:
+        raise ValueError(f"pairs: wi and wo must have the same shape; got {wi.shape}, "
+                         f"{wo.shape}")
+    return wi, wo
+
+
+def _both_ways(brdf, wi, wo, channel, weight) -> tuple[np.ndarray, np.ndarray, str]:
+    """f(wi, wo) and f(wo, wi) on the chosen channel (1/sr), and the channel's name."""
+    with np.errstate(all="ignore"):
+        f_io = np.asarray(brdf.eval(wi, wo), dtype=np.float64)
+        f_oi = np.asarray(brdf.eval(wo, wi), dtype=np.float64)
+        if weight == "cos_i":
+            f_io = f_io * np.clip(wi[..., 2:3], 0, None)
+            f_oi = f_oi * np.clip(wo[..., 2:3], 0, None)
+    ch = _CHANNELS[channel]
+    if ch is None:
+        return luminance(f_io), luminance(f_oi), "luminance"
+    return f_io[..., ch], f_oi[..., ch], "rgb"[ch]
+
+
+def _worst_pairs(wi, wo, a, b, r, inc, n_worst: int) -> list[dict]:
+    """The ``n_worst`` included pairs of largest r: angles in degrees, both values, r."""
+    ri = r[inc]
+    if not ri.size or n_worst <= 0:
+        return []
+    idx = np.flatnonzero(inc)
+    order = idx[np.argsort(-ri, kind="stable")[:n_worst]]
+    ti, pi_ = _angles_deg(wi[order])
+    to, po = _angles_deg(wo[order])
+    return [{"theta_i": float(ti[k]), "phi_i": float(pi_[k]), "theta_o": float(to[k]),
+             "phi_o": float(po[k]), "f_io": float(a[j]), "f_oi": float(b[j]), "r": float(r[j])}
+            for k, j in enumerate(order)]
+
+
+def _statistics(a, b, name, wi, wo, n_worst: int) -> ReciprocityResult:
+    """The :class:`ReciprocityResult` of the values a = f(wi, wo) and b = f(wo, wi)."""
+    finite = np.isfinite(a) & np.isfinite(b)
+    zero = finite & (a == 0) & (b == 0)
+    inc = finite & ~zero
+    r = relative_asymmetry(a, b)
+    ri = r[inc]
+    if ri.size:
+        med, p95, mx, mean = (float(np.median(ri)), float(np.percentile(ri, 95)),
+                              float(ri.max()), float(ri.mean()))
+    else:
+        med = p95 = mx = mean = float("nan")
+    return ReciprocityResult(median=med, p95=p95, max=mx, mean=mean, n_pairs=int(a.size),
+                             n_included=int(inc.sum()), n_zero=int(zero.sum()),
+                             n_nonfinite=int((~finite).sum()), channel=name,
+                             worst=_worst_pairs(wi, wo, a, b, r, inc, n_worst))
+
+
 def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance",
                 n_worst: int = 5, weight: str = "none") -> ReciprocityResult:
     """Relative reciprocity error of a BRDF over random or given direction pairs.
@@ -137,9 +234,9 @@ def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance"
     ----------
     brdf : object
         Anything with ``eval(wi, wo) -> (..., 3)`` in 1/sr.
-    pairs : tuple (wi, wo) of arrays (n, 3), or an object with ``wi`` and ``wo``, optional
-        The pairs to test (a gonio Geometry or Table works). Default: ``n`` random pairs,
-        uniform on the hemisphere, from ``seed``.
+    pairs : tuple (wi, wo) of arrays (n, 3), or a gonio Geometry or Table, optional
+        The pairs to test. Default: ``n`` random pairs, uniform on the hemisphere, from
+        ``seed``.
     n : int, default 20000
         Number of random pairs when ``pairs`` is None.
     seed : int or numpy.random.Generator, default 0
@@ -183,59 +280,25 @@ def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance"
         raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
     if weight not in ("none", "cos_i"):
         raise ValueError(f"weight must be 'none' or 'cos_i'; got {weight!r}")
-    if pairs is None:
-        wi, wo = random_pairs(n, seed)
-    else:
-        if hasattr(pairs, "wi") and hasattr(pairs, "wo"):
-            wi, wo = pairs.wi, pairs.wo
-        else:
-            wi, wo = pairs
-        wi = np.asarray(wi, dtype=np.float64).reshape(-1, 3)
-        wo = np.asarray(wo, dtype=np.float64).reshape(-1, 3)
-        if wi.shape != wo.shape:
-            raise ValueError(f"pairs: wi and wo must have the same shape; got {wi.shape}, "
-                             f"{wo.shape}")
-    with np.errstate(all="ignore"):
-        f_io = np.asarray(brdf.eval(wi, wo), dtype=np.float64)
-        f_oi = np.asarray(brdf.eval(wo, wi), dtype=np.float64)
-        if weight == "cos_i":
-            f_io = f_io * np.clip(wi[..., 2:3], 0, None)
-            f_oi = f_oi * np.clip(wo[..., 2:3], 0, None)
-    ch = _CHANNELS[channel]
-    if ch is None:
-        a, b = f_io @ LUMINANCE, f_oi @ LUMINANCE
-        name = "luminance"
-    else:
-        a, b = f_io[..., ch], f_oi[..., ch]
-        name = "rgb"[ch]
-    finite = np.isfinite(a) & np.isfinite(b)
-    zero = finite & (a == 0) & (b == 0)
-    inc = finite & ~zero
-    r = relative_asymmetry(a, b)
-    ri = r[inc]
-    if ri.size:
-        med, p95, mx, mean = (float(np.median(ri)), float(np.percentile(ri, 95)),
-                              float(ri.max()), float(ri.mean()))
-    else:
-        med = p95 = mx = mean = float("nan")
-    worst = []
-    if ri.size and n_worst > 0:
-        idx = np.flatnonzero(inc)
-        order = idx[np.argsort(-ri, kind="stable")[:n_worst]]
-        ti, pi_ = _angles_deg(wi[order])
-        to, po = _angles_deg(wo[order])
-        for k, j in enumerate(order):
-            worst.append({"theta_i": float(ti[k]), "phi_i": float(pi_[k]),
-                          "theta_o": float(to[k]), "phi_o": float(po[k]),
-                          "f_io": float(a[j]), "f_oi": float(b[j]), "r": float(r[j])})
-    return ReciprocityResult(median=med, p95=p95, max=mx, mean=mean, n_pairs=int(a.size),
-                             n_included=int(inc.sum()), n_zero=int(zero.sum()),
-                             n_nonfinite=int((~finite).sum()), channel=name, worst=worst)
+    wi, wo = _as_pairs(pairs, n, seed)
+    a, b, name = _both_ways(brdf, wi, wo, channel, weight)
+    return _statistics(a, b, name, wi, wo, n_worst)
+
+
+def _report_row(name, variant, source, b, pairs, geometry, channel, n_worst) -> dict[str, Any]:
+    """One row of :class:`ReciprocityReport`: random pairs, the cos_i diagnostic, the grid."""
+    row = {"source": source, "name": name, "variant": variant,
+           "random": reciprocity(b, pairs, channel=channel, n_worst=n_worst).to_dict(),
+           "random_cos_i": reciprocity(b, pairs, channel=channel, n_worst=n_worst,
+                                       weight="cos_i").to_dict()}
+    if geometry is not None:
+        row["geometry"] = reciprocity(b, geometry, channel=channel, n_worst=n_worst).to_dict()
+    return row
 
 
 def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
                        geometry=None, felts=(), channel="luminance",
-                       n_worst: int = 5) -> dict[str, Any]:
+                       n_worst: int = 5) -> ReciprocityReport:
     """Reciprocity statistics per preset and variant, and for measured BRDFs as a contrast.
 
     Parameters
@@ -243,13 +306,13 @@ def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
     presets : sequence of str, optional
         Preset names (default: all of ``brdf.PRESETS``).
     variants : sequence of str, optional
-        Keys of :data:`analysis.energy.VARIANTS` (default: all), so the report shows which
+        Keys of :data:`analysis.variants.VARIANTS` (default: all), so the report shows which
         term (gap, transmission, masking, reweighting) changes the asymmetry.
     n : int, default 20000
         Random pairs (uniform on the hemisphere) per BRDF.
     seed : int, default 0
         Seed of the random pairs (the same pairs for every BRDF).
-    geometry : object with ``wi``, ``wo``, optional
+    geometry : gonio.Geometry, optional
         A gonio geometry examined as well (e.g. ``gonio.full_grid(10)``).
     felts : sequence of str or os.PathLike, optional
         RGL tensor files (``gonio.load_rgl``), reported as measured contrasts.
@@ -260,84 +323,26 @@ def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
 
     Returns
     -------
-    dict
-        ``settings``, ``rows`` (one per BRDF: ``source`` ("model" or "measured"), ``name``,
-        ``variant``, ``random``, ``random_cos_i`` (the ``weight="cos_i"`` diagnostic) and
-        optionally ``geometry``: :meth:`ReciprocityResult.to_dict`),
-        and ``statements`` (plain findings).
+    ReciprocityReport
+        Its findings in words: :func:`reports.prose.reciprocity_statements`.
 
     Raises
     ------
     ValueError
         Unknown preset or variant.
     """
-    import time
-
-    import brdf
-
-    from analysis.energy import VARIANTS
-
     t0 = time.perf_counter()
-    presets = tuple(brdf.PRESETS if presets is None else presets)
-    variants = tuple(VARIANTS if variants is None else variants)
-    for p in presets:
-        if p not in brdf.PRESETS:
-            raise ValueError(f"unknown fabric {p!r}; presets: {', '.join(brdf.PRESETS)}")
-    for v in variants:
-        if v not in VARIANTS:
-            raise ValueError(f"unknown variant {v!r}; variants: {', '.join(VARIANTS)}")
+    presets, variants = check_names(presets, variants)
     pairs = random_pairs(n, seed)
-    rows = []
-
-    def one(name, variant, source, b):
-        row = {"source": source, "name": name, "variant": variant,
-               "random": reciprocity(b, pairs, channel=channel, n_worst=n_worst).to_dict(),
-               "random_cos_i": reciprocity(b, pairs, channel=channel, n_worst=n_worst,
-                                           weight="cos_i").to_dict()}
-        if geometry is not None:
-            row["geometry"] = reciprocity(b, geometry, channel=channel,
-                                          n_worst=n_worst).to_dict()
-        rows.append(row)
-
-    for p in presets:
-        for v in variants:
-            one(p, v, "model", brdf.fabric(p, **VARIANTS[v]))
-    for path in felts:
-        import gonio
-
-        from pathlib import Path
-
-        one(Path(path).stem, None, "measured", gonio.load_rgl(path))
-    statements = []
-    for p in presets:
-        mine = {r["variant"]: r["random"] for r in rows if r["name"] == p}
-        if "default" in mine and mine["default"]["median"] is not None:
-            d = mine["default"]
-            parts = [f"{p}: median {d['median']:.3f}, p95 {d['p95']:.3f}, max {d['max']:.3f} "
-                     "(default)"]
-            for v, s in mine.items():
-                if v != "default" and s["median"] is not None:
-                    parts.append(f"{v} median {s['median']:.3f} "
-                                 f"({'lower' if s['median'] < d['median'] else 'not lower'})")
-            c = next(r["random_cos_i"] for r in rows if r["name"] == p
-                     and r["variant"] == "default")
-            if c["median"] is not None:
-                parts.append(f"without the 1/(n.wi) factor (f cos theta_i) median "
-                             f"{c['median']:.3f}, p95 {c['p95']:.3f}")
-            statements.append("; ".join(parts) + ".")
-    meas = [r for r in rows if r["source"] == "measured" and r["random"]["median"] is not None]
-    for r in meas:
-        s = r["random"]
-        statements.append(f"measured {r['name']}: median {s['median']:.3f}, p95 {s['p95']:.3f},"
-                          f" max {s['max']:.3f} (interpolated table; a contrast, not a model)")
-    return {
-        "settings": {"n": int(n), "seed": seed if isinstance(seed, int) else None,
-                     "channel": channel, "presets": list(presets),
-                     "variants": {v: VARIANTS[v] for v in variants},
-                     "geometry": getattr(geometry, "kind", None) if geometry is not None
-                     else None,
-                     "felts": [str(f) for f in felts],
-                     "metric": "|f(wi,wo) - f(wo,wi)| / max(f(wi,wo), f(wo,wi)); pairs with "
-                               "both 0 excluded and counted (n_zero)"},
-        "rows": rows, "statements": statements, "seconds": time.perf_counter() - t0,
-    }
+    rows = [_report_row(p, v, "model", preset_fabric(p, **VARIANTS[v]), pairs, geometry,
+                        channel, n_worst) for p in presets for v in variants]
+    rows += [_report_row(Path(path).stem, None, "measured", load_rgl(path), pairs, geometry,
+                         channel, n_worst) for path in felts]
+    settings = {"n": int(n), "seed": seed if isinstance(seed, int) else None,
+                "channel": channel, "presets": list(presets),
+                "variants": {v: VARIANTS[v] for v in variants},
+                "geometry": geometry.kind if isinstance(geometry, Geometry) else None,
+                "felts": [str(f) for f in felts],
+                "metric": "|f(wi,wo) - f(wo,wi)| / max(f(wi,wo), f(wo,wi)); pairs with "
+                          "both 0 excluded and counted (n_zero)"}
+    return ReciprocityReport(settings=settings, rows=rows, seconds=time.perf_counter() - t0)

@@ -17,7 +17,10 @@ from typing import Any
 
 import numpy as np
 
+from brdf.fabric import Fabric
 from brdf.frames import from_angles, to_angles
+from brdf.presets import PRESETS
+from brdf.presets import fabric as preset_fabric
 from brdf.protocols import BRDF
 
 __all__ = ["SanityResult", "sanity_scan", "edge_pairs"]
@@ -199,7 +202,7 @@ def _parameter_sets(fabric) -> dict[str, Any]:
             sets[name] = make()
         except ValueError as exc:  # the model refuses the set: worth saying, not a failure
             sets[name] = exc
-    if hasattr(fabric, "options"):
+    if isinstance(fabric, Fabric):
         for opt, val in (("masking", False), ("reweighting", False),
                          ("transmission", "longitudinal"), ("gap", "outgoing"),
                          ("tangent_sampling", "control_points")):
@@ -216,7 +219,7 @@ def sanity_scan(obj, *, parameters: bool | None = None, n_examples: int = 3) -> 
     Parameters
     ----------
     obj : object or str
-        A BRDF with ``eval(wi, wo)``, a fabric (with ``threads`` and ``replace``), or a
+        A BRDF with ``eval(wi, wo)``, a :class:`brdf.Fabric`, or a
         preset name.
     parameters : bool, optional
         Also scan edge parameter sets (default: True for fabrics).
@@ -243,15 +246,12 @@ def sanity_scan(obj, *, parameters: bool | None = None, n_examples: int = 3) -> 
     True
     """
     if isinstance(obj, str):
-        import brdf
-
-        if obj not in brdf.PRESETS:
-            raise ValueError(f"unknown fabric {obj!r}; presets: {', '.join(brdf.PRESETS)}")
-        obj = brdf.fabric(obj)
+        if obj not in PRESETS:
+            raise ValueError(f"unknown fabric {obj!r}; presets: {', '.join(PRESETS)}")
+        obj = preset_fabric(obj)
     if not isinstance(obj, BRDF):
         raise ValueError(f"need a BRDF with eval(wi, wo); got {type(obj).__name__}")
-    is_fabric = hasattr(obj, "threads") and hasattr(obj, "replace")
-    parameters = is_fabric if parameters is None else bool(parameters)
+    parameters = isinstance(obj, Fabric) if parameters is None else bool(parameters)
     sets = _parameter_sets(obj) if parameters else {"as_given": obj}
     pairs = edge_pairs()
     checks = []

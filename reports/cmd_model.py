@@ -93,6 +93,7 @@ def run_eval(args):
 
 
 def run_report(args):
+    from analysis.colour import luminance
     from reports.report import build_report
 
     if args.batch is not None:
@@ -114,7 +115,7 @@ def run_report(args):
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name in names:
         vals = standard_values(brdf.fabric(name))
-        lum = [0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2] for v in vals.values()]
+        lum = luminance(np.array(list(vals.values()), dtype=np.float64)).tolist()
         print(f"{name:31s} " + " ".join(f"{x:19.6g}" for x in lum))
     print(f"wrote {index} (data: {index.parent / 'summary.json'})")
     return 0

@@ -136,8 +136,18 @@ def register(sub):
     p.set_defaults(func=run_sanity)
 
 
+def document(rep, statements) -> dict:
+    """The JSON document of an energy or reciprocity report: its ``to_dict()`` with the
+    findings (:mod:`reports.prose`) as ``statements`` before ``seconds``."""
+    doc = rep.to_dict()
+    seconds = doc.pop("seconds")
+    doc["statements"] = list(statements)
+    doc["seconds"] = seconds
+    return doc
+
+
 def format_energy(rep) -> str:
-    """The energy report as text tables."""
+    """The energy report (its :func:`document`) as text tables."""
     d = rep.to_dict() if hasattr(rep, "to_dict") else rep
     lines = ["Directional albedo maxima (value +- error bound; theta, phi of the fixed "
              "direction in degrees)",
@@ -178,6 +188,7 @@ def run_energy(args) -> int:
     import numpy as np
 
     from analysis.energy import energy_report
+    from reports.prose import energy_statements
 
     presets = _presets(args.fabric)
     variants = _variants(args.variants)
@@ -194,15 +205,16 @@ def run_energy(args) -> int:
     rep = energy_report(presets, variants, theta_deg=theta, phi_deg=phi, tol=args.tol,
                         hemispherical=not args.no_hemispherical, furnace=not args.no_furnace,
                         workers=args.workers, progress=not args.quiet)
-    print(format_energy(rep))
+    doc = document(rep, energy_statements(rep))
+    print(format_energy(doc))
     if target is not None:
-        write_json(target, rep.to_dict())
+        write_json(target, doc)
         print(f"wrote {target}")
     return 0
 
 
 def format_reciprocity(rep: dict) -> str:
-    """The reciprocity report as a text table."""
+    """The reciprocity report (its :func:`document`, with ``notes``) as a text table."""
     lines = [f"Reciprocity error r = |f(wi,wo) - f(wo,wi)| / max(...), on "
              f"{rep['settings']['channel']}; {rep['settings']['n']} random pairs"
              + (", and a gonio full grid" if rep['settings']['geometry'] else ""),
@@ -241,6 +253,7 @@ def run_reciprocity(args) -> int:
     """``microcyl reciprocity``."""
     import gonio
     from analysis.reciprocity import reciprocity_report
+    from reports.prose import reciprocity_statements
 
     presets = _presets(args.fabric)
     variants = _variants(args.variants)
@@ -261,10 +274,11 @@ def run_reciprocity(args) -> int:
                 notes.append(f"measured felt {path} not found: skipped")
     rep = reciprocity_report(presets, variants, n=args.n, seed=args.seed, geometry=geometry,
                              felts=felts, channel=args.channel)
-    rep["notes"] = notes
-    print(format_reciprocity(rep))
+    doc = document(rep, reciprocity_statements(rep))
+    doc["notes"] = notes
+    print(format_reciprocity(doc))
     if target is not None:
-        write_json(target, rep)
+        write_json(target, doc)
         print(f"wrote {target}")
     return 0
 

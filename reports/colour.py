@@ -3,7 +3,8 @@
 Every RGB value in microcyl (f_r, albedo A, renders) is *linear* RGB with the sRGB / Rec. 709
 primaries and white point D65. This module is the one place where such a value becomes a colour
 on screen: the encoding goes through colour-science (``colour.cctf_encoding`` with the sRGB
-inverse EOTF), and luminance uses the Rec. 709 weights.
+inverse EOTF). Luminance is :func:`analysis.colour.luminance` (re-exported here), the one
+definition of the Rec. 709 weights.
 """
 
 from __future__ import annotations
@@ -11,45 +12,16 @@ from __future__ import annotations
 import colour as _colour
 import numpy as np
 
+from analysis.colour import LUMINANCE_WEIGHTS, luminance
+
 __all__ = ["REC709_WEIGHTS", "luminance", "to_srgb", "display_colour", "fabric_colour",
            "line_colour", "CHANNEL_COLOURS"]
 
-#: Rec. 709 luminance weights (R, G, B): the Y row of the sRGB RGB -> XYZ matrix.
-REC709_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
+#: Rec. 709 luminance weights (R, G, B): :data:`analysis.colour.LUMINANCE_WEIGHTS`.
+REC709_WEIGHTS = LUMINANCE_WEIGHTS
 
 #: Matplotlib colours of the three channels when RGB curves are drawn per channel.
 CHANNEL_COLOURS = ("tab:red", "tab:green", "tab:blue")
-
-
-def luminance(rgb) -> np.ndarray:
-    """Rec. 709 luminance Y = 0.2126 R + 0.7152 G + 0.0722 B of linear RGB.
-
-    Parameters
-    ----------
-    rgb : array_like, shape (..., 3)
-        Linear RGB, any unit (f_r in 1/sr gives Y in 1/sr).
-
-    Returns
-    -------
-    numpy.ndarray, shape (...)
-        Luminance, same unit as the input.
-
-    Raises
-    ------
-    ValueError
-        If the last axis does not have length 3.
-
-    Examples
-    --------
-    >>> float(luminance([1.0, 1.0, 1.0]))
-    1.0
-    >>> float(luminance([0.0, 1.0, 0.0]))
-    0.7152
-    """
-    arr = np.asarray(rgb, dtype=np.float64)
-    if arr.ndim == 0 or arr.shape[-1] != 3:
-        raise ValueError(f"rgb must have shape (..., 3); got {arr.shape}")
-    return arr @ REC709_WEIGHTS
 
 
 def to_srgb(rgb, exposure: float = 0.0, normalize: bool = False) -> np.ndarray:

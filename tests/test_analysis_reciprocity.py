@@ -88,12 +88,12 @@ def test_report_variants_and_felts(shared_data):
     felt = shared_data / "rgl" / "acrylic_felt_white_rgb.bsdf"
     rep = reciprocity_report(["linen_plain"], ["default", "gap_outgoing"], n=500,
                              felts=[felt] if felt.is_file() else [])
-    json.dumps(rep)
-    names = [(r["name"], r["variant"]) for r in rep["rows"]]
+    json.dumps(rep.to_dict())
+    names = [(r["name"], r["variant"]) for r in rep.rows]
     assert ("linen_plain", "default") in names and ("linen_plain", "gap_outgoing") in names
-    d = {r["variant"]: r["random"] for r in rep["rows"] if r["source"] == "model"}
+    d = {r["variant"]: r["random"] for r in rep.rows if r["source"] == "model"}
     # the gap term changes linen's asymmetry (a1 + a2 = 0.66 < 1)
     assert d["default"]["median"] != d["gap_outgoing"]["median"]
     if felt.is_file():
-        m = [r for r in rep["rows"] if r["source"] == "measured"][0]
+        m = [r for r in rep.rows if r["source"] == "measured"][0]
         assert m["random"]["median"] < d["default"]["median"]

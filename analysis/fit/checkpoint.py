@@ -15,6 +15,7 @@ import hashlib
 import json
 from pathlib import Path
 
+import h5py
 import numpy as np
 
 from gonio import atomic_write
@@ -95,7 +96,6 @@ class FitFolder:
         """
         if not self.checkpoint_path.exists():
             return None
-        import h5py
         try:
             with h5py.File(self.checkpoint_path, "r") as f:
                 progress = json.loads(f.attrs["progress"])
@@ -113,7 +113,6 @@ class FitFolder:
     def write_checkpoint(self, progress: dict, ensembles: list[dict]):
         """Write the checkpoint whole: ``progress`` (JSON-able) and, per ensemble, a dict of
         arrays (a nested dict becomes an HDF5 group; keys ``attr:NAME`` become attributes)."""
-        import h5py
         with atomic_write(self.checkpoint_path, "wb") as fh:
             with h5py.File(fh, "w") as f:
                 f.attrs["progress"] = json.dumps(plain(progress))
@@ -133,7 +132,7 @@ def _write_node(group, doc: dict):
 
 
 def _read_node(node):
-    if hasattr(node, "keys"):
+    if isinstance(node, h5py.Group):
         out = {name: _read_node(node[name]) for name in node}
         out.update({f"attr:{a}": v for a, v in node.attrs.items()})
         return out

@@ -1,12 +1,13 @@
 r"""How well a fit explains its table: residuals at the posterior median, and the albedo colour
-of the table against the fit's (CIEDE2000, colour-science).
+of the table against the fit's (CIEDE2000, colour-science; :func:`albedo_colours` and
+:func:`albedo_delta_e` live in :mod:`analysis.colour` and are re-exported here).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from analysis.likelihood import is_grey
+from analysis.colour import albedo_colours, albedo_delta_e
 
 __all__ = ["residuals", "albedo_colours", "albedo_delta_e", "fit_quality"]
 
@@ -36,55 +37,6 @@ def residuals(result, prediction=None) -> dict:
     z = r / np.sqrt(s2)
     return {"residual": r, "normalized": z, "rms": float(np.sqrt(np.mean(r * r))),
             "rms_normalized": float(np.sqrt(np.mean(z * z)))}
-
-
-def albedo_colours(table, prediction):
-    r"""Albedo colours (linear RGB) of the table and of a prediction, by the same estimator.
-
-    rho = 2 pi mean over valid points of f_r cos(theta_o): the uniform-hemisphere Monte Carlo
-    estimate of the directional albedo averaged over the table's incidences (unitless); the
-    prediction (f_r in 1/sr at the table's pairs, (n, 3)) uses the same points and mask, so
-    the two are comparable whatever the sampling. A grey table (R = G = B everywhere: CUReT)
-    is compared with the grey of the prediction, the mean of its channels.
-
-    Returns
-    -------
-    measured, predicted : ndarray (3,)
-
-    Examples
-    --------
-    >>> from gonio.table import Table
-    >>> t = Table([[0, 0, 1.0]], [[0, 0, 1.0]], [[0.1, 0.2, 0.3]])
-    >>> m, p = albedo_colours(t, np.array([[0.1, 0.2, 0.3]]))
-    >>> np.allclose(m, p), round(float(m[0]), 4)           # 2 pi 0.1
-    (True, 0.6283)
-    """
-    prediction = np.asarray(prediction, dtype=np.float64)
-    if is_grey(table.values):
-        prediction = np.repeat(prediction.mean(axis=-1, keepdims=True), 3, axis=-1)
-    valid = table.valid & np.isfinite(prediction)
-    cos_o = np.clip(table.wo[:, 2], 0, None)[:, None]
-    meas = np.where(valid, table.values, 0.0) * cos_o
-    pred = np.where(valid, prediction, 0.0) * cos_o
-    cnt = np.maximum(valid.sum(0), 1)
-    return 2 * np.pi * meas.sum(0) / cnt, 2 * np.pi * pred.sum(0) / cnt
-
-
-def albedo_delta_e(measured, predicted) -> float:
-    """CIEDE2000 difference between two linear-sRGB colours (colour-science).
-
-    Examples
-    --------
-    >>> albedo_delta_e([0.2, 0.2, 0.2], [0.2, 0.2, 0.2])
-    0.0
-    >>> albedo_delta_e([0.2, 0.1, 0.05], [0.2, 0.2, 0.2]) > 5
-    True
-    """
-    import colour
-    labs = [colour.XYZ_to_Lab(colour.sRGB_to_XYZ(np.clip(np.asarray(c, float), 0, None),
-                                                 apply_cctf_decoding=False))
-            for c in (measured, predicted)]
-    return float(colour.delta_E(labs[0], labs[1], method="CIE 2000"))
 
 
 def fit_quality(result, table) -> dict:

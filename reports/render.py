@@ -168,7 +168,7 @@ def _shade(scene, fabric, o, d, rng):
     if idx.size == 0:
         return out
     rad = np.zeros((idx.size, 3))
-    is_cloth = np.array([getattr(pr, "material", "diffuse") == "cloth" for pr in prims])
+    is_cloth = np.array([pr.material == "cloth" for pr in prims])
     cloth = is_cloth[pid_h[idx]]
     # cloth: BRDF in the local frame (x = warp, y = n x warp, z = n)
     c = idx[cloth]
@@ -186,7 +186,7 @@ def _shade(scene, fabric, o, d, rng):
     dsel = ~cloth
     if dsel.any():
         di = idx[dsel]
-        alb = np.array([getattr(pr, "albedo", 0.5) for pr in prims])[pid_h[di]]
+        alb = np.array([pr.albedo for pr in prims])[pid_h[di]]
         rad[dsel] = (alb / np.pi * cos_i[di])[:, None] * E[di]
     out[hit[idx]] = rad
     return out

@@ -3,9 +3,9 @@
 The primitives (:mod:`reports.primitives`), cameras (:mod:`reports.cameras`) and lights
 (:mod:`reports.lights`) are re-exported here. Every primitive answers two vectorized
 questions: where does a batch of rays first hit it (:meth:`intersect`), and what is the
-shading frame at given points on it (:meth:`frame`). The frame is the surface normal ``n`` and the warp tangent; the renderer completes it with
-``y = n x warp`` so that local coordinates are (x = warp, y = n x warp, z = n), the frame of
-:meth:`brdf.Fabric.eval`.
+shading frame at given points on it (:meth:`frame`). The frame is the surface normal ``n``
+and the warp tangent; the renderer completes it with ``y = n x warp`` so that local
+coordinates are (x = warp, y = n x warp, z = n), the frame of :meth:`brdf.Fabric.eval`.
 
 World axes: +y is up.  Lengths are in arbitrary scene units (metres, say); point-light
 intensities in W/sr (any consistent radiometric unit), so that radiance comes out in

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import matplotlib
+import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from brdf.frames import half_diff_to_directions
 from gonio.atomic import atomic_write
@@ -19,11 +22,6 @@ __all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
 
 #: What a plot can show of an RGB f_r: its Rec. 709 luminance, each channel, or one channel.
 QUANTITIES = ("luminance", "rgb", "r", "g", "b")
-
-
-def _pyplot():
-    import matplotlib.pyplot as plt  # imported lazily: the backend is the caller's choice
-    return plt
 
 
 def new_axes(ax=None, *, projection=None, figsize=(5.0, 4.0)):
@@ -44,8 +42,7 @@ def new_axes(ax=None, *, projection=None, figsize=(5.0, 4.0)):
         if name != want:
             raise ValueError(f"ax must have projection {want!r}; got {name!r}")
         return ax.figure, ax
-    from matplotlib.figure import Figure
-    fig = _pyplot().figure(figsize=figsize) if _use_pyplot() else Figure(figsize=figsize)
+    fig = plt.figure(figsize=figsize) if _use_pyplot() else Figure(figsize=figsize)
     ax = fig.add_subplot(1, 1, 1, projection=projection)
     return fig, ax
 
@@ -53,7 +50,6 @@ def new_axes(ax=None, *, projection=None, figsize=(5.0, 4.0)):
 def _use_pyplot() -> bool:
     # Figures made through pyplot show up in notebooks; under a non-interactive backend a
     # bare Figure avoids pyplot's global figure list (no leaks in long reports).
-    import matplotlib
     backend = matplotlib.get_backend().lower()
     return not (backend == "agg" or backend.endswith("backend_agg") or backend in ("pdf", "svg"))
 

@@ -13,6 +13,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import brdf
+from analysis.fit import fit_fabric
+from analysis.likelihood import KINDS
+from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
+from gonio import read
 from reports import cliutil
 
 __all__ = ["register", "run", "read_table", "format_summary"]
@@ -20,19 +24,12 @@ __all__ = ["register", "run", "read_table", "format_summary"]
 
 def read_table(path, sample=None):
     """Read a table with ``gonio.read`` (CUReT needs ``sample``)."""
-    try:
-        from gonio import read
-    except ImportError:  # pragma: no cover - until gonio's readers are merged
-        raise ValueError("reading tables needs gonio.read, which this installation lacks") \
-            from None
     opts = {} if sample is None else {"sample": sample}
     return read(path, **opts)
 
 
 def register(sub):
     """Add ``fit`` to the ``microcyl`` sub-parsers."""
-    from analysis.likelihood import KINDS
-    from analysis.params import DEFAULT_FREE, DEFAULT_TIES
     p = sub.add_parser(
         "fit", help="estimate model parameters from a BRDF table (emcee)",
         description="Fit the microcylinder model to a BRDF table: point estimate, then several "
@@ -71,7 +68,6 @@ def register(sub):
 
 
 def _spec_from_args(args, fab):
-    from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
     defaults = defaults_from_fabric(fab)
     ties = args.tie
     if ties is not None:
@@ -90,7 +86,6 @@ def _spec_from_args(args, fab):
 
 def run(args) -> int:
     """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
-    from analysis.fit import fit_fabric
     if args.fabric not in brdf.PRESETS:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")
@@ -100,6 +95,7 @@ def run(args) -> int:
     table = read_table(args.table, args.sample)
     plots = None
     if not args.no_plots:
+        # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
         from reports.fitplots import write_fit_plots as plots
     result = fit_fabric(
         table, fab, spec, out, plots=plots, likelihood=args.likelihood, nu=args.nu,

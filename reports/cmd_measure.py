@@ -14,6 +14,13 @@ import argparse
 import math
 from pathlib import Path
 
+import brdf
+import gonio
+from gonio import Instrument, measure
+from gonio.geometry import SPEC_HELP
+from gonio.geomspec import from_spec
+from gonio.instrument import NOISE_MODELS
+
 __all__ = ["register", "run"]
 
 _ON_OFF = {"on": True, "off": False}
@@ -21,9 +28,6 @@ _ON_OFF = {"on": True, "off": False}
 
 def register(sub):
     """Add the ``measure`` verb to the ``microcyl`` sub-parsers."""
-    from gonio.geometry import SPEC_HELP
-    from gonio.instrument import NOISE_MODELS
-
     p = sub.add_parser(
         "measure", help="measure a fabric on a geometry through a virtual instrument",
         description="Measure a preset fabric on a geometry through a virtual "
@@ -87,38 +91,13 @@ def _fabric_options(args) -> dict:
 
 def _make_fabric(name: str, options: dict):
     """``brdf.fabric(name, **options)``, with a one-line error for an unknown name."""
-    import brdf
-
-    presets = tuple(getattr(brdf, "PRESETS", ()))
-    make = getattr(brdf, "fabric", None)
-    if make is None:
-        raise RuntimeError("this build of microcyl has no brdf.fabric yet")
-    if name not in presets:
-        raise ValueError(f"unknown fabric {name!r}; valid names: {', '.join(presets)}")
-    return make(name, **options)
-
-
-def _writer():
-    """``gonio.write``, or a clear error when this build lacks it."""
-    import gonio
-
-    write = getattr(gonio, "write", None)
-    if write is None:
-        try:  # the formats module may exist without being re-exported yet
-            from gonio.io import write  # type: ignore[attr-defined]
-        except ImportError:
-            write = None
-    if write is None:
-        raise RuntimeError("writing tables needs gonio.write (gonio/io.py), which this build "
-                           "of microcyl does not have yet")
-    return write
+    if name not in brdf.PRESETS:
+        raise ValueError(f"unknown fabric {name!r}; valid names: {', '.join(brdf.PRESETS)}")
+    return brdf.fabric(name, **options)
 
 
 def run(args) -> int:
     """Measure and write; every check on the input happens before the measurement."""
-    from gonio import Instrument, measure
-    from gonio.geomspec import from_spec
-
     out = Path(args.output)
     if not out.parent.is_dir():
         raise OSError(2, "output folder does not exist", str(out.parent))
@@ -132,11 +111,10 @@ def run(args) -> int:
                             azimuths=args.cone_azimuths)
     geometry = from_spec(args.geometry, rotation=math.radians(args.rotation))
     fabric = _make_fabric(args.fabric, _fabric_options(args))
-    write = _writer()
     table = measure(fabric, geometry, instrument, seed=args.seed)
     if "name" not in table.meta["source"]:
         table.meta["source"]["name"] = args.fabric
-    write(table, out)
+    gonio.write(table, out)
     bad = int((~table.valid).any(axis=1).sum())
     note = f", {bad} with a negative or missing value" if bad else ""
     print(f"{args.fabric}: {len(table)} pairs on {geometry.spec} "

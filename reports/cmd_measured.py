@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from analysis.measured import MEASURED, SUMMARY_FILE, fit_measured
 from reports import cliutil
 
 __all__ = ["register", "run"]
@@ -20,7 +21,6 @@ __all__ = ["register", "run"]
 
 def register(sub):
     """Add ``fit-measured`` to the ``microcyl`` sub-parsers."""
-    from analysis.measured import MEASURED
     p = sub.add_parser(
         "fit-measured", help="fit the model to the measured felts and CUReT fabrics",
         description="Fit the microcylinder model to the RGL felts and the CUReT fabric samples "
@@ -45,10 +45,10 @@ def register(sub):
 
 def run(args) -> int:
     """Fit the named (or all) measured datasets; exit 1 when one did not converge."""
-    from analysis.measured import SUMMARY_FILE, fit_measured
     out = cliutil.check_writable_dir(Path(args.output))
     plots = None
     if not args.no_plots:
+        # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
         from reports.fitplots import write_fit_plots as plots
     doc = fit_measured(args.names, out, data_dir=args.data, seed=args.seed,
                        max_steps=args.max_steps, time_limit=args.time_limit,

@@ -7,8 +7,15 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
+
+import analysis.sanity
 import brdf
+import gonio
+from analysis.energy import VARIANTS, EnergyReport, energy_report
+from analysis.reciprocity import reciprocity_report
 from gonio.atomic import atomic_write
+from reports.prose import energy_statements, reciprocity_statements
 
 #: ../shared/data beside the repository (override with --data or MICROCYL_DATA).
 DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -26,8 +33,6 @@ def _presets(name: str) -> tuple[str, ...]:
 
 
 def _variants(text: str | None):
-    from analysis.energy import VARIANTS
-
     if text is None:
         return tuple(VARIANTS)
     out = tuple(v.strip() for v in text.split(",") if v.strip())
@@ -148,7 +153,7 @@ def document(rep, statements) -> dict:
 
 def format_energy(rep) -> str:
     """The energy report (its :func:`document`) as text tables."""
-    d = rep.to_dict() if hasattr(rep, "to_dict") else rep
+    d = rep.to_dict() if isinstance(rep, EnergyReport) else rep
     lines = ["Directional albedo maxima (value +- error bound; theta, phi of the fixed "
              "direction in degrees)",
              f"{'preset':32s} {'variant':27s} {'mode':12s} {'max':>20s} {'theta':>6s} "
@@ -185,11 +190,6 @@ def format_energy(rep) -> str:
 
 def run_energy(args) -> int:
     """``microcyl energy``."""
-    import numpy as np
-
-    from analysis.energy import energy_report
-    from reports.prose import energy_statements
-
     presets = _presets(args.fabric)
     variants = _variants(args.variants)
     phi = _floats(args.phi, "--phi")
@@ -251,10 +251,6 @@ def format_reciprocity(rep: dict) -> str:
 
 def run_reciprocity(args) -> int:
     """``microcyl reciprocity``."""
-    import gonio
-    from analysis.reciprocity import reciprocity_report
-    from reports.prose import reciprocity_statements
-
     presets = _presets(args.fabric)
     variants = _variants(args.variants)
     if args.n < 1:
@@ -298,10 +294,9 @@ def format_sanity(name: str, result) -> list[str]:
 
 def run_sanity(args) -> int:
     """``microcyl sanity``: :func:`analysis.sanity_scan` of each preset."""
-    from analysis.sanity import sanity_scan
     presets = _presets(args.fabric)
     target = _check_json_target(args.json)
-    results = {name: sanity_scan(name) for name in presets}
+    results = {name: analysis.sanity.sanity_scan(name) for name in presets}
     for name, r in results.items():
         print("\n".join(format_sanity(name, r)))
     if target is not None:

@@ -13,9 +13,12 @@ options, size, output folder) before rendering starts.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from pathlib import Path
+
+from reports.lights import PointLight
 
 __all__ = ["register", "run"]
 
@@ -84,6 +87,7 @@ def _fabric_options(args):
 
 def run(args):
     """Check every argument, render, write the files; return 0."""
+    # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
     from reports import imageio
     from reports.render import check_size, render, resolve_fabric
     from reports.scenes import make_scene
@@ -101,10 +105,9 @@ def run(args):
     if args.light_radius is not None:
         if not (args.light_radius >= 0 and math.isfinite(args.light_radius)):
             raise ValueError(f"--light-radius {args.light_radius}: must be >= 0")
-        from dataclasses import replace
-        if not hasattr(scene.light, "radius"):
+        if not isinstance(scene.light, PointLight):
             raise ValueError(f"--light-radius: scene {args.scene!r} has a directional light")
-        scene = scene.replace(light=replace(scene.light, radius=args.light_radius))
+        scene = scene.replace(light=dataclasses.replace(scene.light, radius=args.light_radius))
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers {args.workers}: must be at least 1")
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+import gonio
+
 
 def register(sub):
     """Add ``convert`` and ``info`` to the ``microcyl`` sub-parsers."""
@@ -34,16 +36,12 @@ def _reader_options(p):
 
 
 def _read(args, path):
-    import gonio
-
     options = {k: getattr(args, k) for k in ("sample", "step", "stride")
                if getattr(args, k) is not None}
     return gonio.read(path, **options)
 
 
 def run_convert(args):
-    import gonio
-
     table = _read(args, args.input)
     options = {}
     if getattr(args, "alta_param", None):

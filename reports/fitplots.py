@@ -7,25 +7,30 @@ when given ``filename`` and never calls ``show()``.
 
 from __future__ import annotations
 
-import numpy as np
+from pathlib import Path
 
+import corner
+import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.ticker import MaxNLocator
+
+from analysis.fit import LogPosterior
+from gonio import atomic_write
 
 __all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "posterior_draws",
            "write_fit_plots"]
 
 
 def _plt():
-    import matplotlib
+    """pyplot, on the Agg backend when it can be set (fits run without a display)."""
     matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
     return plt
 
 
 def _save(fig, filename):
     """Save whole or not at all (gonio.atomic_write), in the format of the file's suffix."""
     if filename is not None:
-        from pathlib import Path
-        from gonio import atomic_write
         with atomic_write(filename, "wb") as fh:
             fig.savefig(fh, format=Path(filename).suffix[1:] or "png", dpi=110,
                         bbox_inches="tight")
@@ -40,7 +45,6 @@ def corner_plot(result, truths=None, fig=None, filename=None):
     truths : mapping name -> value, optional
         Drawn as lines (e.g. the simulation's parameters).
     """
-    import corner
     samples = result.samples()
     if samples.shape[0] > 40000:
         samples = samples[np.random.default_rng(0).choice(samples.shape[0], 40000, False)]
@@ -84,7 +88,6 @@ def posterior_draws(result, n: int = 64, seed: int = 0) -> np.ndarray:
 
 
 def _predict_at(result, model_factory, wi, wo, theta):
-    from analysis.fit import LogPosterior
     lp = LogPosterior(result.spec, None, model_factory(wi, wo))
     return lp.predict(theta)
 
@@ -154,7 +157,6 @@ def lobe_plot(result, table, model_factory, theta_i_deg=None, phi_i_deg=None, ax
             v = np.nanmean(np.where(table.valid[sel], table.values[sel], np.nan), -1) \
                 * np.cos(np.radians(ang[sel, 2]))
             a.plot(s, v, "k.", ms=3, label="data")
-        from matplotlib.ticker import MaxNLocator
         a.yaxis.set_major_locator(MaxNLocator(3))
         a.tick_params(labelsize=7)
         a.set_title(f"theta_i = {ti:g} deg: f_r cos(theta_o), mean RGB\n"
@@ -212,7 +214,6 @@ def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
     The signature :func:`analysis.fit.fit_fabric` expects of its ``plots``; returns
     ``{name: path}``.
     """
-    from pathlib import Path
     plt = _plt()
     out = Path(out_dir)
     files = {}

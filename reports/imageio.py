@@ -10,8 +10,16 @@ import os
 from pathlib import Path
 
 import numpy as np
+import OpenEXR
+from PIL import Image
 
 from gonio.atomic import atomic_write
+
+# colour-science's first import sets NumPy's print options to legacy="1.13", which would
+# change every later array repr (doctests included): keep the options as they were
+_PRINT_OPTIONS = np.get_printoptions()
+import colour  # noqa: E402
+np.set_printoptions(**_PRINT_OPTIONS)
 
 __all__ = ["write_exr", "read_exr", "write_png", "encode_srgb", "check_output"]
 
@@ -74,8 +82,6 @@ def write_exr(path, rgb):
     >>> read_exr(out)[1, 2].tolist()
     [0.25, 0.25, 0.25]
     """
-    import OpenEXR
-
     a = np.ascontiguousarray(_check_rgb(rgb), dtype=np.float32)
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
 
@@ -94,8 +100,6 @@ def read_exr(path):
     ValueError
         If the file is not a readable OpenEXR image with R, G and B channels.
     """
-    import OpenEXR
-
     try:
         with OpenEXR.File(str(path)) as f:
             ch = f.channels()
@@ -104,15 +108,6 @@ def read_exr(path):
             return np.stack([np.asarray(ch[c].pixels, np.float32) for c in "RGB"], axis=-1)
     except (KeyError, RuntimeError) as exc:
         raise ValueError(f"{path}: not a readable RGB OpenEXR file ({exc})") from None
-
-
-def _colour():
-    """Import colour-science, keeping NumPy's print options (its import sets legacy="1.13",
-    which would change every later array repr, doctests included)."""
-    options = np.get_printoptions()
-    import colour
-    np.set_printoptions(**options)
-    return colour
 
 
 def encode_srgb(rgb, exposure=0.0):
@@ -135,7 +130,6 @@ def encode_srgb(rgb, exposure=0.0):
     >>> np.round(encode_srgb(np.array([0.0, 0.214041, 1.0, 4.0])), 6).tolist()
     [0.0, 0.5, 1.0, 1.0]
     """
-    colour = _colour()
     exposure = float(exposure)
     if not np.isfinite(exposure):
         raise ValueError(f"exposure={exposure} must be a finite number of stops")
@@ -161,8 +155,6 @@ def write_png(path, rgb, exposure=0.0):
     Path
         ``path``.
     """
-    from PIL import Image
-
     a = _check_rgb(rgb)
     q = np.round(encode_srgb(a, exposure) * 255.0).astype(np.uint8)
 

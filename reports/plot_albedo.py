@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from analysis import AlbedoCurve, AlbedoResult
 from reports._plotting import check_quantity, finish, new_axes, quantity_styles
 from reports.colour import REC709_WEIGHTS, luminance
 
@@ -18,9 +19,9 @@ def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, l
     ----------
     theta_deg : array_like, shape (n,)
         Polar angles in degrees.
-    albedo : array_like, shape (n,) or (n, 3), or a result object
-        Unitless albedo; an object with ``.value`` (and ``.error``), such as the result of
-        ``analysis.albedo``, is accepted in its place.
+    albedo : array_like, shape (n,) or (n, 3), or analysis.AlbedoResult or AlbedoCurve
+        Unitless albedo; a result of ``analysis.albedo`` (or ``analysis.albedo_curve`` over
+        one azimuth) is accepted in its place.
     error : array_like, optional
         One standard error per value (same shape as ``albedo``); taken from the result's
         ``.error`` when ``albedo`` is a result.
@@ -42,9 +43,9 @@ def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, l
     sigma_Y = sqrt(sum_c w_c^2 sigma_c^2) with the Rec. 709 weights w.
     """
     check_quantity(quantity)
-    if hasattr(albedo, "value"):
+    if isinstance(albedo, (AlbedoResult, AlbedoCurve)):
         if error is None:
-            error = getattr(albedo, "error", None)
+            error = albedo.error
         albedo = albedo.value
     theta = np.asarray(theta_deg, dtype=np.float64).reshape(-1)
     val = np.asarray(albedo, dtype=np.float64)

@@ -97,19 +97,10 @@ def plot_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity="rg
     Luminance sigma assumes independent channels: sqrt(sum_c w_c^2 sigma_c^2).
     """
     check_quantity(quantity)
-    idx, ti, to = plane_points(table, phi_deg, tol_deg)
-    values = np.asarray(table.values, dtype=np.float64)[idx]
-    valid = np.asarray(table.valid)[idx].all(axis=1)
-    idx, ti, to, values = idx[valid], ti[valid], to[valid], values[valid]
-    if idx.size == 0:
-        raise ValueError(f"table has no valid points in the plane phi = {phi_deg:g} degrees "
-                         f"(tolerance {tol_deg:g} degrees)")
-    sigma = None if table.sigma is None else np.asarray(table.sigma, float)[idx]
+    ti, to, values, sigma = _plane_data(table, phi_deg, tol_deg)
     distinct = np.unique(np.round(ti * 2.0) / 2.0)
     wanted = distinct[:max_incidences] if theta_i_deg is None else np.atleast_1d(theta_i_deg)
     fig, ax = new_axes(ax, figsize=(6.0, 4.0))
-    styles = quantity_styles(quantity)
-    markers = "osD^v<>"
     x_model = np.linspace(-90.0, 90.0, int(resolution))
     for n, t in enumerate(wanted):
         sel = np.abs(ti - t) <= 0.5
@@ -117,26 +108,9 @@ def plot_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity="rg
             continue
         wi, wo = plane_directions(float(np.mean(ti[sel])), x_model, phi_deg)
         model = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-        meas = reduce_quantity(values[sel], quantity)
-        if sigma is None:
-            err = None
-        elif quantity == "luminance":
-            err = np.sqrt((sigma[sel] ** 2) @ (REC709_WEIGHTS ** 2))
-        else:
-            err = reduce_quantity(sigma[sel], quantity)
-        order = np.argsort(to[sel])
-        for k, col, suffix in styles:
-            channel = "luminance" if k is None else "rgb"[k]
-            y = model[:, k] if model.ndim == 2 else model
-            line, = ax.plot(x_model, y, color=col, lw=1.0, ls=["-", "--", ":", "-."][n % 4],
-                            label=f"model θi = {t:g}°{suffix}")
-            line.set_gid(f"model theta_i={t:g} {channel}")
-            ym = (meas[:, k] if meas.ndim == 2 else meas)[order]
-            em = None if err is None else (err[:, k] if err.ndim == 2 else err)[order]
-            cont = ax.errorbar(to[sel][order], ym, yerr=em, color=col, ls="",
-                               marker=markers[n % len(markers)], ms=3.5, mfc="none",
-                               capsize=1.5, label=f"data θi = {t:g}°{suffix}")
-            cont.lines[0].set_gid(f"data theta_i={t:g} {channel}")
+        err = None if sigma is None else _reduce_sigma(sigma[sel], quantity)
+        _draw_incidence(ax, n, t, quantity, x_model, model, to[sel],
+                        reduce_quantity(values[sel], quantity), err)
     if log:
         ax.set_yscale("log")
     ax.set_xlabel("signed θo (degrees; light on the negative side)")
@@ -146,3 +120,43 @@ def plot_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity="rg
     ax.legend(fontsize=6, frameon=False, ncol=2)
     ax.set_title(title or f"model and measurement, plane φ = {phi_deg:g}°", fontsize=9)
     return finish(fig, ax, filename)
+
+
+def _plane_data(table, phi_deg, tol_deg):
+    """theta_i, signed theta_o (degrees), f_r and sigma (or None) of the valid table points
+    in the plane ``phi_deg``."""
+    idx, ti, to = plane_points(table, phi_deg, tol_deg)
+    values = np.asarray(table.values, dtype=np.float64)[idx]
+    valid = np.asarray(table.valid)[idx].all(axis=1)
+    idx, ti, to, values = idx[valid], ti[valid], to[valid], values[valid]
+    if idx.size == 0:
+        raise ValueError(f"table has no valid points in the plane phi = {phi_deg:g} degrees "
+                         f"(tolerance {tol_deg:g} degrees)")
+    sigma = None if table.sigma is None else np.asarray(table.sigma, float)[idx]
+    return ti, to, values, sigma
+
+
+def _reduce_sigma(sigma, quantity):
+    """sigma (n, 3) of f_r reduced to ``quantity``; luminance with independent channels."""
+    if quantity == "luminance":
+        return np.sqrt((sigma ** 2) @ (REC709_WEIGHTS ** 2))
+    return reduce_quantity(sigma, quantity)
+
+
+def _draw_incidence(ax, n, t, quantity, x_model, model, to, meas, err):
+    """Model lines and measured points (``to`` signed theta_o, degrees) of incidence ``t``,
+    the ``n``-th drawn, one per style of ``quantity``."""
+    markers = "osD^v<>"
+    order = np.argsort(to)
+    for k, col, suffix in quantity_styles(quantity):
+        channel = "luminance" if k is None else "rgb"[k]
+        y = model[:, k] if model.ndim == 2 else model
+        line, = ax.plot(x_model, y, color=col, lw=1.0, ls=["-", "--", ":", "-."][n % 4],
+                        label=f"model θi = {t:g}°{suffix}")
+        line.set_gid(f"model theta_i={t:g} {channel}")
+        ym = (meas[:, k] if meas.ndim == 2 else meas)[order]
+        em = None if err is None else (err[:, k] if err.ndim == 2 else err)[order]
+        cont = ax.errorbar(to[order], ym, yerr=em, color=col, ls="",
+                           marker=markers[n % len(markers)], ms=3.5, mfc="none",
+                           capsize=1.5, label=f"data θi = {t:g}°{suffix}")
+        cont.lines[0].set_gid(f"data theta_i={t:g} {channel}")

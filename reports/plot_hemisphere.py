@@ -8,6 +8,8 @@ the warp, +y (up) the weft.
 
 from __future__ import annotations
 
+import matplotlib
+import matplotlib.colors as mcolors
 import numpy as np
 
 from brdf.frames import from_angles
@@ -109,8 +111,6 @@ def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminanc
     if quantity not in ("luminance", "srgb"):
         raise ValueError(f"quantity must be 'luminance' or 'srgb'; got {quantity!r}")
     check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
-    import matplotlib
-    import matplotlib.colors as mcolors
     values = hemisphere_image(brdf, theta_i_deg, phi_i_deg, resolution)
     if cosine:
         _, _, _, wo = equal_area_grid(resolution)

@@ -8,7 +8,10 @@ the weft, 45 = the diagonal). The light sits on the negative side, wi at signed 
 
 from __future__ import annotations
 
+import matplotlib
 import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from brdf.frames import from_angles
 from reports._plotting import (check_angle, eval_brdf, finish, new_axes,
@@ -83,7 +86,6 @@ def _setup_polar(ax, scale, floor, rmax):
         ax.set_yticklabels([f"1e{base + k}" if (len(shown) - 1 - k) % every == 0 else ""
                             for k in shown], fontsize=6)
     else:
-        from matplotlib.ticker import MaxNLocator
         ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
         ax.yaxis.set_major_locator(MaxNLocator(4))
         ax.tick_params(axis="y", labelsize=6)
@@ -141,32 +143,12 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
     if not decades > 0:
         raise ValueError(f"decades must be positive; got {decades}")
     fig, ax = new_axes(ax, projection="polar")
-    import matplotlib
-    styles = quantity_styles(quantity, colour)
     theta_o = np.linspace(-90.0, 90.0, int(resolution))
-    curves = []
-    for ti in thetas:
-        wi, wo = plane_directions(ti, theta_o, phi_deg)
-        f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-        if cosine:
-            f = f * (np.cos(np.radians(theta_o))[:, None] if f.ndim == 2
-                     else np.cos(np.radians(theta_o)))
-        curves.append(f)
+    curves = [_plane_curve(brdf, ti, theta_o, phi_deg, quantity, cosine) for ti in thetas]
     peak = max(float(np.nanmax(c)) if np.any(np.isfinite(c)) else 0.0 for c in curves)
     floor = _log_floor(peak, decades)
-    rmax = 0.0
-    dashes = ["-", "--", ":", "-."]
-    for n, (ti, f) in enumerate(zip(thetas, curves)):
-        for k, col, suffix in styles:
-            y = f[:, k] if f.ndim == 2 else f
-            r = log_radius(y, floor) if scale == "log" else y
-            rmax = max(rmax, float(np.nanmax(r)))
-            ls = dashes[n % len(dashes)] if (len(styles) > 1 or colour is not None) else "-"
-            if k is None and colour is None:
-                col = matplotlib.colormaps["viridis"](0.85 * n / max(len(thetas) - 1, 1))
-            line, = ax.plot(np.radians(theta_o), r, ls=ls, color=col, lw=1.4,
-                            label=f"θi = {ti:g}°{suffix}")
-            line.set_gid(f"lobe theta_i={ti:g} {'luminance' if k is None else 'rgb'[k]}")
+    rmax = _draw_lobes(ax, thetas, theta_o, curves, quantity_styles(quantity, colour), colour,
+                       floor if scale == "log" else None)
     _setup_polar(ax, scale, floor, rmax)
     for ti in thetas:  # incident directions as arrows from the centre
         ax.annotate("", xy=(np.radians(-ti), rmax * 1.0), xytext=(0, 0),
@@ -178,6 +160,36 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
                  fontsize=9)
     ax.legend(fontsize=6, loc="lower left", bbox_to_anchor=(-0.1, -0.15), ncol=2, frameon=False)
     return finish(fig, ax, filename)
+
+
+def _plane_curve(brdf, theta_i_deg, theta_o, phi_deg, quantity, cosine) -> np.ndarray:
+    """f_r (1/sr), reduced to ``quantity``, over signed ``theta_o`` (degrees) in the plane
+    ``phi_deg`` for one incidence; times cos(theta_o) when ``cosine``."""
+    wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
+    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
+    if cosine:
+        f = f * (np.cos(np.radians(theta_o))[:, None] if f.ndim == 2
+                 else np.cos(np.radians(theta_o)))
+    return f
+
+
+def _draw_lobes(ax, thetas, theta_o, curves, styles, colour, floor) -> float:
+    """One line per incidence and style (log radius above ``floor`` unless it is None);
+    return the largest radius drawn."""
+    rmax = 0.0
+    dashes = ["-", "--", ":", "-."]
+    for n, (ti, f) in enumerate(zip(thetas, curves)):
+        for k, col, suffix in styles:
+            y = f[:, k] if f.ndim == 2 else f
+            r = log_radius(y, floor) if floor is not None else y
+            rmax = max(rmax, float(np.nanmax(r)))
+            ls = dashes[n % len(dashes)] if (len(styles) > 1 or colour is not None) else "-"
+            if k is None and colour is None:
+                col = matplotlib.colormaps["viridis"](0.85 * n / max(len(thetas) - 1, 1))
+            line, = ax.plot(np.radians(theta_o), r, ls=ls, color=col, lw=1.4,
+                            label=f"θi = {ti:g}°{suffix}")
+            line.set_gid(f"lobe theta_i={ti:g} {'luminance' if k is None else 'rgb'[k]}")
+    return rmax
 
 
 def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0, 90.0), *,
@@ -202,7 +214,6 @@ def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0,
     (fig, axes)
         axes is a list of PolarAxes, one per plane.
     """
-    from matplotlib.figure import Figure
     planes = list(np.atleast_1d(planes_deg))
     if fig is None:
         fig = Figure(figsize=(4.2 * len(planes), 3.6))
@@ -296,7 +307,6 @@ def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resoluti
     if cosine:
         r = r * np.cos(T)
     X, Y, Z = (r * wo[..., k] for k in range(3))
-    import matplotlib
     norm = matplotlib.colors.Normalize(0.0, max(float(np.nanmax(r)), 1e-12))
     facecolors = matplotlib.colormaps["viridis"](norm(r))
     ax.plot_surface(X, Y, Z, facecolors=facecolors, rstride=1, cstride=1, linewidth=0,

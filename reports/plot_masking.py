@@ -10,20 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import finish, new_axes
+from brdf import terms
+from reports._plotting import eval_brdf, finish, new_axes
+from reports.colour import line_colour, luminance
+from reports.plot_lobes import _log_floor, _setup_polar, log_radius, plane_directions
 
 __all__ = ["plot_masking_lobes", "plot_masking_terms", "masking_terms"]
-
-SIGMA_U_DEG = 20.0
-
-
-def _terms():
-    """brdf.terms when the model package provides it, else None."""
-    try:
-        from brdf import terms
-    except ImportError:
-        return None
-    return terms if hasattr(terms, "u") and hasattr(terms, "pair_weight") else None
 
 
 def masking_terms(angle_deg, pair_with_deg=0.0):
@@ -40,8 +32,8 @@ def masking_terms(angle_deg, pair_with_deg=0.0):
     -------
     dict of numpy.ndarray
         "M": max(cos(angle), 0); "u": u(angle); "pair": pair weight of (angle, pair_with) with
-        difference angle - pair_with. From ``brdf.terms`` when available, else this module's
-        transliteration of MODEL.md.
+        difference angle - pair_with, from :func:`brdf.terms.u` and
+        :func:`brdf.terms.pair_weight`.
 
     Examples
     --------
@@ -54,15 +46,8 @@ def masking_terms(angle_deg, pair_with_deg=0.0):
     m = np.maximum(np.cos(x), 0.0)
     m_other = np.maximum(np.cos(other), 0.0) * np.ones_like(x)
     delta = np.angle(np.exp(1j * (x - other)))  # wrap into (-pi, pi]
-    terms = _terms()
-    if terms is not None:
-        u = np.asarray(terms.u(x), dtype=np.float64)
-        pair = np.asarray(terms.pair_weight(m, m_other, delta), dtype=np.float64)
-    else:
-        sig = np.radians(SIGMA_U_DEG)
-        u = np.exp(-x ** 2 / (2.0 * sig ** 2))
-        ud = np.exp(-delta ** 2 / (2.0 * sig ** 2))
-        pair = (1.0 - ud) * m * m_other + ud * np.minimum(m, m_other)
+    u = np.asarray(terms.u(x), dtype=np.float64)
+    pair = np.asarray(terms.pair_weight(m, m_other, delta), dtype=np.float64)
     return {"M": m, "u": u, "pair": pair}
 
 
@@ -136,9 +121,6 @@ def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", d
                          f"got {type(brdf).__name__}")
     on = replace(masking=True)
     off = replace(masking=False)
-    from reports.plot_lobes import _log_floor, _setup_polar, log_radius, plane_directions
-    from reports._plotting import eval_brdf
-    from reports.colour import luminance, line_colour
     fig, ax = new_axes(ax, projection="polar")
     theta_o = np.linspace(-90.0, 90.0, int(resolution))
     wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)

@@ -7,6 +7,7 @@ import numpy as np
 from analysis.reciprocity import relative_asymmetry
 from brdf.frames import from_angles
 from reports._plotting import eval_brdf, finish, new_axes
+from reports.colour import luminance
 
 __all__ = ["reciprocity_map", "plot_reciprocity_map"]
 
@@ -46,7 +47,6 @@ def reciprocity_map(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45, quantit
     a = eval_brdf(brdf, wi, wo)
     b = eval_brdf(brdf, wo, wi)
     if quantity == "luminance":
-        from reports.colour import luminance
         a, b = luminance(a), luminance(b)
     err = relative_asymmetry(a, b)
     err[(a == 0) & (b == 0)] = 0.0          # both zero: drawn as reciprocal

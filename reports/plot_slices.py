@@ -11,6 +11,8 @@ wi and wo can both graze and the model's value is a limit it reaches only in rou
 
 from __future__ import annotations
 
+import matplotlib
+import matplotlib.colors as mcolors
 import numpy as np
 
 from brdf.frames import from_angles
@@ -189,7 +191,6 @@ def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4
         ``ax.images[0].get_array()`` is the luminance image in 1/sr (rows theta_d from 0 at
         the bottom, columns theta_h), as :func:`slice_image` returns it.
     """
-    import matplotlib.colors as mcolors
     theta, img = slice_image(brdf, phi_d_deg, phi_h_deg, resolution)
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
     peak = float(np.nanmax(img)) if np.any(img > 0) else 1.0
@@ -205,5 +206,4 @@ def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4
 
 
 def _CMAP():
-    import matplotlib
     return matplotlib.colormaps["magma"].with_extremes(bad="black", under="black")

@@ -21,6 +21,7 @@ the mean of its samples; rays that hit nothing give 0.
 
 from __future__ import annotations
 
+import functools
 import multiprocessing
 import os
 import signal
@@ -28,6 +29,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
+import brdf
+from brdf.protocols import BRDF
 from gonio.progress import progress_bar
 from reports.imageio import write_exr, write_png
 from reports.scenes import SCENES, Scene, make_scene
@@ -83,13 +86,11 @@ def resolve_fabric(fabric, **options):
         For an unknown name or an object without ``eval``.
     """
     if isinstance(fabric, str):
-        import brdf
-        presets = tuple(getattr(brdf, "PRESETS", ()))
-        if fabric not in presets:
+        if fabric not in brdf.PRESETS:
             raise ValueError(f"fabric {fabric!r} is unknown; choose one of "
-                             f"{', '.join(presets) if presets else '(no presets available)'}")
+                             f"{', '.join(brdf.PRESETS)}")
         return brdf.fabric(fabric, **options)
-    if not callable(getattr(fabric, "eval", None)):
+    if not isinstance(fabric, BRDF):
         raise ValueError(f"fabric={fabric!r} must be a preset name or have an eval(wi, wo) method")
     if options:
         return fabric.replace(**options)
@@ -167,7 +168,7 @@ def _shade(scene, fabric, o, d, rng):
     if idx.size == 0:
         return out
     rad = np.zeros((idx.size, 3))
-    is_cloth = np.array([getattr(pr, "material", "diffuse") == "cloth" for pr in prims])
+    is_cloth = np.array([pr.material == "cloth" for pr in prims])
     cloth = is_cloth[pid_h[idx]]
     # cloth: BRDF in the local frame (x = warp, y = n x warp, z = n)
     c = idx[cloth]
@@ -185,7 +186,7 @@ def _shade(scene, fabric, o, d, rng):
     dsel = ~cloth
     if dsel.any():
         di = idx[dsel]
-        alb = np.array([getattr(pr, "albedo", 0.5) for pr in prims])[pid_h[di]]
+        alb = np.array([pr.albedo for pr in prims])[pid_h[di]]
         rad[dsel] = (alb / np.pi * cos_i[di])[:, None] * E[di]
     out[hit[idx]] = rad
     return out
@@ -289,11 +290,42 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     True
     """
     check_size(width, height, spp)
+    scene = _scene_of(scene, light, camera)
+    fabric = resolve_fabric(fabric)
+    workers = _check_workers(tile, workers)
+    _probe(fabric)
+    ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
+           "spp": int(spp), "seed": int(seed)}
+    tiles = _tiles(width, height, tile)
+    image = np.zeros((height, width, 3), np.float32)
+    workers = min(workers, len(tiles))
+    new_bar = functools.partial(progress_bar, len(tiles), desc=f"render {scene.name or 'scene'}",
+                                unit="tile", enabled=progress)
+    if workers == 1:
+        with new_bar() as bar:
+            for t in tiles:
+                _paste(image, _render_tile(t, ctx))
+                bar.update()
+    else:
+        _render_pool(image, tiles, ctx, workers, new_bar)
+    return image
+
+
+def _scene_of(scene, light, camera) -> Scene:
+    """The Scene to render: ``scene`` (a name or a Scene) with ``light``/``camera`` replaced."""
     if not isinstance(scene, Scene):
         if not isinstance(scene, str):
             raise ValueError(f"scene={scene!r} must be a scene name or a Scene")
         scene = make_scene(scene)
-    fabric = resolve_fabric(fabric)
+    if light is not None:
+        scene = scene.replace(light=light)
+    if camera is not None:
+        scene = scene.replace(camera=camera)
+    return scene
+
+
+def _check_workers(tile, workers) -> int:
+    """Check ``tile``; return ``workers`` (default: the usable cores), checked."""
     if isinstance(tile, bool) or not isinstance(tile, (int, np.integer)) or tile < 1:
         raise ValueError(f"tile={tile!r} must be a positive integer")
     if workers is None:
@@ -303,32 +335,26 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
             workers = os.cpu_count() or 1
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
         raise ValueError(f"workers={workers!r} must be a positive integer")
-    if light is not None:
-        scene = scene.replace(light=light)
-    if camera is not None:
-        scene = scene.replace(camera=camera)
-    # one tiny evaluation: a broken BRDF fails now, not after the pool starts
+    return workers
+
+
+def _probe(fabric) -> None:
+    """One tiny evaluation: a broken BRDF fails now, not after the pool starts."""
     z = np.array([[0.0, 0.0, 1.0]])
     probe = np.asarray(fabric.eval(z, z))
     if probe.shape != (1, 3):
         raise ValueError(f"fabric.eval returned shape {probe.shape} for one pair; (1, 3) expected")
 
-    ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
-           "spp": int(spp), "seed": int(seed)}
-    tiles = _tiles(width, height, tile)
-    image = np.zeros((height, width, 3), np.float32)
-    workers = min(workers, len(tiles))
-    def new_bar():
-        return progress_bar(len(tiles), desc=f"render {scene.name or 'scene'}", unit="tile",
-                            enabled=progress)
 
-    if workers == 1:
-        with new_bar() as bar:
-            for t in tiles:
-                (_, y0, y1, x0, x1), img = _render_tile(t, ctx)
-                image[y0:y1, x0:x1] = img
-                bar.update()
-        return image
+def _paste(image, done) -> None:
+    """Put a rendered tile ``((index, y0, y1, x0, x1), pixels)`` into ``image``."""
+    (_, y0, y1, x0, x1), img = done
+    image[y0:y1, x0:x1] = img
+
+
+def _render_pool(image, tiles, ctx, workers, new_bar) -> None:
+    """Render ``tiles`` in ``workers`` processes into ``image``; ``new_bar()`` makes the
+    progress bar, once the workers are started."""
     # fork (where available) shares the scene and fabric without pickling; the workers are
     # started by the first submit, before this process starts any thread of its own (tqdm)
     methods = multiprocessing.get_all_start_methods()
@@ -339,9 +365,7 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
         futures = [pool.submit(_render_tile, t) for t in tiles]
         with new_bar() as bar:
             for fut in as_completed(futures):
-                (_, y0, y1, x0, x1), img = fut.result()
-                image[y0:y1, x0:x1] = img
+                _paste(image, fut.result())
                 bar.update()
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
-    return image

@@ -14,6 +14,8 @@ import json
 import shutil
 from pathlib import Path
 
+from analysis.fit.results import read_results
+
 __all__ = ["read_measured", "measured_page", "PLOTS"]
 
 #: The figures of a fit, in page order, with captions.
@@ -41,7 +43,6 @@ def read_measured(folder) -> dict:
     ValueError
         The folder holds no readable ``measured.json`` (the message names it).
     """
-    from analysis.fit.results import read_results
     folder = Path(folder)
     path = folder / "measured.json"
     try:

@@ -115,17 +115,6 @@ def test_usage_errors_exit_2(capsys, args):
     assert "\n" not in capsys.readouterr().err.strip()
 
 
-def test_missing_writer_is_a_clear_error(tmp_path, monkeypatch, capsys):
-    monkeypatch.delattr(gonio, "write", raising=False)
-    import sys
-    monkeypatch.setitem(sys.modules, "gonio.io", None)       # as if gonio/io.py were absent
-    status = main(["measure", "velvet", "--geometry", "plane:warp:45:0",
-                   "-o", str(tmp_path / "t.exr")])
-    err = capsys.readouterr().err
-    assert status == 1 and "needs gonio.write" in err
-    assert not (tmp_path / "t.exr").exists()
-
-
 def test_missing_output_folder(tmp_path, written, capsys):
     status = main(["measure", "velvet", "-o", str(tmp_path / "nope" / "t.exr")])
     assert status == 1 and "output folder does not exist" in capsys.readouterr().err

@@ -12,6 +12,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import brdf  # noqa: E402
+from analysis import AlbedoResult  # noqa: E402
 from gonio import Table  # noqa: E402
 from reports import plots  # noqa: E402
 from reports_standin import Lambert, Phongish  # noqa: E402
@@ -223,10 +224,9 @@ def test_albedo_from_arrays_and_results():
     val = np.array([[0.5, 0.6, 0.7], [0.4, 0.5, 0.6], [0.3, 0.2, 1.1]])
     err = np.full((3, 3), 0.01)
 
-    class Result:
-        value, error = val, err
-
-    fig, ax = plots.plot_albedo(theta, Result())
+    result = AlbedoResult(value=val, error=err, direction=np.zeros((3, 3)), swap=False,
+                          method="threads", evals=0, level=np.zeros(3, int))
+    fig, ax = plots.plot_albedo(theta, result)
     lines = lines_by_gid(ax)
     for k, c in enumerate("rgb"):
         assert np.allclose(lines[f"albedo albedo {c}"].get_ydata(), val[:, k])

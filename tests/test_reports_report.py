@@ -11,8 +11,11 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
+from analysis import EnergyReport  # noqa: E402
+from analysis.sanity import edge_pairs  # noqa: E402
 from reports import report as rep  # noqa: E402
-from reports_standin import Phongish  # noqa: E402
+from reports.report import sec_energy, sec_renders  # noqa: E402
+from reports_standin import Lambert, Phongish  # noqa: E402
 
 FABRICS = ["velvet", "silk_crepe_de_chine"]
 
@@ -38,25 +41,27 @@ def parse(path: Path) -> _Links:
     return p
 
 
-class FakeCurve:
-    def __init__(self, theta, phi):
-        t = np.radians(np.asarray(theta))[:, None, None]
-        self.value = np.broadcast_to(0.5 * np.cos(t) * np.array([1.0, 0.8, 0.6]),
-                                     (len(theta), len(phi), 3)).copy()
-        self.error = np.full_like(self.value, 1e-3)
+def fake_energy_report(calls):
+    """energy_report with the curves 0.5 cos(theta) (1, 0.8, 0.6), error 1e-3."""
+    def energy_report(presets, variants, *, theta_deg, phi_deg, **kw):
+        calls.append("albedo")
+        t = np.radians(np.asarray(theta_deg))[:, None, None]
+        value = np.broadcast_to(0.5 * np.cos(t) * np.array([1.0, 0.8, 0.6]),
+                                (len(theta_deg), len(phi_deg), 3)).copy()
+        curve = {"preset": presets[0], "variant": variants[0], "mode": "furnace",
+                 "value": value.tolist(), "error": np.full_like(value, 1e-3).tolist()}
+        return EnergyReport(settings={}, curves=[curve], hemispherical=[], furnace=[],
+                            statements=[], seconds=0.0)
+    return energy_report
 
 
 def fake_providers(monkeypatch, calls):
-    def albedo_curve(fab, theta, phi):
-        calls.append("albedo")
-        return FakeCurve(theta, phi)
-
     def render(scene, fab, width, height, spp, progress):
         calls.append(("render", scene, getattr(fab, "options", {}).get("masking")))
         return np.full((height, width, 3), 0.25, dtype=np.float32)
 
-    table = {("analysis", "albedo_curve"): albedo_curve, ("reports.render", "render"): render}
-    monkeypatch.setattr(rep, "_optional", lambda m, a: table.get((m, a)))
+    monkeypatch.setattr(sec_energy, "energy_report", fake_energy_report(calls))
+    monkeypatch.setattr(sec_renders, "render", render)
 
 
 @pytest.fixture(scope="module")
@@ -112,20 +117,49 @@ def test_report_data_and_no_leftovers(built):
     assert leftovers == []
 
 
-def test_absent_providers_say_not_available(tmp_path, monkeypatch):
-    monkeypatch.setattr(rep, "_optional", lambda m, a: None)
-    fab = Phongish()
-    index = rep.build_report({"standin": fab}, tmp_path / "rep", quality="fast", progress=False,
-                             sections=["energy", "renders", "parameters"])
+def test_sanity_section_shows_the_scan_per_fabric(built):
+    out, _, _ = built
+    summary = json.loads((out / "summary.json").read_text())
+    directions = list(edge_pairs())
+    for name in FABRICS:
+        page = parse(out / f"{name}.html")
+        assert ("sanity", "report-section", name) in page.sections
+        text = (out / f"{name}.html").read_text()
+        sec = text[text.index('<section id="sanity"'):]
+        sec = sec[:sec.index("</section>")]
+        head = sec[sec.index("<thead>"):sec.index("</thead>")]
+        assert all(f"<th>{d}</th>" in head for d in directions)
+        rows = sec[sec.index("<tbody>"):sec.index("</tbody>")].split("<tr>")[1:]
+        cells = [r.split("<td>")[1:] for r in rows]
+        assert cells[0][0].startswith("as_given")
+        assert all(len(c) == 1 + len(directions) for c in cells)
+        checks = json.loads((out / name / "sanity.json").read_text())["checks"]
+        assert len(checks) == len(rows) * len(directions)
+        s = summary["fabrics"][name]["sanity"]
+        assert s["n_checks"] == len(checks) and s["ok"] == all(
+            c[1:] == ["ok</td>"] * (len(c) - 2) + ["ok</td></tr>"] for c in cells)
+        assert s["ok"]                                   # the presets pass (microcyl sanity)
+    assert "Sanity compared" in (out / "index.html").read_text()
+
+
+def test_a_brdf_that_is_no_preset_gets_its_albedo_and_says_what_is_not_available(tmp_path):
+    index = rep.build_report({"standin": Lambert()}, tmp_path / "rep", quality="fast",
+                             progress=False,
+                             sections=["energy", "renders", "parameters", "masking", "fit"])
     page = (tmp_path / "rep" / "standin.html").read_text()
-    assert page.count("Not available") == 2
-    assert "albedo" in page and "reports.render" in page
+    assert page.count("Not available") == 2          # masking (no replace) and fit
+    assert "replace(masking" in page and "results.json" in page
     assert "Albedo compared" in index.read_text()
     assert (tmp_path / "rep" / "standin" / "parameters.json").is_file()
+    energy = json.loads((tmp_path / "rep" / "summary.json").read_text())[
+        "fabrics"]["standin"]["energy"]
+    # a Lambertian surface of albedo A reflects exactly A in every direction
+    assert energy["max"] == pytest.approx(0.5, abs=1e-3)
+    assert np.asarray(energy["value"]) == pytest.approx(
+        np.broadcast_to([0.5, 0.4, 0.3], (3, 2, 3)), abs=1e-3)
 
 
 def test_rerun_replaces_a_report_but_never_another_folder(tmp_path, monkeypatch):
-    monkeypatch.setattr(rep, "_optional", lambda m, a: None)
     kw = dict(quality="fast", progress=False, sections=["parameters"])
     out = tmp_path / "rep"
     rep.build_report({"a": Phongish()}, out, **kw)
@@ -140,12 +174,10 @@ def test_rerun_replaces_a_report_but_never_another_folder(tmp_path, monkeypatch)
 
 
 def test_interrupted_report_leaves_nothing(tmp_path, monkeypatch):
-    monkeypatch.setattr(rep, "_optional", lambda m, a: None)
-
     def boom(page):
         raise KeyboardInterrupt
 
-    monkeypatch.setitem(rep._BUILDERS, "reciprocity", boom)
+    monkeypatch.setitem(rep.BUILDERS, "reciprocity", boom)
     with pytest.raises(KeyboardInterrupt):
         rep.build_report({"a": Phongish(), "b": Phongish()}, tmp_path / "rep", quality="fast",
                          progress=False, sections=["parameters", "reciprocity"])

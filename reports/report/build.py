@@ -1,0 +1,217 @@
+"""``build_report``: every fabric's page, the overview and summary.json, swapped in whole."""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import brdf
+from gonio.atomic import file_mode
+from gonio.progress import progress_bar
+from reports.report.folder import MARKER, check_output_dir, swap_into_place, write_file
+from reports.report.markup import nav, now, page, plain_json, swatch
+from reports.report.overview import overview
+from reports.report.page import Page
+from reports.report.sections import FabricReport, run_section
+from reports.report.settings import QUALITIES, SECTIONS, TITLES
+from reports.report_measured import measured_page, overview_table, read_measured
+
+__all__ = ["build_report", "resolve_fabrics"]
+
+_RESERVED = ("index", "overview", "summary")
+
+
+def _items(fabrics) -> list:
+    if fabrics is None:
+        fabrics = tuple(brdf.PRESETS)
+    if isinstance(fabrics, str):
+        fabrics = (fabrics,)
+    if isinstance(fabrics, dict):
+        return list(fabrics.items())
+    items = []
+    for f in fabrics:
+        if isinstance(f, str):
+            items.append((f, None))
+        elif isinstance(f, tuple) and len(f) == 2:
+            items.append(f)
+        else:
+            raise ValueError(f"fabrics must hold preset names or (name, BRDF) pairs; "
+                             f"got {f!r}")
+    return items
+
+
+def resolve_fabrics(fabrics) -> dict:
+    """Name -> BRDF, or None for a preset given by name; see :func:`build_report`.
+
+    Raises
+    ------
+    ValueError
+        For an empty selection, an unknown preset, a name given twice, or a name that cannot
+        name a page.
+    """
+    items = _items(fabrics)
+    if not items:
+        raise ValueError("fabrics is empty; give at least one of " + ", ".join(brdf.PRESETS))
+    out = {}
+    for name, fab in items:
+        if not isinstance(name, str) or not name or "/" in name or name.startswith(".") \
+                or name in _RESERVED:
+            raise ValueError(f"fabric name {name!r} cannot name a report page")
+        if fab is None and name not in brdf.PRESETS:
+            raise ValueError(f"unknown fabric {name!r}; valid: {', '.join(brdf.PRESETS)}")
+        if name in out:
+            raise ValueError(f"fabric {name!r} is given twice")
+        out[name] = fab
+    return out
+
+
+def _sections(sections) -> list[str]:
+    sections = list(dict.fromkeys(SECTIONS if sections is None else sections))
+    bad = [s for s in sections if s not in SECTIONS]
+    if bad:
+        raise ValueError(f"unknown section {bad[0]!r}; valid: {', '.join(SECTIONS)}")
+    return [s for s in SECTIONS if s in sections]
+
+
+def _fabric_page(tmp: Path, name: str, given, sections, q, fit_results, bar) -> FabricReport:
+    """Build every section of one fabric; return what was built (the page is not written)."""
+    fab = given if given is not None else brdf.fabric(name)
+    rep = FabricReport(name, fab)
+    pg = Page(tmp, name, fab, q, preset=name if given is None else None,
+              fit_results=fit_results.get(name))
+    for sec in sections:
+        bar.set_description(f"{name}: {sec}")
+        rep.runs.append(run_section(sec, pg))
+        bar.update(1)
+    return rep
+
+
+def _fabric_html(rep: FabricReport) -> str:
+    return (f"<p>{swatch(rep.fabric)}Fabric <b>{html.escape(rep.name)}</b>.</p>"
+            + "".join(r.html(rep.name) for r in rep.runs))
+
+
+def _index_fabrics(reports: list[FabricReport]) -> str:
+    return "".join(
+        f'<section class="fabric" id="fabric-{html.escape(r.name)}"><h2>{swatch(r.fabric)}'
+        f'<a href="{html.escape(r.name)}.html">{html.escape(r.name)}</a></h2><ul>'
+        + "".join(f"<li>{html.escape(TITLES[s.name])}: {html.escape(s.status)}</li>"
+                  for s in r.runs)
+        + "</ul></section>" for r in reports)
+
+
+def _measured(tmp: Path, title: str, names, measured_fits) -> tuple[str, dict]:
+    """Write measured.html; return the overview's section on it and the summary's entry."""
+    mbody, summary = measured_page(tmp, measured_fits)
+    write_file(tmp / "measured.html", page(f"{title}: fits to measured data",
+                                           nav(names, "measured", True), mbody))
+    return ('<section id="measured-fits"><h2>Fits to measured data</h2>'
+            + overview_table(measured_fits)
+            + '<p>Details: <a href="measured.html">measured.html</a>.</p></section>'), summary
+
+
+def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,
+           measured_fits, title: str, progress: bool) -> None:
+    """Write the whole report into ``tmp``."""
+    t_start = time.perf_counter()
+    q = QUALITIES[quality]
+    names = list(resolved)
+    has_measured = measured_fits is not None
+    bar = progress_bar(len(names) * len(sections) + 1, desc="report", unit="section",
+                       enabled=progress)
+    reports = []
+    for name, given in resolved.items():
+        rep = _fabric_page(tmp, name, given, sections, q, fit_results, bar)
+        reports.append(rep)
+        write_file(tmp / f"{name}.html", page(f"{title}: {name}",
+                                              nav(names, name, has_measured), _fabric_html(rep)))
+    bar.set_description("overview")
+    body = overview(tmp, reports, sections, q)
+    measured_summary = None
+    if has_measured:
+        section, measured_summary = _measured(tmp, title, names, measured_fits)
+        body += section
+    write_file(tmp / "index.html", page(title, nav(names, None, has_measured),
+                                        body + _index_fabrics(reports)))
+    bar.update(1)
+    bar.close()
+    doc = {"title": title, "generated": now(), "quality": quality, "sections": sections,
+           "fabrics": {r.name: r.summary() for r in reports},
+           "seconds": round(time.perf_counter() - t_start, 2)}
+    if measured_summary is not None:
+        doc["measured"] = measured_summary
+    write_file(tmp / "summary.json", json.dumps(plain_json(doc), indent=1))
+    write_file(tmp / MARKER, "microcyl report folder: replaced whole by the next run\n")
+
+
+def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True,
+                 quality="default", fit_results=None, measured=None,
+                 title="microcyl report") -> Path:
+    """Write the HTML report on ``fabrics`` to ``out_dir``; return the path of index.html.
+
+    Parameters
+    ----------
+    fabrics : str, sequence or mapping, optional
+        Preset names (default every name in ``brdf.PRESETS``), or (name, BRDF) pairs, or a
+        mapping name -> BRDF (any object with ``.eval``; presets are made with default
+        options when only a name is given).
+    out_dir : str or path
+        Output folder. Replaced as a whole at the end if it already holds a report written
+        by this function; an existing folder that is not a report is never touched.
+    sections : sequence of str, optional
+        Per-fabric sections, a subset of :data:`SECTIONS` (default all), in any order.
+    progress : bool
+        Show a tqdm bar over fabrics and sections.
+    quality : {"default", "fast"}
+        Resolutions of plots and renders (:data:`QUALITIES`).
+    fit_results : mapping of str to path, optional
+        Fabric name -> ``results.json`` of a fit, shown in the "fit" section.
+    measured : path, optional
+        Output folder of ``microcyl fit-measured``: adds the page ``measured.html`` (fits to
+        the measured felts and CUReT fabrics) and its table on the overview.
+    title : str
+        Title of the overview page.
+
+    Returns
+    -------
+    pathlib.Path
+        ``out_dir/index.html``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown fabric, section or quality, or an output folder that is not a report;
+        raised before any work.
+    OSError
+        If the output folder cannot be written; raised before any work.
+
+    Notes
+    -----
+    Built in a temporary folder beside ``out_dir`` and renamed into place at the end; a
+    failure or interrupt removes the temporary folder and leaves ``out_dir`` as it was.
+    """
+    if quality not in QUALITIES:
+        raise ValueError(f"quality must be one of {', '.join(QUALITIES)}; got {quality!r}")
+    sections = _sections(sections)
+    resolved = resolve_fabrics(fabrics)
+    measured_fits = read_measured(measured) if measured is not None else None
+    out = check_output_dir(out_dir)
+    fits = {str(k): v for k, v in dict(fit_results or {}).items()}
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
+    except OSError as exc:
+        raise OSError(f"output folder {out.parent} is not writable: {exc.strerror or exc}") \
+            from None
+    try:
+        os.chmod(tmp, file_mode(0o777))
+        _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress)
+        swap_into_place(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out / "index.html"

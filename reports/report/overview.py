@@ -1,0 +1,127 @@
+"""The overview page (index.html): fabrics, lobes and albedo compared, masking terms,
+reciprocity and sanity compared."""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import numpy as np
+
+from reports.plot_albedo import plot_albedo
+from reports.plot_lobes import plot_lobe_comparison
+from reports.plot_masking import plot_masking_terms
+from reports.report.markup import fmt, swatch, table
+from reports.report.page import Page, new_figure
+from reports.report.sec_energy import EnergyData
+from reports.report.sec_parameters import THREAD_FIELDS, THREAD_HEADER, parameters_of
+from reports.report.sec_reciprocity import ReciprocityData
+from reports.report.sec_sanity import SanityData
+from reports.report.sections import FabricReport
+
+__all__ = ["overview"]
+
+
+def _fabrics(reports: list[FabricReport]) -> str:
+    rows = []
+    for r in reports:
+        params = parameters_of(r.fabric)
+        for j, t in enumerate(params["threads"]):
+            rows.append([r.name if j == 0 else "", f"T{j + 1}"] +
+                        [fmt(t[f]) for f in THREAD_FIELDS])
+        if not params["threads"]:
+            rows.append([r.name, "n/a"] + [""] * len(THREAD_FIELDS))
+    links = "".join(f'<li>{swatch(r.fabric)}<a href="{html.escape(r.name)}.html">'
+                    f'{html.escape(r.name)}</a></li>' for r in reports)
+    return ('<section id="overview"><h2>Fabrics</h2>'
+            + table(["fabric", "thread", *THREAD_HEADER], rows)
+            + f"<ul>{links}</ul></section>")
+
+
+def _lobes(p: Page, reports: list[FabricReport]) -> str:
+    fabrics = {r.name: r.fabric for r in reports}
+    out = ['<section id="combined-lobes"><h2>Lobes compared</h2>']
+    for ti, phi in ((30.0, 0.0), (60.0, 0.0), (60.0, 90.0)):
+        fig, ax = plot_lobe_comparison(fabrics, ti, phi, resolution=p.q["lobe"])
+        out.append(p.figure(fig, f"lobes_ti{ti:g}_phi{phi:g}.png",
+                            f"Luminance f_r (1/sr, log) of every fabric, θi = {ti:g}°, plane "
+                            f"φ = {phi:g}°; each curve in the fabric's own sRGB colour."))
+    return "".join(out) + "</section>"
+
+
+def _albedo(p: Page, reports: list[FabricReport]) -> str:
+    have = {r.name: e for r in reports if (e := r.data(EnergyData)) is not None}
+    out = ['<section id="albedo-comparison"><h2>Albedo compared</h2>']
+    if not have:
+        out.append('<p class="na">Not available: no fabric has energy results (the energy '
+                   'section was not requested).</p></section>')
+        return "".join(out)
+    fig, axes = new_figure(2, 1, figsize=(11.0, 4.0))
+    for j, (ax, phi) in enumerate(zip(axes, (0.0, 90.0))):
+        for name, e in have.items():
+            plot_albedo(e.theta_deg, np.asarray(e.value)[:, j], np.asarray(e.error)[:, j],
+                        quantity="luminance", colour=e.colour, label=name, ax=ax,
+                        title=f"luminance albedo, wo at φ = {phi:g}°")
+    out.append(p.figure(fig, "albedo_comparison.png", "Rec. 709 luminance of the "
+                        "directional albedo of every fabric, against θo, wo along the warp "
+                        "(left) and the weft (right), each in the fabric's own colour."))
+    rows = [[n, f"{e.max:.4f}", f"{e.max_error:.1e}", f"{e.max_where[0]:g}",
+             f"{e.max_where[1]:g}", e.max_where[2], "yes" if e.exceeds_one else "no"]
+            for n, e in have.items()]
+    out.append(table(["fabric", "max albedo", "error", "θ (deg)", "φ (deg)", "channel",
+                      "exceeds 1"], rows))
+    return "".join(out) + "</section>"
+
+
+def _masking(p: Page) -> str:
+    fig, ax = plot_masking_terms(resolution=max(p.q["lobe"], 61))
+    return ('<section id="masking"><h2>Shadowing, masking and reweighting terms</h2>'
+            + p.figure(fig, "masking_terms.png", "M(φ) = max(cos φ, 0) (and P(ψ), the same "
+                       "form), the blend u with σu = 20°, and the paired weight M(wi, wo) "
+                       "against φo for φi = 0°, 30°, 60° (MODEL.md).")
+            + "</section>")
+
+
+def _reciprocity(reports: list[FabricReport]) -> str:
+    recs = {r.name: d.maps for r in reports if (d := r.data(ReciprocityData)) is not None}
+    if not recs:
+        return ""
+    return ('<section id="reciprocity-comparison"><h2>Reciprocity compared</h2>'
+            + table(["fabric", "warp plane median", "warp plane max", "weft plane median",
+                     "weft plane max"],
+                    [[n, f"{r['warp']['median']:.3g}", f"{r['warp']['max']:.3g}",
+                      f"{r['weft']['median']:.3g}", f"{r['weft']['max']:.3g}"]
+                     for n, r in recs.items()])
+            + "</section>")
+
+
+def _sanity(reports: list[FabricReport]) -> str:
+    have = {r.name: d for r in reports if (d := r.data(SanityData)) is not None}
+    if not have:
+        return ""
+    rows = [[n, len(d.result.checks), sum(c["n"] for c in d.result.checks), d.n_failing,
+             "yes" if d.result.ok else "no"] for n, d in have.items()]
+    return ('<section id="sanity-comparison"><h2>Sanity compared</h2>'
+            + table(["fabric", "checks", "evaluations", "failing", "all pass"], rows)
+            + "</section>")
+
+
+def overview(root: Path, reports: list[FabricReport], sections, q: dict) -> str:
+    """The body of index.html; its figures go to ``root/overview``.
+
+    Parameters
+    ----------
+    root : Path
+        The (temporary) report folder.
+    reports : list of FabricReport
+        Every fabric as built, in page order.
+    sections : sequence of str
+        The per-fabric sections requested.
+    q : dict
+        Resolutions (a value of :data:`reports.report.QUALITIES`).
+    """
+    p = Page(root, "overview", None, q)
+    return (_fabrics(reports) + _lobes(p, reports) + _albedo(p, reports) + _masking(p)
+            + _reciprocity(reports) + _sanity(reports)
+            + f"<p>Sections per fabric: {html.escape(', '.join(sections))}. "
+            f'Data: <a href="summary.json">summary.json</a>.</p>')

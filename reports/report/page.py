@@ -1,0 +1,104 @@
+"""Where a section writes: its fabric's folder of figures and data files."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import html
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+from reports._plotting import save_figure
+from reports.report.folder import write_file
+from reports.report.markup import plain_json
+
+__all__ = ["Page", "new_figure", "replace_3d"]
+
+
+@dataclasses.dataclass
+class Page:
+    """One fabric's page, as its sections see it.
+
+    Attributes
+    ----------
+    root : Path
+        The (temporary) report folder.
+    folder : str
+        Sub-folder of ``root`` for this page's files.
+    fabric : object
+        The BRDF shown.
+    q : dict
+        Resolutions (a value of :data:`reports.report.QUALITIES`).
+    preset : str or None
+        The preset name when ``fabric`` is that preset with default options, else None.
+    fit_results : path or None
+        ``results.json`` of a fit of this fabric.
+    """
+
+    root: Path
+    folder: str
+    fabric: Any
+    q: dict
+    preset: str | None = None
+    fit_results: Any = None
+
+    def path(self, filename: str) -> Path:
+        """The path of ``filename`` in the page's folder (created)."""
+        d = self.root / self.folder
+        d.mkdir(exist_ok=True)
+        return d / filename
+
+    def rel(self, filename: str) -> str:
+        """``filename``'s link relative to the report folder."""
+        return f"{self.folder}/{filename}"
+
+    def figure(self, fig, filename: str, caption: str) -> str:
+        """Save ``fig`` atomically beside the page, close it, return its <figure> HTML."""
+        try:
+            save_figure(fig, self.path(filename), dpi=self.q["dpi"])
+        finally:
+            _close(fig)
+        return (f'<figure><img src="{html.escape(self.rel(filename))}" '
+                f'alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}'
+                f'</figcaption></figure>')
+
+    def json(self, filename: str, data) -> str:
+        """Write ``data`` as strict JSON beside the page, return a link to it."""
+        write_file(self.path(filename), json.dumps(plain_json(data), indent=1))
+        return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
+
+    def csv(self, filename: str, header: list[str], rows) -> str:
+        """Write ``rows`` as CSV (floats to 9 digits) beside the page, return a link to it."""
+        buf = io.StringIO()
+        w = csv.writer(buf)
+        w.writerow(header)
+        for row in rows:
+            w.writerow([f"{v:.9g}" if isinstance(v, (float, np.floating)) else v for v in row])
+        write_file(self.path(filename), buf.getvalue())
+        return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
+
+
+def _close(fig):
+    if plt.fignum_exists(getattr(fig, "number", -1)):
+        plt.close(fig)
+
+
+def new_figure(ncols=1, nrows=1, figsize=None, polar=False, **kw):
+    """A constrained-layout Figure (not registered with pyplot) and its list of axes."""
+    fig = Figure(figsize=figsize or (4.6 * ncols, 3.8 * nrows), layout="constrained")
+    axes = [fig.add_subplot(nrows, ncols, k + 1, projection="polar" if polar else None, **kw)
+            for k in range(ncols * nrows)]
+    return fig, axes
+
+
+def replace_3d(fig, ax):
+    """Replace ``ax`` in ``fig`` by a 3-D axes in the same place; return it."""
+    spec = ax.get_subplotspec()
+    ax.remove()
+    return fig.add_subplot(spec, projection="3d")

@@ -1,0 +1,145 @@
+"""The figure-only sections: lobes, slices, hemisphere and 3-D lobe, shadowing and masking."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reports._plotting import eval_brdf
+from reports.colour import luminance
+from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
+from reports.plot_lobes import plane_directions, plot_lobe_3d, plot_lobe_planes
+from reports.plot_masking import plot_masking_lobes
+from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
+                                 plot_slice_theta_o)
+from reports.report.page import Page, new_figure, replace_3d
+from reports.report.settings import Section, Unavailable
+
+__all__ = ["can_unmask", "section_lobes", "section_slices", "section_hemisphere",
+           "section_masking", "PLANES"]
+
+#: Incidence angles of the lobe plots, degrees.
+LOBE_THETAS = (0.0, 30.0, 60.0)
+#: Planes of the lobe plots: azimuth from the warp, degrees.
+PLANES = (0.0, 45.0, 90.0)
+
+
+def can_unmask(fab) -> bool:
+    """Whether ``fab.replace(masking=False)`` gives the BRDF with masking switched off.
+
+    A :class:`brdf.Fabric` can; so can a user's model with such a ``replace`` (the brdf
+    contract has no Protocol for it, so this is tried).
+    """
+    replace = getattr(fab, "replace", None)
+    if not callable(replace):
+        return False
+    try:
+        replace(masking=False)
+    except TypeError:
+        return False
+    return True
+
+
+def _lobes_csv(p: Page) -> str:
+    """f_r (1/sr) per channel and luminance in every plane and incidence, as lobes.csv."""
+    theta_o = np.linspace(-90.0, 90.0, p.q["lobe"])
+    cols, header = [theta_o], ["theta_o_deg"]
+    for phi in PLANES:
+        for ti in LOBE_THETAS:
+            wi, wo = plane_directions(ti, theta_o, phi)
+            f = eval_brdf(p.fabric, wi, wo)
+            for k, c in enumerate("rgb"):
+                cols.append(f[:, k])
+                header.append(f"f_{c}_phi{phi:g}_ti{ti:g}")
+            cols.append(luminance(f))
+            header.append(f"f_Y_phi{phi:g}_ti{ti:g}")
+    return p.csv("lobes.csv", header, np.stack(cols, axis=1))
+
+
+def section_lobes(p: Page) -> Section:
+    """Polar lobes in the warp, diagonal and weft planes, linear, log and per channel."""
+    out = []
+    for scale in ("linear", "log"):
+        fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale=scale,
+                                  resolution=p.q["lobe"])
+        out.append(p.figure(fig, f"lobes_{scale}.png",
+                            f"Luminance f_r (1/sr, {scale}) in the planes φ = 0° (warp), 45° and "
+                            f"90° (weft), for θi = 0°, 30°, 60°."))
+    fig, _ = plot_lobe_planes(p.fabric, (30.0, 60.0), PLANES, quantity="rgb", scale="linear",
+                              resolution=p.q["lobe"])
+    out.append(p.figure(fig, "lobes_rgb.png", "f_r per channel (red, green, blue curves), "
+                        "linear, θi = 30° (solid) and 60° (dashed)."))
+    link = _lobes_csv(p)
+    return Section("".join(out) + f"<p>Data (f_r in 1/sr, signed θo in degrees): {link}</p>")
+
+
+def section_slices(p: Page) -> Section:
+    """Cartesian slices against θo, θh and θd, and θh × θd images (BRDF Explorer)."""
+    fig, axes = new_figure(3, 1, figsize=(14.0, 3.8))
+    plot_slice_theta_o(p.fabric, 30.0, 180.0, 0.0, resolution=p.q["lobe"], ax=axes[0], log=True)
+    plot_slice_theta_h(p.fabric, 10.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[1])
+    plot_slice_theta_d(p.fabric, 0.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[2])
+    out = [p.figure(fig, "slices.png", "Cartesian slices, per channel in red, green and blue: "
+                    "f_r against θo (θi = 30°, light on the −x side, view in the warp plane); "
+                    "against θh (θd = 10°, φd = 90°, φh = 0); against θd (θh = 0, φd = 90°).")]
+    fig, axes = new_figure(2, 1, figsize=(10.0, 4.0))
+    for ax, phi_h in zip(axes, (0.0, 90.0)):
+        plot_slice_image(p.fabric, 90.0, phi_h, resolution=p.q["image"], ax=ax)
+    out.append(p.figure(fig, "slice_image.png", "Luminance f_r (1/sr, log) over θh × θd at "
+                        "φd = 90°, with the half vector in the warp plane (φh = 0) and the weft "
+                        "plane (φh = 90°)."))
+    return Section("".join(out))
+
+
+def _colour_and_lobe3d(p: Page) -> str:
+    """The sRGB colour of f_r(wo) at θi = 45° beside the 3-D lobe."""
+    img = hemisphere_image(p.fabric, 45.0, 0.0, p.q["hemi"])
+    peak = float(np.nanmax(luminance(img))) if np.any(np.isfinite(img)) else 0.0
+    exposure = float(np.log2(0.7 / peak)) if peak > 0 else 0.0
+    fig, axes = new_figure(2, 1, figsize=(10.0, 4.2))
+    plot_hemisphere(p.fabric, 45.0, 0.0, quantity="srgb", exposure=exposure,
+                    resolution=p.q["hemi"], ax=axes[0],
+                    title=f"f_r(wo) colour, sRGB, exposure {exposure:+.1f} stops")
+    plot_lobe_3d(p.fabric, 45.0, 0.0, resolution=p.q["lobe3d"], ax=replace_3d(fig, axes[1]))
+    return p.figure(fig, "lobe3d.png", "Left: the colour of f_r(wo) (θi = 45°, φi = 0), "
+                    "linear RGB encoded to sRGB by colour-science, exposure set so the "
+                    "peak luminance shows at 0.7. Right: the 3-D lobe, radius = luminance "
+                    "f_r cos θo (1/sr).")
+
+
+def section_hemisphere(p: Page) -> Section:
+    """f_r over the viewing hemisphere for three lights, its colour, and the 3-D lobe."""
+    fig, axes = new_figure(3, 1, figsize=(15.0, 4.2))
+    plot_hemisphere(p.fabric, 45.0, 0.0, resolution=p.q["hemi"], ax=axes[0])
+    plot_hemisphere(p.fabric, 45.0, 90.0, resolution=p.q["hemi"], ax=axes[1])
+    plot_hemisphere(p.fabric, 60.0, 45.0, resolution=p.q["hemi"], ax=axes[2])
+    out = [p.figure(fig, "hemisphere.png", "Luminance f_r(wo) (1/sr, log colour scale) over "
+                    "the viewing hemisphere, equal-area projection (+x warp, +y weft), for the "
+                    "light at θi = 45° along the warp, 45° along the weft, and 60° at φ = 45°.")]
+    out.append(_colour_and_lobe3d(p))
+    return Section("".join(out))
+
+
+def section_masking(p: Page) -> Section:
+    """Lobes with shadowing and masking on and off, at θi = 60° and 80°.
+
+    Raises
+    ------
+    Unavailable
+        For a BRDF without ``replace(masking=False)`` (a measured table, a user's model).
+    """
+    if not can_unmask(p.fabric):
+        raise Unavailable("this BRDF has no replace(masking=...)")
+    fig, axes = new_figure(3, 1, figsize=(13.0, 3.8), polar=True)
+    for ax, phi in zip(axes, PLANES):
+        plot_masking_lobes(p.fabric, 60.0, phi, resolution=p.q["lobe"], ax=ax)
+    out = [p.figure(fig, "masking_lobes.png", "Luminance f_r (1/sr) at θi = 60° with shadowing "
+                    "and masking on (solid, the fabric's colour) and off (dashed, grey), in the "
+                    "planes φ = 0° (warp), 45° and 90° (weft).")]
+    fig, axes = new_figure(3, 1, figsize=(13.0, 3.8), polar=True)
+    for ax, phi in zip(axes, PLANES):
+        plot_masking_lobes(p.fabric, 80.0, phi, resolution=p.q["lobe"], ax=ax, scale="log")
+    out.append(p.figure(fig, "masking_lobes_grazing.png", "The same at grazing incidence "
+                        "θi = 80°, log scale."))
+    out.append('<p>The terms M, P and u themselves are drawn on the <a href="index.html#masking">'
+               'overview page</a>.</p>')
+    return Section("".join(out))

@@ -1,0 +1,49 @@
+"""The "fit" section: the posterior summary of a ``microcyl fit`` of the fabric."""
+
+from __future__ import annotations
+
+import dataclasses
+import html
+from typing import Any
+
+from analysis.fit.results import read_results
+from reports.report.markup import fmt, table
+from reports.report.page import Page
+from reports.report.settings import Section, Unavailable
+
+__all__ = ["FitData", "section_fit"]
+
+_COLUMNS = ("median", "lo68", "hi68", "lo95", "hi95", "tau", "rhat", "ess")
+
+
+@dataclasses.dataclass(frozen=True)
+class FitData:
+    """The results document of a fit (:func:`analysis.fit.results.read_results`)."""
+
+    results: dict
+
+    def summary(self) -> dict[str, Any]:
+        """``fit``: the results document."""
+        return {"fit": self.results}
+
+
+def section_fit(p: Page) -> Section:
+    """Per parameter: median, 68 % and 95 % intervals, τ, R-hat, ESS; and convergence.
+
+    Raises
+    ------
+    Unavailable
+        When no ``results.json`` was given for the fabric, or it cannot be read.
+    """
+    if p.fit_results is None:
+        raise Unavailable("no fitting results for this fabric (run `microcyl fit` and pass its "
+                          "results.json)")
+    try:
+        data = read_results(p.fit_results)
+    except ValueError as exc:
+        raise Unavailable(str(exc)) from None
+    rows = [[k] + [fmt(v.get(f)) for f in _COLUMNS] for k, v in data["parameters"].items()]
+    return Section(table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat",
+                          "ESS"], rows)
+                   + f"<p>Converged: {html.escape(fmt(data.get('converged')))}</p>",
+                   FitData(data))

@@ -1,0 +1,66 @@
+"""The "parameters" section: each thread's parameters, the options, f_r at standard geometries."""
+
+from __future__ import annotations
+
+import dataclasses
+import html
+from typing import Any
+
+from reports.report.markup import fmt, plain_json, table
+from reports.report.page import Page
+from reports.report.settings import Section
+from reports.standard import STANDARD_GEOMETRIES, standard_values
+
+__all__ = ["ParametersData", "THREAD_FIELDS", "THREAD_HEADER", "parameters_of",
+           "section_parameters"]
+
+#: Thread attributes shown, in table order.
+THREAD_FIELDS = ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area", "offsets", "lengths")
+#: Column headings of :data:`THREAD_FIELDS` (gamma and offsets in degrees).
+THREAD_HEADER = ("eta", "A (RGB)", "k_d", "γs (deg)", "γv (deg)", "area a", "offsets (deg)",
+                 "lengths")
+
+
+def parameters_of(fab) -> dict:
+    """Plain data of a BRDF's threads (the :data:`THREAD_FIELDS`) and options.
+
+    A BRDF without threads or options (a measured table, a user's analytic model) gives an
+    empty list and dict.
+    """
+    threads = [{f: plain_json(getattr(t, f, None)) for f in THREAD_FIELDS}
+               for t in getattr(fab, "threads", ()) or ()]
+    return {"threads": threads, "options": plain_json(dict(getattr(fab, "options", {}) or {}))}
+
+
+@dataclasses.dataclass(frozen=True)
+class ParametersData:
+    """The parameters of a fabric and its f_r (1/sr, RGB) at the standard geometries."""
+
+    parameters: dict
+    standard_geometries: dict | None
+
+    def summary(self) -> dict[str, Any]:
+        """``parameters`` and (for a BRDF with threads) ``standard_geometries``."""
+        out = {"parameters": self.parameters}
+        if self.standard_geometries is not None:
+            out["standard_geometries"] = self.standard_geometries
+        return out
+
+
+def section_parameters(p: Page) -> Section:
+    """Thread table, options and f_r at :data:`reports.standard.STANDARD_GEOMETRIES`."""
+    params = parameters_of(p.fabric)
+    link = p.json("parameters.json", params)
+    if not params["threads"]:
+        return Section(f"<p>This BRDF exposes no threads.</p><p>Data: {link}</p>",
+                       ParametersData(params, None))
+    rows = [[f"T{j + 1}"] + [fmt(t[f]) for f in THREAD_FIELDS]
+            for j, t in enumerate(params["threads"])]
+    opts = ", ".join(f"{k} = {fmt(v)}" for k, v in params["options"].items()) or "n/a"
+    values = standard_values(p.fabric)
+    std = table(["geometry", "θi, φi (deg)", "θo, φo (deg)", "f_r R", "f_r G", "f_r B (1/sr)"],
+                [[g[0], f"{g[1]:g}, {g[2]:g}", f"{g[3]:g}, {g[4]:g}"]
+                 + [f"{v:.5g}" for v in values[g[0]]] for g in STANDARD_GEOMETRIES])
+    return Section(f"{table(['thread', *THREAD_HEADER], rows)}<p>Options: {html.escape(opts)}</p>"
+                   f"<h3>f_r at standard geometries</h3>{std}<p>Data: {link}</p>",
+                   ParametersData(params, values))

@@ -1,0 +1,59 @@
+"""What a report holds: its sections in page order, their titles, the resolutions per quality,
+and the two small types every section shares (:class:`Section`, :class:`Unavailable`)."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+__all__ = ["SECTIONS", "TITLES", "QUALITIES", "Section", "SectionData", "Unavailable"]
+
+#: Per-fabric sections in page order.
+SECTIONS = ("parameters", "lobes", "slices", "hemisphere", "masking", "energy", "reciprocity",
+            "sanity", "renders", "fit")
+
+TITLES = {
+    "parameters": "Parameters", "lobes": "Lobes in the planes of incidence",
+    "slices": "Slices (BRDF Explorer)", "hemisphere": "Hemisphere and 3-D lobe",
+    "masking": "Shadowing and masking", "energy": "Energy: directional albedo",
+    "reciprocity": "Reciprocity", "sanity": "Sanity: finite, non-negative f_r at the edges",
+    "renders": "Renders", "fit": "Fitting results",
+}
+
+#: Resolutions per quality. "default" keeps plotting near 5 s a preset on 2 cores;
+#: "fast" is for tests and previews. Angles in degrees; render = (width, height, spp).
+QUALITIES = {
+    "default": dict(lobe=181, hemi=101, image=90, recip=45, lobe3d=(30, 60),
+                    albedo_theta=np.arange(0.0, 90.0, 3.0), render=(320, 180, 16), dpi=100),
+    "fast": dict(lobe=37, hemi=21, image=12, recip=8, lobe3d=(6, 10),
+                 albedo_theta=np.array([0.0, 45.0, 85.0]), render=(32, 18, 1), dpi=50),
+}
+
+
+class Unavailable(Exception):
+    """A section cannot be shown for this fabric (no fit results, no masking to switch off);
+    the message says why and the page says "Not available"."""
+
+
+@runtime_checkable
+class SectionData(Protocol):
+    """A section's data: what it adds to the fabric's entry of ``summary.json``."""
+
+    def summary(self) -> dict[str, Any]:
+        """Keys and plain values for the fabric's entry of ``summary.json``."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Section:
+    """What a section builder returns: its HTML fragment and its data (None: figures only).
+
+    Examples
+    --------
+    >>> Section("<p>hi</p>").data is None
+    True
+    """
+
+    html: str
+    data: SectionData | None = None

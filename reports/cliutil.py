@@ -8,6 +8,8 @@ import tempfile
 from pathlib import Path
 
 import brdf
+from analysis.likelihood import KINDS
+from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
 __all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties"]
@@ -43,8 +45,6 @@ def add_fabric_options(parser: argparse.ArgumentParser) -> None:
 
 def add_fit_options(p: argparse.ArgumentParser) -> None:
     """Add the options of a fit (``microcyl fit`` and ``fit-batch``): spec and sampler."""
-    from analysis.likelihood import KINDS
-    from analysis.params import DEFAULT_FREE, DEFAULT_TIES
     p.add_argument("--free", default=None, metavar="NAMES",
                    help="comma-separated free parameters, or a TOML file (default "
                         f"{','.join(DEFAULT_FREE)})")

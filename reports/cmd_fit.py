@@ -13,9 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import brdf
-from analysis.fit import fit_fabric
-from analysis.likelihood import KINDS
-from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
+from analysis.fit import fit_fabric, fit_spec
 from gonio import read
 from reports import cliutil
 
@@ -39,25 +37,7 @@ def register(sub):
                                                   ".bsdf, CUReT abrdf.dat with --sample)")
     p.add_argument("--fabric", required=True, metavar="PRESET",
                    help=f"preset giving fixed values and the start: {', '.join(brdf.PRESETS)}")
-    p.add_argument("--free", default=None, metavar="NAMES",
-                   help="comma-separated free parameters, or a TOML file (default "
-                        f"{','.join(DEFAULT_FREE)})")
-    p.add_argument("--spec", default=None, metavar="TOML",
-                   help="TOML file with free, tie, [bounds], [prior], [start]")
-    p.add_argument("--tie", action="append", default=None, metavar="A=B",
-                   help="tie A to B (A=B or A=1-B); repeatable; 'none' for no tie (default "
-                        f"{','.join(DEFAULT_TIES)} when --free is not given)")
-    p.add_argument("--likelihood", choices=KINDS, default="gaussian")
-    p.add_argument("--nu", type=float, default=4.0, help="Student-t degrees of freedom")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--max-steps", type=int, default=20000, metavar="N",
-                   help="step limit per ensemble (default 20000)")
-    p.add_argument("--ensembles", type=int, default=4, metavar="K")
-    p.add_argument("--walkers", type=int, default=None, metavar="W",
-                   help="walkers per ensemble (default 2 x ndim + 2)")
-    p.add_argument("--check-every", type=int, default=50, metavar="N",
-                   help="steps between convergence checks (default 50)")
-    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS")
+    cliutil.add_fit_options(p)
     p.add_argument("--sample", type=int, default=None, metavar="N",
                    help="CUReT sample number (for abrdf.dat)")
     p.add_argument("--no-plots", action="store_true", help="skip the plots")
@@ -68,20 +48,7 @@ def register(sub):
 
 
 def _spec_from_args(args, fab):
-    defaults = defaults_from_fabric(fab)
-    ties = args.tie
-    if ties is not None:
-        ties = [t for item in ties for t in item.split(",") if t.strip().lower() != "none"]
-    free = args.free
-    toml = args.spec
-    if free is not None and free.lower().endswith(".toml"):
-        toml, free = free, None
-    if ties is None and free is None and toml is None:
-        ties = list(DEFAULT_TIES)
-    if toml is not None:
-        return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties)
-    return ParamSpec(free if free is not None else DEFAULT_FREE, defaults=defaults,
-                     ties=ties or ())
+    return fit_spec(fab, args.free, cliutil.split_ties(args.tie), args.spec)
 
 
 def run(args) -> int:
@@ -98,10 +65,8 @@ def run(args) -> int:
         # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
         from reports.fitplots import write_fit_plots as plots
     result = fit_fabric(
-        table, fab, spec, out, plots=plots, likelihood=args.likelihood, nu=args.nu,
-        ensembles=args.ensembles, walkers=args.walkers, seed=args.seed,
-        max_steps=args.max_steps, check_every=args.check_every, time_limit=args.time_limit,
-        progress=not args.no_progress,
+        table, fab, spec, out, plots=plots, progress=not args.no_progress,
+        **cliutil.fit_kwargs(args),
         config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
     print(format_summary(result))
     q = result.quality

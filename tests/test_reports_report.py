@@ -51,7 +51,7 @@ def fake_energy_report(calls):
         curve = {"preset": presets[0], "variant": variants[0], "mode": "furnace",
                  "value": value.tolist(), "error": np.full_like(value, 1e-3).tolist()}
         return EnergyReport(settings={}, curves=[curve], hemispherical=[], furnace=[],
-                            statements=[], seconds=0.0)
+                            seconds=0.0)
     return energy_report
 
 

@@ -1,0 +1,115 @@
+"""`microcyl fit-batch` as a user runs it: a subprocess with the progress bar on, a real output
+folder, a local cluster; against `dask scheduler` and two `dask worker` processes; Ctrl-C and
+the same command again."""
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import brdf
+import gonio
+
+pytest.importorskip("distributed")
+ROOT = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="100")
+FIT = ["--fabric", "silk_crepe_de_chine", "--free", "kd1,gamma_s1", "--tie", "none"]
+
+
+def microcyl(*args, **kw):
+    return subprocess.run([sys.executable, "-m", "reports", *map(str, args)], env=ENV,
+                          capture_output=True, text=True, timeout=600, **kw)
+
+
+@pytest.fixture(scope="module")
+def tables(tmp_path_factory):
+    d = tmp_path_factory.mktemp("tables")
+    fab = brdf.fabric("silk_crepe_de_chine")
+    for k, spec in enumerate(["full:20:45", "full:30"]):      # 1,089 and 625 pairs
+        t = gonio.measure(fab, spec, gonio.Instrument(snr=20, floor=1e-4), seed=k,
+                          progress=False)
+        gonio.write(t, d / f"silk{k}.csv")
+    return d
+
+
+def test_fit_batch_with_progress_a_corrupt_table_and_the_page(tables, tmp_path):
+    src = tmp_path / "in"
+    shutil.copytree(tables, src)
+    (src / "broken.exr").write_bytes(b"not an exr file")
+    out = tmp_path / "out"
+    r = microcyl("fit-batch", src, *FIT, "--workers", "2", "-o", out)
+    assert r.returncode == 1, r.stderr                 # one table failed
+    assert "fits:" in r.stderr and "table" in r.stderr     # tqdm's bar over tables
+    assert "broken: error" in r.stdout and "broken.exr" in r.stdout
+    assert "2 converged, 0 not converged, 1 errors" in r.stdout
+    rows = {x["name"]: x for x in json.loads((out / "summary.json").read_text())["tables"]}
+    assert rows["silk0"]["status"] == rows["silk1"]["status"] == "converged"
+    page = (out / "index.html").read_text()
+    for name in ("silk0", "silk1"):
+        for plot in json.loads((out / name / "results.json").read_text())["plots"].values():
+            assert f'{name}/{plot}' in page and (out / name / plot).exists()
+    again = microcyl("fit-batch", src, *FIT, "--workers", "1", "--no-progress", "-o", out)
+    assert again.returncode == 1 and "silk0:" not in again.stdout   # converged: not redone
+
+
+def _wait_for(path, timeout=60.0):
+    deadline = time.time() + timeout
+    while time.time() < deadline and not path.exists():
+        time.sleep(0.1)
+    assert path.exists(), f"{path} did not appear"
+
+
+def test_fit_batch_on_a_dask_scheduler_and_two_workers(tables, tmp_path):
+    dask = shutil.which("dask", path=str(Path(sys.executable).parent)) or shutil.which("dask")
+    if dask is None:
+        pytest.skip("the dask command is not installed")
+    sched_file = tmp_path / "scheduler.json"
+    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", "0",
+                               "--no-dashboard", "--scheduler-file", str(sched_file)],
+                              env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        _wait_for(sched_file)
+        for _ in range(2):
+            procs.append(subprocess.Popen(
+                [dask, "worker", "--scheduler-file", str(sched_file), "--nworkers", "1",
+                 "--nthreads", "1", "--no-dashboard"], env=ENV,
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        address = json.loads(sched_file.read_text())["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        out = tmp_path / "out"
+        r = microcyl("fit-batch", tables, *FIT, "--scheduler", address, "--no-plots",
+                     "-o", out)
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "2 converged, 0 not converged, 0 errors" in r.stdout
+        assert {(out / n / "results.json").exists() for n in ("silk0", "silk1")} == {True}
+    finally:
+        for p in procs[::-1]:
+            p.terminate()
+        for p in procs:
+            p.wait(timeout=30)
+
+
+def test_ctrl_c_stops_the_batch_and_the_same_command_resumes(tables, tmp_path):
+    out = tmp_path / "out"
+    args = [sys.executable, "-m", "reports", "fit-batch", str(tables), *FIT,
+            "--check-every", "25", "--workers", "2", "--no-plots", "-o", str(out)]
+    p = subprocess.Popen(args, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True)
+    _wait_for(out / "silk0" / "checkpoint.h5", timeout=120)
+    p.send_signal(signal.SIGINT)
+    stdout, stderr = p.communicate(timeout=120)
+    assert p.returncode == 130, stderr
+    last = stderr.strip().splitlines()[-1]
+    assert "interrupted" in last and "resumes" in last
+    assert "Traceback" not in stderr
+    r = microcyl(*args[3:])
+    assert r.returncode == 0, r.stderr
+    rows = {x["name"]: x for x in json.loads((out / "summary.json").read_text())["tables"]}
+    assert {x["status"] for x in rows.values()} == {"converged"}
+    assert rows["silk0"]["resumed_from"] > 0 or "silk0" in stdout  # resumed, or had ended

@@ -36,14 +36,15 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import os
-import time
 from pathlib import Path
 
 import numpy as np
 
-import analysis.fit
+from analysis.batch import BatchJob, run_batch
+from analysis.fit.results import read_results
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write
@@ -209,15 +210,16 @@ def measured_spec(name, fab=None):
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
                  max_steps: int = 20000, time_limit: float | None = None,
                  rgl_step: float = 15.0, plots=None, progress: bool = True,
-                 echo=None) -> dict:
-    """Fit measured datasets; write ``out_dir/NAME/`` and ``out_dir/measured.json``.
+                 echo=None, workers: int | None = None, scheduler: str | None = None) -> dict:
+    """Fit measured datasets as a batch (:func:`analysis.batch.run_batch`); write
+    ``out_dir/NAME/``, the batch summaries and ``out_dir/measured.json``.
 
     Parameters
     ----------
     names : sequence of str, optional
         Keys of :data:`analysis.measured.MEASURED` (default all).
     out_dir : path
-        Output folder; existing fits there are resumed.
+        Output folder; existing fits there are resumed, converged ones not redone.
     data_dir : path, optional
         The measured-data folder (default :func:`analysis.measured.default_data_dir`).
     seed, max_steps, time_limit
@@ -227,16 +229,18 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     plots : callable, optional
         Draws each fit's plots (see :func:`analysis.fit.fit_fabric`).
     progress : bool
-        A progress bar per fit.
+        A progress bar over the datasets.
     echo : callable, optional
         Called with one line per finished dataset.
+    workers, scheduler
+        The Dask cluster (see :func:`analysis.batch.run_batch`).
 
     Returns
     -------
     dict
         The ``measured.json`` document: ``{"datasets": {name: {...}}}``; each entry's
         ``wall_s`` is the time of the run that wrote it (a resumed fit counts only its last
-        run, a finished one only the re-summary).
+        run).
 
     Raises
     ------
@@ -249,56 +253,50 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     bad = [n for n in names if n not in MEASURED]
     if bad:
         raise ValueError(f"unknown measured dataset {bad[0]!r}; valid: {', '.join(MEASURED)}")
-    tables = {n: load_measured(n, data_dir, rgl_step=rgl_step) for n in names}
+    root = (Path(data_dir) if data_dir is not None else default_data_dir()).resolve()
+    tables = {n: load_measured(n, root, rgl_step=rgl_step) for n in names}
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    jobs = [_job(n, root, rgl_step, plots, {"seed": seed, "max_steps": max_steps,
+                                            "time_limit": time_limit}) for n in names]
+    summary = run_batch(jobs, out, workers=workers, scheduler=scheduler, progress=progress,
+                        echo=echo)
     spath = out / SUMMARY_FILE
+    # read just before writing: another fit-measured run may have added its datasets
+    doc = _read_summary(spath)
     for n in names:
-        entry, result = _fit_one(n, tables[n], out, plots=plots, seed=seed,
-                                 max_steps=max_steps, time_limit=time_limit,
-                                 progress=progress, rgl_step=rgl_step)
-        # read just before writing: another fit-measured run may have added its datasets
-        doc = _read_summary(spath)
-        doc["datasets"][n] = entry
-        with atomic_write(spath, "w") as fh:
-            fh.write(json.dumps(doc, indent=2) + "\n")
-        if echo is not None:
-            echo(_echo_line(n, entry, result))
+        doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
+    with atomic_write(spath, "w") as fh:
+        fh.write(json.dumps(doc, indent=2) + "\n")
     return doc
 
 
-def _fit_one(n: str, table, out: Path, *, plots, seed, max_steps, time_limit, progress,
-             rgl_step) -> tuple[dict, object]:
-    """Fit dataset ``n`` into ``out/n``: its summary entry and the :class:`FitResult`."""
+def _job(n: str, root: Path, rgl_step: float, plots, fit: dict) -> BatchJob:
+    """The batch job of dataset ``n``: read on the worker by :func:`load_measured`."""
     d = MEASURED[n]
-    spec, fab = measured_spec(n)
-    t0 = time.perf_counter()
-    result = analysis.fit.fit_fabric(  # looked up at call time: tests substitute it
-        table, fab, spec, out / n, plots=plots, seed=seed, max_steps=max_steps,
-        time_limit=time_limit, progress=progress,
-        config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
-    entry = {
-        "title": d.title, "preset": d.preset, "source": str(table.meta.get("source", "")),
-        "pairs": len(table), "values_used": result.counts["used"],
-        "free": list(result.names), "ties": list(d.ties),
-        "converged": bool(result.converged), "reason": result.reason,
-        "steps": result.steps, "wall_s": round(time.perf_counter() - t0, 2),
-        "quality": result.quality,
-        "albedo_delta_e2000": result.quality.get("albedo_delta_e2000"),
-        "results": f"{n}/results.json",
-    }
-    return entry, result
+    return BatchJob(n, str(root / d.path), d.sample, d.preset, d.free, d.ties, fit=fit,
+                    loader=functools.partial(load_measured, n, str(root), rgl_step),
+                    plots=plots,
+                    config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
 
 
-def _echo_line(n: str, entry: dict, result) -> str:
-    """The line :func:`fit_measured` prints for a finished dataset."""
-    return (f"{n}: {'converged' if result.converged else 'NOT converged'} after "
-            f"{result.steps} steps (this run {entry['wall_s']:.0f} s); residual rms "
-            f"{entry['quality']['rms_residual']:.3f}"
-            + (f", albedo CIEDE2000 {entry['albedo_delta_e2000']:.1f}"
-               if entry["albedo_delta_e2000"] is not None else "")
-            + (f"; resumed from step {result.timing['resumed_from']}"
-               if result.timing.get("resumed_from") else ""))
+def _entry(n: str, table, row: dict, out: Path) -> dict:
+    """The ``measured.json`` entry of dataset ``n`` from its batch row and results."""
+    d = MEASURED[n]
+    entry = {"title": d.title, "preset": d.preset,
+             "source": str(table.meta.get("source", "")), "pairs": len(table),
+             "free": list(d.free), "ties": list(d.ties), "converged": False,
+             "reason": row.get("error") or row.get("reason", ""),
+             "steps": row.get("steps", 0), "wall_s": row.get("wall_s"),
+             "results": f"{n}/results.json"}
+    if row["status"] == "error":
+        return dict(entry, error=row["error"], values_used=0, quality={},
+                    albedo_delta_e2000=None)
+    res = read_results(out / n / "results.json")
+    quality = res.get("quality", {})
+    return dict(entry, converged=bool(res["converged"]), reason=res["reason"],
+                values_used=res.get("fit", {}).get("points", {}).get("used"),
+                free=list(res["parameters"]), quality=quality,
+                albedo_delta_e2000=quality.get("albedo_delta_e2000"))
 
 
 def _read_summary(path: Path) -> dict:

@@ -37,6 +37,11 @@ def register(sub):
     p.add_argument("--rgl-step", type=float, default=15.0, metavar="DEG",
                    help="outgoing-direction step when sampling an RGL file (default 15)")
     p.add_argument("--seed", type=int, default=0)
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="local Dask worker processes (default: one per core)")
+    g.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     p.add_argument("--no-plots", action="store_true")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
@@ -53,7 +58,7 @@ def run(args) -> int:
     doc = fit_measured(args.names, out, data_dir=args.data, seed=args.seed,
                        max_steps=args.max_steps, time_limit=args.time_limit,
                        rgl_step=args.rgl_step, plots=plots, progress=not args.no_progress,
-                       echo=print)
+                       echo=print, workers=args.workers, scheduler=args.scheduler)
     names = args.names or list(doc["datasets"])
     bad = [n for n in names if not doc["datasets"][n]["converged"]]
     print(f"{len(names) - len(bad)} of {len(names)} fits converged; summary: "

@@ -192,7 +192,7 @@ def test_fit_measured_with_progress_killed_and_resumed(tmp_path, shared_data):
     p = _cli(*args)
     stdout, stderr = p.communicate(timeout=600)
     assert p.returncode == 1, stderr            # 400 steps: not converged, and it says so
-    assert "emcee:" in stderr                    # the bar was drawn on the pipe
+    assert "fits:" in stderr                     # the batch's bar was drawn on the pipe
     kept = int(stdout.split("resumed from step ")[1].split()[0])
     assert kept >= seen
     doc = json.loads((out / "measured.json").read_text())

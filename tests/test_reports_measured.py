@@ -84,19 +84,19 @@ def test_report_page_of_measured_fits(fitted, tmp_path):
 def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeypatch):
     """Two fit-measured runs into one folder: the one that finishes last must not drop the
     entry the other wrote while it was fitting."""
-    import analysis.fit
+    import analysis.measured
     from analysis.measured import fit_measured
-    real = analysis.fit.fit_fabric
+    real = analysis.measured.run_batch
 
-    def fit_and_other_run_finishing(*a, **kw):
+    def batch_and_other_run_finishing(*a, **kw):
         out = real(*a, **kw)
         (tmp_path / "measured.json").write_text(json.dumps(
             {"datasets": {"curet_07_velvet": {"converged": True, "steps": 1}}}))
         return out
 
-    monkeypatch.setattr(analysis.fit, "fit_fabric", fit_and_other_run_finishing)
+    monkeypatch.setattr(analysis.measured, "run_batch", batch_and_other_run_finishing)
     doc = fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, max_steps=20,
-                       plots=None, progress=False)
+                       plots=None, progress=False, workers=1)
     on_disk = json.loads((tmp_path / "measured.json").read_text())
     assert set(on_disk["datasets"]) == set(doc["datasets"]) == {"curet_07_velvet",
                                                                "curet_44_linen"}

@@ -68,7 +68,9 @@ def describe_row(row: dict) -> str:
     if row["status"] == "error":
         return f"{row['name']}: error: {row['error']}"
     verdict = "converged" if row["status"] == "converged" else "NOT converged"
-    return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s)"
+    resumed = (f"; resumed from step {row['resumed_from']}" if row.get("resumed_from")
+               else "")
+    return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
 
 
 def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,

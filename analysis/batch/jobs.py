@@ -56,6 +56,9 @@ class BatchJob:
         a :func:`functools.partial` of :func:`analysis.measured.load_measured`).
     plots : callable, optional
         Passed to :func:`analysis.fit.fit_fabric` (e.g. ``reports.fitplots.write_fit_plots``).
+    config_extra : dict, optional
+        Recorded in (and matched against) the fit's stored configuration; default the
+        preset, its options and the sample, as ``microcyl fit`` records them.
     """
 
     name: str
@@ -70,6 +73,7 @@ class BatchJob:
     read_options: dict = dataclasses.field(default_factory=dict)
     loader: Callable | None = None
     plots: Callable | None = None
+    config_extra: dict | None = None
 
     def fabric(self) -> brdf.Fabric:
         """The start fabric (preset and options)."""

@@ -40,9 +40,11 @@ def run_job(job: BatchJob, out_dir) -> dict:
         spec = job.param_spec(fab)
         fit_kw = dict(job.fit)
         fit_kw.setdefault("threads", 1)
+        extra = job.config_extra
+        if extra is None:
+            extra = {"fabric": job.preset, "options": fab.options, "sample": job.sample}
         result = fit_fabric(table, fab, spec, folder, plots=job.plots, progress=False,
-                            config_extra={"fabric": job.preset, "options": fab.options,
-                                          "sample": job.sample}, **fit_kw)
+                            config_extra=extra, **fit_kw)
     except Exception as exc:        # noqa: BLE001 - the batch records it and goes on
         return error_row(job, exc, time.perf_counter() - t0)
     return result_row(job, result, time.perf_counter() - t0)

@@ -5,7 +5,7 @@ from analysis.albedo import (AlbedoCurve, AlbedoResult, HemisphericalAlbedo, alb
 from analysis.energy import VARIANTS, EnergyReport, energy_report, white_furnace
 from analysis.reciprocity import (ReciprocityReport, ReciprocityResult, reciprocity,
                                   reciprocity_report)
-from analysis.colour import LUMINANCE_WEIGHTS, luminance
+from analysis.colour import luminance
 from analysis.sanity import SanityResult, sanity_scan
 from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rhat
 from analysis.fit import FabricModel, FitResult, LogPosterior, fit_fabric, write_results
@@ -18,7 +18,7 @@ __all__ = []
 __all__ += ["albedo", "albedo_curve", "albedo_hemispherical", "AlbedoResult", "AlbedoCurve",
             "HemisphericalAlbedo", "energy_report", "white_furnace", "EnergyReport", "VARIANTS",
             "reciprocity", "reciprocity_report", "ReciprocityResult", "ReciprocityReport",
-            "sanity_scan", "SanityResult", "luminance", "LUMINANCE_WEIGHTS"]
+            "sanity_scan", "SanityResult", "luminance"]
 __all__ += ["ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
             "Likelihood", "fit_fabric", "FitResult", "FabricModel", "LogPosterior", "write_results",
             "autocorr_time", "split_rhat", "ess", "interval_summary",

@@ -9,17 +9,35 @@ its matrix from the primaries instead, 0.212639 R + 0.715169 G + 0.072192 B: the
 
 from __future__ import annotations
 
-import colour
+import functools
+
 import numpy as np
 
 from analysis.likelihood import is_grey
 
 __all__ = ["LUMINANCE_WEIGHTS", "luminance", "albedo_colours", "albedo_delta_e"]
 
-#: Luminance weights (R, G, B) of linear RGB: the Y row of the sRGB RGB -> XYZ matrix.
-LUMINANCE_WEIGHTS = np.array(colour.RGB_COLOURSPACES["sRGB"].matrix_RGB_to_XYZ[1],
-                             dtype=np.float64)
-LUMINANCE_WEIGHTS.setflags(write=False)
+
+def _colour():
+    """colour-science, imported on use: ``import colour`` also loads its plotting package and
+    matplotlib (about 1.5 s), which every ``microcyl`` verb would pay through this package."""
+    import colour
+    return colour
+
+
+@functools.cache
+def _weights() -> np.ndarray:
+    w = np.array(_colour().RGB_COLOURSPACES["sRGB"].matrix_RGB_to_XYZ[1], dtype=np.float64)
+    w.setflags(write=False)
+    return w
+
+
+def __getattr__(name):
+    """``LUMINANCE_WEIGHTS``: the luminance weights (R, G, B) of linear RGB, the Y row of
+    colour-science's sRGB RGB -> XYZ matrix (computed on first use)."""
+    if name == "LUMINANCE_WEIGHTS":
+        return _weights()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def luminance(rgb) -> np.ndarray:
@@ -54,7 +72,7 @@ def luminance(rgb) -> np.ndarray:
     arr = np.asarray(rgb, dtype=np.float64)
     if arr.ndim == 0 or arr.shape[-1] != 3:
         raise ValueError(f"rgb must have shape (..., 3); got {arr.shape}")
-    return arr @ LUMINANCE_WEIGHTS
+    return arr @ _weights()
 
 
 def albedo_colours(table, prediction):
@@ -117,6 +135,7 @@ def albedo_delta_e(measured, predicted) -> float:
     >>> albedo_delta_e([0.2, 0.1, 0.05], [0.2, 0.2, 0.2]) > 5
     True
     """
+    colour = _colour()
     labs = [colour.XYZ_to_Lab(colour.sRGB_to_XYZ(np.clip(np.asarray(c, float), 0, None),
                                                  apply_cctf_decoding=False))
             for c in (measured, predicted)]

@@ -119,15 +119,13 @@ MEASURED: dict[str, MeasuredDataset] = {d.name: d for d in (
 
 
 def default_data_dir() -> Path:
-    """The measured-data folder: ``$MICROCYL_DATA``, else ``../shared/data`` from the current
-    folder, else the same beside this source tree's parent."""
+    """The measured-data folder: ``$MICROCYL_DATA``, else ``shared/data`` beside this source
+    tree (``../shared/data`` from the repository). The command line also looks beside the
+    current folder (:func:`reports.cliutil.data_dir`)."""
     env = os.environ.get("MICROCYL_DATA")
     if env:
         return Path(env)
-    here = Path.cwd() / ".." / "shared" / "data"
-    if here.is_dir():
-        return here.resolve()
-    return (Path(__file__).resolve().parents[2] / "shared" / "data")
+    return Path(__file__).resolve().parents[2] / "shared" / "data"
 
 
 def _dataset(name) -> MeasuredDataset:
@@ -167,8 +165,8 @@ def load_measured(name, data_dir=None, rgl_step: float = 15.0):
     root = Path(data_dir) if data_dir is not None else default_data_dir()
     path = root / d.path
     if not path.exists():
-        raise FileNotFoundError(2, f"measured data for {d.name} not found (set --data or "
-                                   f"MICROCYL_DATA)", str(path))
+        raise FileNotFoundError(2, f"measured data for {d.name} not found (give the data "
+                                   f"folder, or set MICROCYL_DATA)", str(path))
     if d.kind == "rgl":
         table = read(path, step=float(rgl_step))
         if load_rgl(path).isotropic:

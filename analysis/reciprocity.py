@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from analysis.colour import LUMINANCE_WEIGHTS, luminance
+from analysis.colour import luminance
 from analysis.variants import VARIANTS, check_names
 from brdf.frames import to_angles
 from brdf.presets import fabric as preset_fabric
@@ -32,10 +32,8 @@ from gonio.rgl import load_rgl
 from gonio.table import Table
 
 __all__ = ["ReciprocityResult", "ReciprocityReport", "reciprocity", "reciprocity_report",
-           "random_pairs", "LUMINANCE", "relative_asymmetry"]
+           "random_pairs", "relative_asymmetry"]
 
-#: Rec. ITU-R BT.709 luminance weights of linear RGB (:data:`analysis.colour.LUMINANCE_WEIGHTS`).
-LUMINANCE = LUMINANCE_WEIGHTS
 
 
 def relative_asymmetry(a, b) -> np.ndarray:

@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import tempfile
 from pathlib import Path
 
 import brdf
 from analysis.likelihood import KINDS
+from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
 __all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir",
-           "add_fit_options", "fit_kwargs", "split_ties"]
+           "add_fit_options", "fit_kwargs", "split_ties", "data_dir"]
 
 
 def _on_off(value: str) -> bool:
@@ -102,6 +104,18 @@ def parse_angle_pair(text: str) -> tuple[float, float]:
     if not (math.isfinite(theta) and math.isfinite(phi)):
         raise argparse.ArgumentTypeError(f"angles must be finite, got {text!r}")
     return theta, phi
+
+
+def data_dir(arg=None) -> Path:
+    """The measured-data folder of a verb: ``--data`` when given, else ``$MICROCYL_DATA``,
+    else ``../shared/data`` from the current folder when it exists, else the one beside the
+    source tree (:func:`analysis.measured.default_data_dir`)."""
+    if arg:
+        return Path(arg)
+    if os.environ.get("MICROCYL_DATA"):
+        return Path(os.environ["MICROCYL_DATA"])
+    here = Path.cwd().parent / "shared" / "data"
+    return here.resolve() if here.is_dir() else default_data_dir()
 
 
 def check_writable_dir(path: Path) -> Path:

@@ -15,7 +15,6 @@ from pathlib import Path
 import brdf
 from analysis.batch import jobs_from_inputs, run_batch
 from reports import cliutil
-from reports.fitplots import write_fit_plots
 from reports.report_batch import write_batch_page
 
 __all__ = ["register", "run"]
@@ -57,6 +56,10 @@ def run(args) -> int:
     if args.fabric not in brdf.PRESETS:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")
+    plots = None
+    if not args.no_plots:
+        # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
+        from reports.fitplots import write_fit_plots as plots
     fab = cliutil.fabric_from_args(args.fabric, args)
     out = cliutil.check_writable_dir(Path(args.output))
     free = args.free.split(",") if args.free and not args.free.endswith(".toml") else args.free
@@ -65,7 +68,7 @@ def run(args) -> int:
         spec=args.spec, samples=args.sample, fit=cliutil.fit_kwargs(args),
         fabric_options=fab.options,
         read_options={} if args.rgl_step is None else {"step": args.rgl_step},
-        plots=None if args.no_plots else write_fit_plots)
+        plots=plots)
     print(f"fit-batch: {len(jobs)} tables into {out}")
     summary = run_batch(jobs, out, workers=args.workers, scheduler=args.scheduler,
                         progress=not args.no_progress)

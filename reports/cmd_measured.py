@@ -55,7 +55,8 @@ def run(args) -> int:
     if not args.no_plots:
         # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
         from reports.fitplots import write_fit_plots as plots
-    doc = fit_measured(args.names, out, data_dir=args.data, seed=args.seed,
+    doc = fit_measured(args.names, out, data_dir=cliutil.data_dir(args.data),
+                       seed=args.seed,
                        max_steps=args.max_steps, time_limit=args.time_limit,
                        rgl_step=args.rgl_step, plots=plots, progress=not args.no_progress,
                        echo=print, workers=args.workers, scheduler=args.scheduler)

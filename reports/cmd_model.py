@@ -93,6 +93,8 @@ def run_eval(args):
 
 
 def run_report(args):
+    # lazy: the report loads matplotlib and colour-science (~2 s), which the other verbs of
+    # this module and `microcyl --help` skip
     from analysis.colour import luminance
     from reports.report import build_report
 

@@ -15,10 +15,9 @@ import gonio
 from analysis.energy import VARIANTS, EnergyReport, energy_report
 from analysis.reciprocity import reciprocity_report
 from gonio.atomic import atomic_write
+from reports import cliutil
 from reports.prose import energy_statements, reciprocity_statements
 
-#: ../shared/data beside the repository (override with --data or MICROCYL_DATA).
-DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 FELTS = ("acrylic_felt_white_rgb.bsdf", "acrylic_felt_pink_rgb.bsdf",
          "acrylic_felt_purple_rgb.bsdf")
 
@@ -261,7 +260,7 @@ def run_reciprocity(args) -> int:
     geometry = gonio.full_grid(args.grid_step) if args.grid_step > 0 else None
     notes, felts = [], []
     if not args.no_felts:
-        data = Path(args.data or os.environ.get("MICROCYL_DATA") or DEFAULT_DATA)
+        data = cliutil.data_dir(args.data)
         for name in FELTS:
             path = data / "rgl" / name
             if path.is_file():

@@ -15,7 +15,7 @@ from analysis.batch.summary import SUMMARY_CSV, SUMMARY_JSON, BatchSummary
 from analysis.fit.results import read_results
 from gonio import atomic_write
 
-__all__ = ["write_batch_page", "PAGE"]
+__all__ = ["write_batch_page", "PAGE", "CAPTIONS"]
 
 PAGE = "index.html"
 
@@ -25,6 +25,12 @@ th{background:#f0f0f0}td.num{text-align:right;font-variant-numeric:tabular-nums}
 .converged{color:#176}.not_converged{color:#a60}.error{color:#b00}
 .plots{display:grid;grid-template-columns:repeat(auto-fill,minmax(260px,1fr));gap:10px}
 .plots img{width:100%;border:1px solid #ddd}figure{margin:0}figcaption{font-size:13px}"""
+
+
+#: Captions of the fit plots (reports.fitplots) by name.
+CAPTIONS = {"corner": "posterior (corner plot)",
+            "lobes": "posterior predictive: 5-95% band of f_r cos(theta_o) over the data",
+            "residuals": "residuals at the posterior median", "traces": "chains (traces)"}
 
 
 def _params(rows) -> list[str]:
@@ -73,7 +79,7 @@ def _fit_section(out: Path, row) -> str:
         if (out / rel).exists():
             figs.append(f'<figure><a href="{html.escape(rel)}"><img src="{html.escape(rel)}" '
                         f'alt="{html.escape(what)} of {name}" loading="lazy"></a>'
-                        f"<figcaption>{html.escape(what)}</figcaption></figure>")
+                        f"<figcaption>{html.escape(CAPTIONS.get(what, what))}</figcaption></figure>")
     plots = f'<div class="plots">{"".join(figs)}</div>' if figs else "<p>no plots</p>"
     return (f'<h3 id="{name}">{name}</h3><p>{html.escape(doc.get("reason", ""))} &middot; '
             f'<a href="{html.escape(row["folder"])}/results.json">results.json</a> &middot; '

@@ -6,6 +6,7 @@ import dataclasses
 import html
 from typing import Any
 
+from brdf import schema
 from reports.report.markup import fmt, plain_json, table
 from reports.report.page import Page
 from reports.report.settings import Section
@@ -14,11 +15,10 @@ from reports.standard import STANDARD_GEOMETRIES, standard_values
 __all__ = ["ParametersData", "THREAD_FIELDS", "THREAD_HEADER", "parameters_of",
            "section_parameters"]
 
-#: Thread attributes shown, in table order.
-THREAD_FIELDS = ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area", "offsets", "lengths")
-#: Column headings of :data:`THREAD_FIELDS` (gamma and offsets in degrees).
-THREAD_HEADER = ("eta", "A (RGB)", "k_d", "γs (deg)", "γv (deg)", "area a", "offsets (deg)",
-                 "lengths")
+#: Thread attributes shown, in table order (the parameter schema's).
+THREAD_FIELDS = schema.THREAD_FIELDS
+#: Column headings of :data:`THREAD_FIELDS`, with units (gamma and offsets in degrees).
+THREAD_HEADER = tuple(p.heading for p in schema.THREAD_PARAMS)
 
 
 def parameters_of(fab) -> dict:

@@ -14,7 +14,8 @@ from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
 __all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir",
-           "add_fit_options", "fit_kwargs", "split_ties", "data_dir"]
+           "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
+           "add_cluster_options"]
 
 
 def _on_off(value: str) -> bool:
@@ -66,6 +67,15 @@ def add_fit_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--check-every", type=int, default=50, metavar="N",
                    help="steps between convergence checks (default 50)")
     p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS")
+
+
+def add_cluster_options(p: argparse.ArgumentParser) -> None:
+    """Add ``--workers N`` / ``--scheduler ADDRESS`` (the Dask cluster of a batch)."""
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="local Dask worker processes (default: one per core)")
+    g.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
 
 
 def fit_kwargs(args: argparse.Namespace) -> dict:

@@ -37,11 +37,7 @@ def register(sub):
                    help="CUReT samples of an abrdf.dat input")
     p.add_argument("--rgl-step", type=float, default=None, metavar="DEG",
                    help="outgoing-direction step for RGL .bsdf inputs (default the reader's)")
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="local worker processes (default: one per core)")
-    g.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    cliutil.add_cluster_options(p)
     p.add_argument("--no-plots", action="store_true", help="skip each fit's plots")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")

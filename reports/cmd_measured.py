@@ -37,11 +37,7 @@ def register(sub):
     p.add_argument("--rgl-step", type=float, default=15.0, metavar="DEG",
                    help="outgoing-direction step when sampling an RGL file (default 15)")
     p.add_argument("--seed", type=int, default=0)
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="local Dask worker processes (default: one per core)")
-    g.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    cliutil.add_cluster_options(p)
     p.add_argument("--no-plots", action="store_true")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.metadata
+import os
 import sys
 
 __all__ = ["main", "build_parser", "COMMAND_MODULES"]
@@ -36,6 +38,13 @@ class _Parser(argparse.ArgumentParser):
                   if " " in self.prog else f"microcyl: error: {message}\n")
 
 
+def _version() -> str:
+    try:
+        return importlib.metadata.version("microcyl")
+    except importlib.metadata.PackageNotFoundError:     # run from a source tree, not installed
+        return "(not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the full ``microcyl`` parser with every registered verb."""
     parser = _Parser(
@@ -43,6 +52,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Measure and analyse the microcylinder cloth BRDF "
                     "(Sadeghi et al., ACM TOG 2013).",
     )
+    parser.add_argument("--version", action="version", version=f"microcyl {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMAND_MODULES:
@@ -68,6 +78,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         status = args.func(args)
+        sys.stdout.flush()                # a closed pipe surfaces here, not at exit
+    except BrokenPipeError:               # `microcyl fabrics | head`: the reader left
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())   # and the flush at exit must not fail either
+        return 0
     except KeyboardInterrupt as exc:      # a fit says where its checkpoint is
         print(f"microcyl {args.command}: {str(exc) or 'interrupted'}", file=sys.stderr)
         return 130

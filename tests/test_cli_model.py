@@ -87,3 +87,22 @@ def test_help_everywhere(capsys):
             main(argv)
         assert exc.value.code == 0
     assert "--tangent-samples" in capsys.readouterr().out
+
+
+def test_version_and_a_closed_pipe(tmp_path):
+    """`microcyl --version`, and `microcyl fabrics | head` (the reader gone) without a
+    broken-pipe error."""
+    import os
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root)
+    v = subprocess.run([sys.executable, "-m", "reports", "--version"], env=env,
+                       capture_output=True, text=True, timeout=120)
+    assert v.returncode == 0 and v.stdout.startswith("microcyl ")
+    r, w = os.pipe()
+    os.close(r)                                     # the reader has already left
+    p = subprocess.run([sys.executable, "-m", "reports", "fabrics"], stdout=w, env=env,
+                       stderr=subprocess.PIPE, text=True, timeout=120)
+    os.close(w)
+    assert p.returncode == 0 and "BrokenPipe" not in p.stderr and p.stderr == ""

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 
 import brdf
+import gonio
 from reports import cliutil
 from reports.report_batch import write_batch_page
 from reports.standard import STANDARD_GEOMETRIES, standard_values
@@ -17,6 +19,8 @@ def register(sub):
     p = sub.add_parser("fabrics", help="list the presets and their parameters",
                        description="List the paper's six fabrics (Table II) and their "
                                    "parameters (gamma and offsets in degrees).")
+    p.add_argument("--json", action="store_true",
+                   help="print the presets as JSON (scripts; gamma and offsets in degrees)")
     p.set_defaults(func=run_fabrics)
 
     p = sub.add_parser("eval", help="evaluate f_r of a preset at one pair of directions",
@@ -28,6 +32,7 @@ def register(sub):
                    help="direction toward the light, degrees")
     p.add_argument("--wo", type=cliutil.parse_angle_pair, required=True, metavar="THETA,PHI",
                    help="direction toward the viewer, degrees")
+    p.add_argument("--json", action="store_true", help="print the result as JSON (scripts)")
     cliutil.add_fabric_options(p)
     p.set_defaults(func=run_eval)
 
@@ -77,8 +82,20 @@ def format_fabrics_table(names=brdf.PRESETS) -> str:
     return "\n".join(lines)
 
 
+def fabrics_document(names=brdf.PRESETS) -> dict:
+    """The presets as plain data: per fabric its threads' parameters (the schema's names;
+    gamma and offsets in degrees) and the units."""
+    params = brdf.schema.THREAD_PARAMS
+    return {"units": {p.name: p.unit for p in params},
+            "fabrics": {n: [{p.name: gonio.plain(getattr(t, p.name)) for p in params}
+                            for t in brdf.preset_threads(n)] for n in names}}
+
+
 def run_fabrics(args):
-    print(format_fabrics_table())
+    if args.json:
+        print(json.dumps(fabrics_document(), indent=1))
+    else:
+        print(format_fabrics_table())
     return 0
 
 
@@ -88,6 +105,11 @@ def run_eval(args):
     wi = brdf.directions.from_angles(*np.radians(args.wi))
     wo = brdf.directions.from_angles(*np.radians(args.wo))
     f = fab.eval(wi, wo)
+    if args.json:
+        print(json.dumps({"fabric": args.fabric, "wi_deg": list(args.wi),
+                          "wo_deg": list(args.wo), "f_r": [float(x) for x in f],
+                          "unit": "1/sr", "options": gonio.plain(fab.options)}))
+        return 0
     print(f"f_r [1/sr]  R {f[0]:.9g}  G {f[1]:.9g}  B {f[2]:.9g}")
     return 0
 

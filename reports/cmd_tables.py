@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 import gonio
@@ -25,6 +27,7 @@ def register(sub):
                        description="Print a table's source, size, angle ranges (degrees), "
                                    "value ranges and missing values.")
     q.add_argument("file", metavar="FILE")
+    q.add_argument("--json", action="store_true", help="print the facts as JSON (scripts)")
     _reader_options(q)
     q.set_defaults(func=run_info)
 
@@ -53,34 +56,57 @@ def run_convert(args):
     return 0
 
 
-def describe(table) -> str:
-    """A few lines on what a table holds (used by ``microcyl info``)."""
+def table_facts(table) -> dict:
+    """What a table holds, as plain data (``microcyl info --json``): angles in degrees over
+    the rows with data, value ranges per channel (f_r in the table's units), missing counts."""
     ang = np.degrees(table.angles)
-    lines = [f"source: {table.meta.get('source', 'unknown')}",
-             f"format: {table.meta.get('file_format', 'unknown')}",
-             f"rows: {len(table)}",
-             f"units: {table.meta.get('units', '1/sr')}"]
     valid = table.valid
     data = valid.any(axis=1)          # a MERL file lists its empty bins below the horizon too
-    note = "" if data.all() else " (rows with data)"
     sel = ang[data] if data.any() else ang
-    for k, name in enumerate(("theta_i", "phi_i", "theta_o", "phi_o")):
-        lines.append(f"{name}: {sel[:, k].min():.4g} .. {sel[:, k].max():.4g} deg{note}")
+    values = {}
     for c, name in enumerate("RGB"):
         v = table.values[valid[:, c], c]
-        rng = f"{v.min():.6g} .. {v.max():.6g}" if v.size else "none valid"
-        lines.append(f"{name}: {rng}")
-    n_nan = int(np.count_nonzero(np.isnan(table.values)))
-    n_neg = int(np.count_nonzero(table.values < 0))
-    n_inf = int(np.count_nonzero(np.isinf(table.values)))
-    lines.append(f"missing values: {int(np.count_nonzero(~valid))} of {valid.size} "
-                 f"(NaN {n_nan}, negative {n_neg}, infinite {n_inf}); rows with any: "
-                 f"{int(np.count_nonzero(~valid.all(axis=1)))}")
-    lines.append("sigma: " + ("none" if table.sigma is None else
-                              f"{np.nanmin(table.sigma):.6g} .. {np.nanmax(table.sigma):.6g}"))
+        values[name] = [float(v.min()), float(v.max())] if v.size else None
+    return {
+        "source": str(table.meta.get("source", "unknown")),
+        "format": str(table.meta.get("file_format", "unknown")),
+        "rows": len(table), "units": str(table.meta.get("units", "1/sr")),
+        "angles_deg": {name: [float(sel[:, k].min()), float(sel[:, k].max())]
+                       for k, name in enumerate(("theta_i", "phi_i", "theta_o", "phi_o"))},
+        "angles_over": "all rows" if data.all() else "rows with data",
+        "values": values,
+        "missing": {"values": int(np.count_nonzero(~valid)), "of": int(valid.size),
+                    "nan": int(np.count_nonzero(np.isnan(table.values))),
+                    "negative": int(np.count_nonzero(table.values < 0)),
+                    "infinite": int(np.count_nonzero(np.isinf(table.values))),
+                    "rows_with_any": int(np.count_nonzero(~valid.all(axis=1)))},
+        "sigma": None if table.sigma is None else [float(np.nanmin(table.sigma)),
+                                                   float(np.nanmax(table.sigma))],
+    }
+
+
+def describe(table) -> str:
+    """A few lines on what a table holds (used by ``microcyl info``)."""
+    f = table_facts(table)
+    note = "" if f["angles_over"] == "all rows" else " (rows with data)"
+    lines = [f"source: {f['source']}", f"format: {f['format']}", f"rows: {f['rows']}",
+             f"units: {f['units']}"]
+    lines += [f"{k}: {lo:.4g} .. {hi:.4g} deg{note}" for k, (lo, hi) in f["angles_deg"].items()]
+    lines += [f"{k}: " + ("none valid" if r is None else f"{r[0]:.6g} .. {r[1]:.6g}")
+              for k, r in f["values"].items()]
+    m = f["missing"]
+    lines.append(f"missing values: {m['values']} of {m['of']} (NaN {m['nan']}, negative "
+                 f"{m['negative']}, infinite {m['infinite']}); rows with any: "
+                 f"{m['rows_with_any']}")
+    lines.append("sigma: " + ("none" if f["sigma"] is None else
+                              f"{f['sigma'][0]:.6g} .. {f['sigma'][1]:.6g}"))
     return "\n".join(lines)
 
 
 def run_info(args):
-    print(describe(_read(args, args.file)))
+    table = _read(args, args.file)
+    if args.json:
+        print(json.dumps(gonio.plain(table_facts(table), nonfinite="null"), indent=1))
+    else:
+        print(describe(table))
     return 0

@@ -106,3 +106,19 @@ def test_version_and_a_closed_pipe(tmp_path):
                        stderr=subprocess.PIPE, text=True, timeout=120)
     os.close(w)
     assert p.returncode == 0 and "BrokenPipe" not in p.stderr and p.stderr == ""
+
+
+def test_json_of_fabrics_and_eval(capsys):
+    assert main(["fabrics", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert set(doc["fabrics"]) == set(brdf.PRESETS) and doc["units"]["gamma_s"] == "deg"
+    warp = doc["fabrics"]["polyester_satin_charmeuse"][0]
+    assert warp["eta"] == 1.539 and warp["gamma_s"] == 2.5          # Table II
+    assert warp["offsets"] == [-32, -32, -18, 0, 0, 18, 32, 32]
+    assert main(["eval", "silk_shot", "--wi", "20,10", "--wo", "50,200", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    expect = brdf.fabric("silk_shot").eval(
+        brdf.directions.from_angles(math.radians(20), math.radians(10)),
+        brdf.directions.from_angles(math.radians(50), math.radians(200)))
+    np.testing.assert_allclose(out["f_r"], expect, rtol=1e-15)
+    assert out["unit"] == "1/sr" and out["wi_deg"] == [20.0, 10.0]

@@ -61,3 +61,18 @@ def test_info_of_a_measured_merl_file_stays_above_the_horizon(tmp_path, capsys):
     for name in ("theta_i", "theta_o"):
         line = next(ln for ln in text.splitlines() if ln.startswith(name + ":"))
         assert float(line.split("..")[1].split()[0]) <= 90.0 and "(rows with data)" in line
+
+
+def test_info_json(tmp_path, capsys):
+    import json
+    src = tmp_path / "t.csv"
+    table = random_table(0)
+    gonio.write(table, src)
+    assert main(["info", str(src), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    back = gonio.read(src)
+    assert doc["rows"] == 50 and doc["missing"]["nan"] == 1 and doc["missing"]["negative"] == 1
+    theta_o = np.degrees(back.angles[:, 2])
+    assert doc["angles_deg"]["theta_o"] == [theta_o.min(), theta_o.max()]
+    g = back.values[back.valid[:, 1], 1]
+    assert doc["values"]["G"] == [g.min(), g.max()]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import importlib.metadata
+import logging
 import os
 import sys
 
@@ -53,11 +54,27 @@ def build_parser() -> argparse.ArgumentParser:
                     "(Sadeghi et al., ACM TOG 2013).",
     )
     parser.add_argument("--version", action="version", version=f"microcyl {_version()}")
+    noise = parser.add_mutually_exclusive_group()
+    noise.add_argument("-v", "--verbose", action="store_true", dest="log_verbose",
+                       help="more diagnostics on stderr (logging level DEBUG)")
+    noise.add_argument("-q", "--quiet", action="store_true", dest="log_quiet",
+                       help="only warnings and errors on stderr (no 'wrote ...' lines)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(sub)
     return parser
+
+
+def _configure_logging(args) -> None:
+    """Diagnostics ("wrote FILE", what a verb is about to do) go through the ``microcyl``
+    logger to stderr: INFO by default, DEBUG with -v, WARNING with -q. Results go to stdout."""
+    log = logging.getLogger("microcyl")
+    log.handlers[:] = [logging.StreamHandler(sys.stderr)]
+    log.handlers[0].setFormatter(logging.Formatter("%(message)s"))
+    log.propagate = False
+    log.setLevel(logging.DEBUG if getattr(args, "log_verbose", False)
+                 else logging.WARNING if getattr(args, "log_quiet", False) else logging.INFO)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -76,6 +93,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     parser = build_parser()
     args = parser.parse_args(argv)
+    _configure_logging(args)
     try:
         status = args.func(args)
         sys.stdout.flush()                # a closed pipe surfaces here, not at exit

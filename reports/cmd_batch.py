@@ -10,6 +10,7 @@ The work is :func:`analysis.batch.run_batch`; this module parses the arguments a
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import brdf
@@ -18,6 +19,8 @@ from reports import cliutil
 from reports.report_batch import write_batch_page
 
 __all__ = ["register", "run"]
+
+log = logging.getLogger("microcyl")
 
 
 def register(sub):
@@ -65,7 +68,7 @@ def run(args) -> int:
         fabric_options=fab.options,
         read_options={} if args.rgl_step is None else {"step": args.rgl_step},
         plots=plots)
-    print(f"fit-batch: {len(jobs)} tables into {out}")
+    log.info(f"fit-batch: {len(jobs)} tables into {out}")
     summary = run_batch(jobs, out, workers=args.workers, scheduler=args.scheduler,
                         progress=not args.no_progress)
     page = write_batch_page(out)

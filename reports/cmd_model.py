@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,8 @@ import gonio
 from reports import cliutil
 from reports.report_batch import write_batch_page
 from reports.standard import STANDARD_GEOMETRIES, standard_values
+
+log = logging.getLogger("microcyl")
 
 
 def register(sub):
@@ -121,7 +124,7 @@ def run_report(args):
     from reports.report import build_report
 
     if args.batch is not None:
-        print(f"batch page: {write_batch_page(args.batch)}")
+        log.info(f"wrote the batch page {write_batch_page(args.batch)}")
         return 0
     names = tuple(dict.fromkeys(args.fabric)) if args.fabric else brdf.PRESETS
     fits = {}
@@ -141,5 +144,5 @@ def run_report(args):
         vals = standard_values(brdf.fabric(name))
         lum = luminance(np.array(list(vals.values()), dtype=np.float64)).tolist()
         print(f"{name:31s} " + " ".join(f"{x:19.6g}" for x in lum))
-    print(f"wrote {index} (data: {index.parent / 'summary.json'})")
+    log.info(f"wrote {index} (data: {index.parent / 'summary.json'})")
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
 import os
 from pathlib import Path
@@ -17,6 +18,8 @@ from analysis.reciprocity import reciprocity_report
 from gonio.atomic import atomic_write
 from reports import cliutil
 from reports.prose import energy_statements, reciprocity_statements
+
+log = logging.getLogger("microcyl")
 
 FELTS = ("acrylic_felt_white_rgb.bsdf", "acrylic_felt_pink_rgb.bsdf",
          "acrylic_felt_purple_rgb.bsdf")
@@ -208,7 +211,7 @@ def run_energy(args) -> int:
     print(format_energy(doc))
     if target is not None:
         write_json(target, doc)
-        print(f"wrote {target}")
+        log.info(f"wrote {target}")
     return 0
 
 
@@ -274,7 +277,7 @@ def run_reciprocity(args) -> int:
     print(format_reciprocity(doc))
     if target is not None:
         write_json(target, doc)
-        print(f"wrote {target}")
+        log.info(f"wrote {target}")
     return 0
 
 
@@ -300,5 +303,5 @@ def run_sanity(args) -> int:
         print("\n".join(format_sanity(name, r)))
     if target is not None:
         write_json(target, {name: r.to_dict() for name, r in results.items()})
-        print(f"wrote {target}")
+        log.info(f"wrote {target}")
     return 0 if all(r.ok for r in results.values()) else 1

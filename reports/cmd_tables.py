@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import json
+import logging
 
 import numpy as np
 
 import gonio
+
+log = logging.getLogger("microcyl")
 
 
 def register(sub):
@@ -52,7 +55,7 @@ def run_convert(args):
             raise ValueError("--alta-param applies to an .alta output only")
         options["param"] = args.alta_param
     gonio.write(table, args.output, **options)
-    print(f"wrote {len(table)} rows to {args.output}")
+    log.info(f"wrote {len(table)} rows to {args.output}")
     return 0
 
 

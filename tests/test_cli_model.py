@@ -64,8 +64,8 @@ def test_report_writes_html_and_summary(tmp_path, capsys):
     np.testing.assert_allclose(std["specular 30 warp"], brdf.fabric("velvet").eval(wi, wo),
                                rtol=1e-12)
     assert data["fabrics"]["velvet"]["parameters"]["threads"][1]["offsets"] == [-90, -55, 55, 90]
-    printed = capsys.readouterr().out
-    assert "velvet" in printed and "index.html" in printed
+    printed = capsys.readouterr()
+    assert "velvet" in printed.out and "index.html" in printed.err   # "wrote": a diagnostic
 
 
 def test_report_bad_fit_argument(tmp_path, capsys):
@@ -122,3 +122,23 @@ def test_json_of_fabrics_and_eval(capsys):
         brdf.directions.from_angles(math.radians(50), math.radians(200)))
     np.testing.assert_allclose(out["f_r"], expect, rtol=1e-15)
     assert out["unit"] == "1/sr" and out["wi_deg"] == [20.0, 10.0]
+
+
+def test_diagnostics_through_logging(tmp_path):
+    """'wrote ...' lines are diagnostics on stderr: shown by default, gone with -q; the
+    result itself stays on stdout."""
+    import os
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root)
+    out = tmp_path / "v.json"
+
+    def run(*flags):
+        return subprocess.run([sys.executable, "-m", "reports", *flags, "sanity", "velvet",
+                               "--json", str(out)], env=env, capture_output=True, text=True,
+                              timeout=300)
+    loud, quiet = run(), run("-q")
+    assert loud.returncode == quiet.returncode == 0, loud.stderr
+    assert f"wrote {out}" in loud.stderr and "wrote" not in quiet.stderr
+    assert "velvet" in quiet.stdout and quiet.stdout == loud.stdout

@@ -177,6 +177,8 @@ def _pdf_flat(fabric, wi, wo):
     t0, b = _axes(fabric)
     sig = _sigmas(fabric)
     masking = fabric.options["masking"]
+    if wo.shape[0] > 1 and np.all(wo == wo[:1]):
+        wo = wo[:1]                     # one viewer (the common case): its terms once
     total = COSINE_SHARE / np.pi * np.maximum(wi[:, 2], 0.0)
     for j, c in enumerate(fabric._const):
         if thread[j] == 0.0:
@@ -191,6 +193,7 @@ def _pdf_flat(fabric, wi, wo):
         br = wo @ b[j]                                    # only theta_r of wo is needed
         mu = -np.arctan2(sr, np.sqrt(xr * xr + br[:, None] ** 2))
         th = np.arctan2(si, cth)
+        scale = [_GAUSS_NORM / (s * _gauss_mass(mu, s)) for s in sig[j]]
         # p_phi / cos(theta) and p_phi for the two parametrizations
         if masking:
             pphi = np.maximum(xi, 0.0) / (2.0 * cth)
@@ -200,7 +203,7 @@ def _pdf_flat(fabric, wi, wo):
         for k in range(2):
             s = sig[j, k]
             z = (th - mu) / s
-            g = np.exp(-0.5 * z * z) * (_GAUSS_NORM / s) / _gauss_mass(mu, s)
+            g = np.exp(-0.5 * z * z) * scale[k]
             dens = dens + lobe[j, k] * g / cth
         total += thread[j] * ((dens * pphi) @ c.weight)
     return total

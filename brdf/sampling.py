@@ -66,7 +66,8 @@ def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
     -------
     thread : ndarray, shape (2,)
         Probability of choosing each thread's lobes; ``thread.sum() = 1 - COSINE_SHARE``
-        (1 - COSINE_SHARE is spread over the threads with area > 0).
+        (1 - COSINE_SHARE is spread over the threads with area > 0; with none, it is 0 and
+        the cosine-weighted part takes all: its probability is ``1 - thread.sum()``).
     lobe : ndarray, shape (2, 3)
         Within a thread, the probabilities of the surface, volume and isotropic lobes
         (rows sum to 1).
@@ -179,7 +180,7 @@ def _pdf_flat(fabric, wi, wo):
     masking = fabric.options["masking"]
     if wo.shape[0] > 1 and np.all(wo == wo[:1]):
         wo = wo[:1]                     # one viewer (the common case): its terms once
-    total = COSINE_SHARE / np.pi * np.maximum(wi[:, 2], 0.0)
+    total = (1.0 - thread.sum()) / np.pi * np.maximum(wi[:, 2], 0.0)
     for j, c in enumerate(fabric._const):
         if thread[j] == 0.0:
             continue
@@ -234,7 +235,7 @@ def _components(fabric):
     tangent offset (cos, sin) and kind (0 surface, 1 volume, 2 isotropic). Component 0 is
     the cosine-weighted hemisphere."""
     thread, lobe = lobe_probabilities(fabric)
-    prob, jj, ca, sa, kind = [COSINE_SHARE], [0], [1.0], [0.0], [-1]
+    prob, jj, ca, sa, kind = [1.0 - thread.sum()], [0], [1.0], [0.0], [-1]
     for j, c in enumerate(fabric._const):
         if thread[j] == 0.0:
             continue

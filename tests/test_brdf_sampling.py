@@ -187,6 +187,15 @@ def test_weight_is_fr_cos_over_pdf(variant, record_property):
     assert largest < (10.0 if fab.options["masking"] else 20.0)
 
 
+def test_no_thread_area_samples_the_cosine_part_only():
+    t = brdf.preset_threads("linen_plain")[0].replace(area=0.0)
+    fab = brdf.Fabric((t, t))
+    wo = _wo(40.0, 10.0)
+    wi, weight, p = fab.sample(wo, np.random.default_rng(0).random((200, 2)))
+    np.testing.assert_allclose(p, wi[:, 2] / np.pi, rtol=1e-12)
+    assert np.all(wi[:, 2] > 0) and np.all(weight == 0)      # f_r = 0 without threads
+
+
 def test_pdf_positive_where_fr_positive():
     wi, wo = random_pairs(4000, np.random.default_rng(4))
     for name in brdf.PRESETS:

@@ -1,10 +1,11 @@
 """brdf: the microcylinder cloth BRDF of Sadeghi, Bisker, De Deken and Jensen (2013).
 
 The model as ``../shared/spec/MODEL.md`` specifies it: threads with tangent curves, fabrics
-of two threads, the paper's six presets, and every variant. NumPy and SciPy only.
+of two threads, the paper's six presets, and every variant; importance sampling of a fabric
+(:mod:`brdf.sampling`: ``Fabric.sample``, ``Fabric.pdf``). NumPy and SciPy only.
 """
 
-from brdf import directions, frames, schema, terms
+from brdf import directions, frames, sampling, schema, terms
 from brdf.curve import SAMPLING_METHODS, TangentCurve
 from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
 from brdf.presets import PRESETS, fabric, preset_threads
@@ -14,5 +15,5 @@ from brdf.thread import Thread
 __all__ = [
     "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
-    "schema", "terms", "BRDF", "ThreadedBRDF",
+    "schema", "terms", "sampling", "BRDF", "ThreadedBRDF",
 ]

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from brdf import schema, validate
+from brdf import sampling, schema, validate
 from brdf.curve import SAMPLING_METHODS
 from brdf.frames import flat_pairs
 from brdf.kernel import thread_geometry
@@ -264,6 +264,29 @@ class Fabric:
         combine_rgb([s[0][None] for s in shades], [s[1][None] for s in shades], area,
                     albedo, inv[None], out)
         return out[0]
+
+    # -- importance sampling (brdf/sampling.py) ------------------------------------------
+    def sample(self, wo, u):
+        r"""Draw directions toward the light: ``(wi, weight, pdf)``, see :func:`brdf.sampling.sample`.
+
+        ``u`` (..., 2) uniform in [0, 1); ``weight`` = f_r cos(theta_i) / pdf (RGB); ``pdf``
+        in 1/sr.
+
+        Examples
+        --------
+        >>> import brdf
+        >>> fab = brdf.fabric("velvet")
+        >>> wo = brdf.directions.from_angles(np.radians(60), 0.0)
+        >>> wi, weight, pdf = fab.sample(wo, np.random.default_rng(0).random((4, 2)))
+        >>> bool(np.allclose(pdf, fab.pdf(wo, wi)))
+        True
+        """
+        return sampling.sample(self, wo, u)
+
+    def pdf(self, wo, wi) -> np.ndarray:
+        """Density (1/sr) of :meth:`sample`'s directions wi for the viewer wo, see
+        :func:`brdf.sampling.pdf`."""
+        return sampling.pdf(self, wo, wi)
 
     def prepare(self, wi, wo) -> "Prepared":
         """Precompute the geometry of fixed pairs for repeated shading (fits).

@@ -1,0 +1,263 @@
+"""brdf.sampling: sample against pdf (chi-square, as pbrt-v4 and Mitsuba check theirs), the
+pdf's normalization on the sphere, the weights, and a Monte Carlo albedo against
+analysis.albedo."""
+
+import math
+import zlib
+
+import numpy as np
+import pytest
+from scipy import stats
+
+import analysis
+import brdf
+from _chi2 import cell_integrals, chi2_pvalue, histogram, sidak
+from spec_reference import curve_samples, random_pairs
+
+#: Variants that change what the sampler draws (masking shapes the azimuth; the tangent
+#: rule and the rotation move the lobes).
+DRAW_VARIANTS = [{}, {"masking": False}, {"tangent_sampling": "control_points"},
+                 {"tangent_samples": 5}, {"rotation": 0.7}]
+#: Variants that change f_r only: the sampler is that of the base variant (second item).
+F_ONLY_VARIANTS = [({"reweighting": False}, {}), ({"transmission": "longitudinal"}, {}),
+                   ({"gap": "outgoing"}, {}),
+                   ({"masking": False, "reweighting": False}, {"masking": False})]
+ALL_VARIANTS = DRAW_VARIANTS + [v for v, _ in F_ONLY_VARIANTS]
+#: Viewer directions (theta_o, phi_o) in degrees: normal, oblique, grazing along -warp.
+WOS = [(0.0, 0.0), (50.0, 20.0), (85.0, 180.0)]
+CHI2_CASES = [(p, v, wo) for p in brdf.PRESETS for v in DRAW_VARIANTS for wo in WOS]
+CHI2_CASES += [(p, {}, (85.0, 45.0)) for p in brdf.PRESETS]
+ALPHA = 0.01                                       # family-wise significance
+N_CHI2 = 40_000
+
+
+def _id(v):
+    return "-".join(f"{k}={x}" for k, x in v.items()) or "default"
+
+
+def _wo(theta_deg, phi_deg):
+    return brdf.directions.from_angles(math.radians(theta_deg), math.radians(phi_deg))
+
+
+def _seed(*parts):
+    return zlib.crc32(repr(parts).encode())
+
+
+# -- chi-square goodness of fit -----------------------------------------------------------
+@pytest.mark.parametrize("name,variant,wo", CHI2_CASES,
+                         ids=[f"{p}-{_id(v)}-{wo[0]:g},{wo[1]:g}" for p, v, wo in CHI2_CASES])
+def test_chi2_sample_matches_pdf(name, variant, wo):
+    fab = brdf.fabric(name, **variant)
+    w = _wo(*wo)
+    u = np.random.default_rng(_seed(name, variant, wo)).random((N_CHI2, 2))
+    wi, _, _ = fab.sample(w, u)
+    expected = N_CHI2 * cell_integrals(lambda d: fab.pdf(w, d), tol=1e-6)
+    assert expected.sum() == pytest.approx(N_CHI2, rel=2e-3)
+    stat, dof, p = chi2_pvalue(histogram(wi), expected)
+    level = sidak(ALPHA, len(CHI2_CASES))
+    assert p > level, f"chi2 = {stat:.1f} on {dof} dof, p = {p:.3g} < {level:.3g}"
+
+
+@pytest.mark.parametrize("variant,base", F_ONLY_VARIANTS, ids=[_id(v) for v, _ in F_ONLY_VARIANTS])
+def test_f_only_variants_draw_as_their_base(variant, base):
+    # these variants change f_r, not the sampler: same directions, same pdf as the base
+    # (whose draws the chi-square tests check), so only the weights differ.
+    u = np.random.default_rng(3).random((500, 2))
+    for name in brdf.PRESETS:
+        w = _wo(85.0, 180.0)
+        a = brdf.fabric(name, **variant).sample(w, u)
+        b = brdf.fabric(name, **base).sample(w, u)
+        np.testing.assert_array_equal(a[0], b[0])
+        np.testing.assert_array_equal(a[2], b[2])
+
+
+def test_chi2_detects_a_wrong_pdf():
+    # the test has power: samples against the pdf of a viewer 8 degrees off, or against the
+    # pdf without masking's cos-shaped azimuth, fail it.
+    fab = brdf.fabric("silk_shot")
+    w = _wo(50.0, 20.0)
+    wi, _, _ = fab.sample(w, np.random.default_rng(0).random((N_CHI2, 2)))
+    for other, w2 in ((fab, _wo(58.0, 20.0)), (fab.replace(masking=False), w)):
+        expected = N_CHI2 * cell_integrals(lambda d: other.pdf(w2, d), tol=1e-6)
+        assert chi2_pvalue(histogram(wi), expected)[2] < 1e-6
+
+
+def test_chi2_pooling_by_hand():
+    obs = [3, 2, 10, 20]
+    exp = [1.0, 4.5, 9.5, 20.0]
+    # 1.0 + 4.5 pooled (5.5), then 9.5, 20: three cells, two dof
+    stat, dof, p = chi2_pvalue(obs, exp)
+    want = (5 - 5.5) ** 2 / 5.5 + (10 - 9.5) ** 2 / 9.5 + 0.0
+    assert dof == 2 and stat == pytest.approx(want)
+    assert p == pytest.approx(stats.chi2.sf(want, 2))
+
+
+# -- the pdf integrates to 1 over the sphere ----------------------------------------------
+PDF_CASES = [(p, v, wo) for p in brdf.PRESETS for v in ({}, {"masking": False})
+             for wo in ((0.0, 0.0), (85.0, 180.0))]
+
+
+@pytest.mark.parametrize("name,variant,wo", PDF_CASES,
+                         ids=[f"{p}-{_id(v)}-{wo[0]:g}" for p, v, wo in PDF_CASES])
+def test_pdf_integrates_to_one(name, variant, wo, record_property):
+    fab = brdf.fabric(name, **variant)
+    w = _wo(*wo)
+    cells = cell_integrals(lambda d: fab.pdf(w, d), tol=2e-7)
+    total = cells.sum()
+    below = cells[: cells.shape[0] // 2].sum()       # cos(theta) < 0: wasted draws
+    record_property("mass_below_horizon", float(below))
+    print(f"{name} {_id(variant)} theta_o={wo[0]:g}: integral {total:.6f}, below the "
+          f"horizon {below:.4f}")
+    # the adaptive rule converges from below at the integrable 1/cos(theta) peaks at the
+    # tangents (narrow lobes ending at the horizon: 1.7e-4 short for the charmeuse at
+    # theta_o = 85 with tol 2e-7, 6e-6 with a 7-point rule)
+    assert total == pytest.approx(1.0, abs=3e-4)
+    assert 0.0 <= below < 0.75
+    # the share of draws below the horizon is that mass
+    wi, weight, _ = fab.sample(w, np.random.default_rng(5).random((20_000, 2)))
+    frac = np.mean(wi[:, 2] < 0)
+    assert abs(frac - below) < 5 * math.sqrt(below * (1 - below) / 20_000) + 1e-3
+    assert np.all(weight[wi[:, 2] <= 0] == 0)
+
+
+# -- an independent transliteration of the pdf -------------------------------------------
+def reference_pdf(fabric, wo, wi):
+    """The mixture density of one pair, written from MODEL.md's angles and scipy.stats."""
+    share, lobe = brdf.sampling.lobe_probabilities(fabric)
+    opts = fabric.options
+    total = brdf.sampling.COSINE_SHARE * max(wi[2], 0.0) / math.pi
+    rot = opts["rotation"]
+    n = np.array([0.0, 0.0, 1.0])
+    for j, th in enumerate(fabric.threads):
+        ang = rot + j * math.pi / 2
+        t0 = np.array([math.cos(ang), math.sin(ang), 0.0])
+        b = np.cross(n, t0)
+        alphas = curve_samples(th.offsets, th.lengths, opts["tangent_samples"],
+                               opts["tangent_sampling"])
+        for a in alphas:
+            t = math.cos(a) * t0 + math.sin(a) * n
+            nt = math.cos(a) * n - math.sin(a) * t0
+            theta_i = math.asin(np.clip(wi @ t, -1, 1))
+            theta_r = math.asin(np.clip(wo @ t, -1, 1))
+            phi = math.atan2(wi @ b, wi @ nt)
+            p_phi = max(math.cos(phi), 0.0) / 2 if opts["masking"] else 1 / (2 * math.pi)
+            dens = lobe[j, 2] / 2
+            for k, gamma in enumerate((th.gamma_s, th.gamma_v)):
+                sd = 2 * math.radians(gamma)
+                lo, hi = (-math.pi / 2 + theta_r) / sd, (math.pi / 2 + theta_r) / sd
+                g = stats.truncnorm.pdf(theta_i, lo, hi, loc=-theta_r, scale=sd)
+                dens += lobe[j, k] * g / math.cos(theta_i)
+            total += share[j] * dens * p_phi / len(alphas)
+    return total
+
+
+@pytest.mark.parametrize("variant", ALL_VARIANTS, ids=[_id(v) for v in ALL_VARIANTS])
+def test_pdf_matches_reference(variant):
+    rng = np.random.default_rng(11)
+    wi, wo = random_pairs(12, rng)
+    wi = wi * np.where(rng.random(12) < 0.3, -1.0, 1.0)[:, None]   # some below the horizon
+    for name in brdf.PRESETS:
+        fab = brdf.fabric(name, **variant)
+        got = fab.pdf(wo, wi)
+        want = [reference_pdf(fab, b, a) for a, b in zip(wi, wo)]
+        np.testing.assert_allclose(got, want, rtol=1e-9)
+
+
+# -- weights -------------------------------------------------------------------------------
+@pytest.mark.parametrize("variant", ALL_VARIANTS, ids=[_id(v) for v in ALL_VARIANTS])
+def test_weight_is_fr_cos_over_pdf(variant, record_property):
+    u = np.random.default_rng(2).random((3000, 2))
+    largest = 0.0
+    for name in brdf.PRESETS:
+        fab = brdf.fabric(name, **variant)
+        for wo in ((0.0, 0.0), (30.0, 100.0), (85.0, 180.0), (89.0, 45.0)):
+            w = _wo(*wo)
+            wi, weight, p = fab.sample(w, u)
+            np.testing.assert_allclose(np.linalg.norm(wi, axis=-1), 1.0, rtol=1e-12)
+            np.testing.assert_allclose(p, fab.pdf(w, wi), rtol=1e-12)
+            f = fab.eval(wi, w)
+            want = f * np.maximum(wi[:, 2], 0.0)[:, None] / p[:, None]
+            np.testing.assert_allclose(weight, want, rtol=1e-12, atol=0)
+            assert np.all(p > 0) and np.all(np.isfinite(weight)) and np.all(weight >= 0)
+            assert np.all(p[f.max(axis=-1) > 0] > 0)
+            largest = max(largest, float(weight.max()))
+    record_property("largest_weight", largest)
+    # largest seen: about 6.5 with masking, 14.7 without (f_r cos(theta_i) peaks where Q
+    # vanishes at the horizon, near the mirror direction of a grazing viewer)
+    assert largest < (10.0 if fab.options["masking"] else 20.0)
+
+
+def test_no_thread_area_samples_the_cosine_part_only():
+    t = brdf.preset_threads("linen_plain")[0].replace(area=0.0)
+    fab = brdf.Fabric((t, t))
+    wo = _wo(40.0, 10.0)
+    wi, weight, p = fab.sample(wo, np.random.default_rng(0).random((200, 2)))
+    np.testing.assert_allclose(p, wi[:, 2] / np.pi, rtol=1e-12)
+    assert np.all(wi[:, 2] > 0) and np.all(weight == 0)      # f_r = 0 without threads
+
+
+def test_pdf_positive_where_fr_positive():
+    wi, wo = random_pairs(4000, np.random.default_rng(4))
+    for name in brdf.PRESETS:
+        fab = brdf.fabric(name)
+        pos = fab.eval(wi, wo).max(axis=-1) > 0
+        assert np.all(fab.pdf(wo, wi)[pos] > 0)
+
+
+# -- Monte Carlo albedo ---------------------------------------------------------------------
+MC_CASES = [(p, {}, wo) for p in brdf.PRESETS for wo in ((0.0, 0.0), (60.0, 30.0), (85.0, 180.0))]
+MC_CASES += [(p, v, (85.0, 45.0)) for p in brdf.PRESETS for v in ALL_VARIANTS[1:]]
+N_MC = 40_000
+
+
+@pytest.mark.parametrize("name,variant,wo", MC_CASES,
+                         ids=[f"{p}-{_id(v)}-{wo[0]:g}" for p, v, wo in MC_CASES])
+def test_mc_albedo_matches_analysis(name, variant, wo):
+    fab = brdf.fabric(name, **variant)
+    w = _wo(*wo)
+    u = np.random.default_rng(_seed("mc", name, variant, wo)).random((N_MC, 2))
+    _, weight, _ = fab.sample(w, u)
+    mean = weight.mean(axis=0)
+    se = weight.std(axis=0, ddof=1) / math.sqrt(N_MC)
+    ref = analysis.albedo(fab, w)
+    z = stats.norm.isf(0.5 * sidak(ALPHA, 3 * len(MC_CASES)))
+    np.testing.assert_array_less(np.abs(mean - ref.value), z * se + ref.error + 1e-12)
+
+
+# -- interface -------------------------------------------------------------------------------
+def test_shapes_broadcasting_and_determinism():
+    fab = brdf.fabric("velvet")
+    wo = brdf.directions.from_angles(np.radians([10.0, 70.0]), 0.0)       # (2, 3)
+    u = np.random.default_rng(0).random((5, 1, 2))
+    wi, weight, p = fab.sample(wo, u)
+    assert wi.shape == (5, 2, 3) and weight.shape == (5, 2, 3) and p.shape == (5, 2)
+    again = fab.sample(wo, u)
+    for a, b in zip((wi, weight, p), again):
+        assert a.tobytes() == b.tobytes()
+    assert fab.pdf(wo, wi).shape == (5, 2)
+    wi0, w0, p0 = fab.sample([0.0, 0.0, 0.0], [0.5, 0.5])
+    assert np.isnan(wi0).all() and np.isnan(w0).all() and np.isnan(p0)
+    wib, wb, pb = fab.sample([0.0, 0.6, -0.8], np.random.default_rng(1).random((50, 2)))
+    assert np.all(wb == 0) and np.all(pb > 0)            # viewer below: f_r = 0
+
+
+@pytest.mark.parametrize("u,match", [
+    (np.zeros((4, 3)), r"u must have shape \(\.\.\., 2\)"),
+    ([0.5, 1.0], r"u must lie in \[0, 1\)"),
+    ([-0.1, 0.5], r"u must lie in \[0, 1\)"),
+    ([np.nan, 0.5], r"u must lie in \[0, 1\)"),
+    (np.zeros((3, 2)), "does not broadcast"),
+    ("ab", "u must be a numeric array"),
+])
+def test_bad_u(u, match):
+    wo = np.tile([0.0, 0.0, 1.0], (2, 1))
+    with pytest.raises(ValueError, match=match):
+        brdf.fabric("linen_plain").sample(wo, u)
+
+
+def test_bad_directions():
+    fab = brdf.fabric("linen_plain")
+    with pytest.raises(ValueError, match="wo must have shape"):
+        fab.sample([0.0, 1.0], [0.5, 0.5])
+    with pytest.raises(ValueError, match="wi must have shape"):
+        fab.pdf([0.0, 0.0, 1.0], [0.0, 1.0])

@@ -1,8 +1,9 @@
-"""Time the cylinder render at 1280 x 720 and 16 samples per pixel (the issue's budget: 2 min).
+"""Time the cylinder render at 1280 x 720 and 16 samples per pixel (the issue's budget: 2 min),
+with the scene's sky (MIS of Fabric.sample and cosine directions) and without it, interleaved.
 
 Usage: python bench/bench_render.py [FABRIC] [--width W] [--height H] [--spp N] [--workers N]
-Prints the wall time.  Other work on the machine
-slows it down: note the load average printed beside the figure.
+Prints the wall times and their ratio.  Other work on the machine slows it down: note the
+load average printed beside the figures.
 """
 
 import argparse
@@ -12,6 +13,7 @@ import time
 import numpy as np
 
 import reports.render as R
+from reports.scenes import make_scene
 
 
 def main():
@@ -26,15 +28,20 @@ def main():
     a = p.parse_args()
     import brdf
     fab = brdf.fabric(a.fabric, masking=a.masking == "on")
-    t0 = time.perf_counter()
-    img = R.render(a.scene, fab, width=a.width, height=a.height, spp=a.spp, workers=a.workers,
-                   progress=True)
-    dt = time.perf_counter() - t0
-    load = os.getloadavg()
-    print(f"{a.scene} {a.fabric} masking={a.masking} {a.width}x{a.height} spp={a.spp}: "
-          f"{dt:.1f} s wall (budget 120 s); mean radiance {float(np.mean(img)):.4g}; "
-          f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; "
-          f"{len(os.sched_getaffinity(0))} cores")
+    scene = make_scene(a.scene)
+    times = {}
+    for label, sc in (("sky", scene), ("key light only", scene.replace(environment=None))):
+        t0 = time.perf_counter()
+        img = R.render(sc, fab, width=a.width, height=a.height, spp=a.spp, workers=a.workers,
+                       progress=True)
+        times[label] = dt = time.perf_counter() - t0
+        load = os.getloadavg()
+        print(f"{a.scene} {a.fabric} masking={a.masking} {a.width}x{a.height} spp={a.spp}, "
+              f"{label}: {dt:.1f} s wall (budget 120 s); mean radiance "
+              f"{float(np.mean(img)):.4g}; load average {load[0]:.2f} {load[1]:.2f} "
+              f"{load[2]:.2f}; {len(os.sched_getaffinity(0))} cores")
+    if scene.environment is not None:
+        print(f"the sky costs {times['sky'] / times['key light only']:.2f} x the key light alone")
 
 
 if __name__ == "__main__":

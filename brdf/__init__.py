@@ -9,11 +9,11 @@ from brdf import directions, frames, sampling, schema, terms
 from brdf.curve import SAMPLING_METHODS, TangentCurve
 from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
 from brdf.presets import PRESETS, fabric, preset_threads
-from brdf.protocols import BRDF, ThreadedBRDF
+from brdf.protocols import BRDF, SampledBRDF, ThreadedBRDF
 from brdf.thread import Thread
 
 __all__ = [
     "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
-    "schema", "terms", "sampling", "BRDF", "ThreadedBRDF",
+    "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
 ]

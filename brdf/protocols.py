@@ -11,7 +11,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["BRDF", "ThreadedBRDF"]
+__all__ = ["BRDF", "ThreadedBRDF", "SampledBRDF"]
 
 
 @runtime_checkable
@@ -35,3 +35,22 @@ class ThreadedBRDF(BRDF, Protocol):
 
     def eval_threads(self, wi, wo) -> np.ndarray:
         """Per-thread RGB f_r in 1/sr, threads on the second-to-last axis."""
+
+
+@runtime_checkable
+class SampledBRDF(BRDF, Protocol):
+    """A BRDF with importance sampling: ``sample(wo, u) -> (wi, weight, pdf)`` and
+    ``pdf(wo, wi)`` in 1/sr (as :meth:`brdf.Fabric.sample` and :meth:`brdf.Fabric.pdf`).
+
+    Examples
+    --------
+    >>> import brdf
+    >>> isinstance(brdf.fabric("velvet"), SampledBRDF)
+    True
+    """
+
+    def sample(self, wo, u):
+        """Directions toward the light, ``f_r cos / pdf`` (RGB) and the pdf (1/sr)."""
+
+    def pdf(self, wo, wi) -> np.ndarray:
+        """Density (1/sr) of ``sample``'s directions."""

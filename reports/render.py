@@ -7,9 +7,11 @@ samples that hit lit cloth reach the BRDF, in batches of one image tile at a tim
 are spread over the processor cores.  :func:`write_exr` and :func:`write_png` (from
 :mod:`reports.imageio`) save the result.
 
-Shading (one light sample per camera sample, no indirect light):
+Shading (direct light only: one key-light sample per camera sample, plus the sky when the
+scene has an environment light, :mod:`reports.envlight`, no bounces):
 
-    L_o = f_r(wi, wo) * E * cos(theta_i) * V
+    L_o = f_r(wi, wo) * E * cos(theta_i) * V  [+ the sky's, by MIS of Fabric.sample and
+                                                cosine directions]
 
 with ``E`` the light's irradiance normal to ``wi`` (point light: ``I / r^2``; disc light:
 ``I cos(theta_l) / r^2``; directional light: its irradiance), ``cos(theta_i) = n . wi``,
@@ -32,8 +34,10 @@ import numpy as np
 import brdf
 from brdf.protocols import BRDF
 from gonio.progress import progress_bar
+from reports.envlight import environment_radiance
 from reports.imageio import write_exr, write_png
 from reports.scenes import SCENES, Scene, make_scene
+from reports.tracing import intersect, occluded
 
 __all__ = ["render", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT", "SCENES",
            "resolve_fabric", "check_size"]
@@ -97,34 +101,7 @@ def resolve_fabric(fabric, **options):
     return fabric
 
 
-# --------------------------------------------------------------------------- tracing
-def _intersect(prims, o, d, tmin):
-    """Nearest hit: t (inf on a miss), primitive index and part index."""
-    n = len(o)
-    best = np.full(n, np.inf)
-    pid = np.full(n, -1, np.int16)
-    part = np.zeros(n, np.int8)
-    for k, prim in enumerate(prims):
-        t, pt = prim.intersect(o, d, tmin)
-        closer = t < best
-        best = np.where(closer, t, best)
-        pid[closer] = k
-        part[closer] = pt[closer]
-    return best, pid, part
-
-
-def _occluded(prims, o, d, tmax, tmin):
-    """True where a primitive lies between ``o`` and ``o + tmax d``."""
-    hit = np.zeros(len(o), bool)
-    for prim in prims:
-        rest = np.nonzero(~hit)[0]
-        if rest.size == 0:
-            break
-        t, _ = prim.intersect(o[rest], d[rest], tmin)
-        hit[rest] = t < tmax[rest]
-    return hit
-
-
+# --------------------------------------------------------------------------- shading
 def _sample_offsets(rng, npix, spp):
     """Stratified (n-rooks) offsets in [0, 1)^2, shape (npix, spp) each."""
     k = np.broadcast_to(np.arange(spp), (npix, spp))
@@ -133,15 +110,12 @@ def _sample_offsets(rng, npix, spp):
     return jx, jy
 
 
-def _shade(scene, fabric, o, d, rng):
-    """Radiance (m, 3) of the rays ``(o, d)``."""
+def _hits(scene, o, d):
+    """The rays' first hits: indices of the rays that hit, points, normals turned toward
+    the viewer, warps, directions to the viewer and primitive indices."""
     prims = scene.primitives
-    eps = 1e-6 * scene.scale
-    t, pid, part = _intersect(prims, o, d, eps)
-    out = np.zeros((len(o), 3))
+    t, pid, part = intersect(prims, o, d, 1e-6 * scene.scale)
     hit = np.nonzero(np.isfinite(t))[0]
-    if hit.size == 0:
-        return out
     p = o[hit] + t[hit, None] * d[hit]
     wo = -d[hit]
     n = np.empty((hit.size, 3))
@@ -151,44 +125,60 @@ def _shade(scene, fabric, o, d, rng):
         sel = pid_h == k
         if sel.any():
             n[sel], warp[sel] = prim.frame(p[sel], part[hit][sel])
-    # two-sided: face the viewer
-    cos_o = np.einsum("ij,ij->i", n, wo)
-    flip = cos_o < 0
+    flip = np.einsum("ij,ij->i", n, wo) < 0          # two-sided: face the viewer
     n[flip] *= -1
-    cos_o = np.abs(cos_o)
+    return hit, p, n, warp, wo, pid_h
+
+
+def _local(n, warp):
+    """World -> local frames (m, 3, 3): rows warp, n x warp, n."""
+    return np.stack([warp, np.cross(n, warp), n], axis=1)
+
+
+def _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng):
+    """Radiance (m, 3) from the scene's light: f_r E cos(theta_i) V (one shadow ray)."""
+    out = np.zeros((len(p), 3))
     wi, dist, E = scene.light.sample(p, rng)
     cos_i = np.einsum("ij,ij->i", n, wi)
-    lit = (cos_i > 0) & (cos_o > 0) & np.any(E > 0, axis=1)
-    idx = np.nonzero(lit)[0]
+    idx = np.nonzero((cos_i > 0) & (np.einsum("ij,ij->i", n, wo) > 0)
+                     & np.any(E > 0, axis=1))[0]
     if idx.size == 0:
         return out
     off = 1e-4 * scene.scale
-    blocked = _occluded(prims, p[idx] + off * n[idx], wi[idx], dist[idx] - 2 * off, eps)
+    blocked = occluded(scene.primitives, p[idx] + off * n[idx], wi[idx], dist[idx] - 2 * off,
+                       1e-6 * scene.scale)
     idx = idx[~blocked]
-    if idx.size == 0:
-        return out
-    rad = np.zeros((idx.size, 3))
-    is_cloth = np.array([pr.material == "cloth" for pr in prims])
-    cloth = is_cloth[pid_h[idx]]
-    # cloth: BRDF in the local frame (x = warp, y = n x warp, z = n)
-    c = idx[cloth]
+    c, di = idx[cloth[idx]], idx[~cloth[idx]]
     if c.size:
-        nn, uu = n[c], warp[c]
-        vv = np.cross(nn, uu)
-        frame = np.stack([uu, vv, nn], axis=1)                  # (m, 3, 3) rows = axes
+        frame = _local(n[c], warp[c])
         wi_l = np.einsum("mij,mj->mi", frame, wi[c])
         wo_l = np.einsum("mij,mj->mi", frame, wo[c])
         f = np.empty((c.size, 3))
         for s in range(0, c.size, BRDF_BATCH):
             f[s:s + BRDF_BATCH] = fabric.eval(wi_l[s:s + BRDF_BATCH], wo_l[s:s + BRDF_BATCH])
-        rad[cloth] = f * (E[c] * cos_i[c, None])
-    # diffuse: albedo / pi
-    dsel = ~cloth
-    if dsel.any():
-        di = idx[dsel]
-        alb = np.array([pr.albedo for pr in prims])[pid_h[di]]
-        rad[dsel] = (alb / np.pi * cos_i[di])[:, None] * E[di]
-    out[hit[idx]] = rad
+        out[c] = f * (E[c] * cos_i[c, None])
+    out[di] = (albedo[di] / np.pi * cos_i[di])[:, None] * E[di]     # diffuse: albedo / pi
+    return out
+
+
+def _shade(scene, fabric, o, d, rng):
+    """Radiance (m, 3) of the rays ``(o, d)``: the key light, plus the sky when the scene has
+    an environment light (:mod:`reports.envlight`)."""
+    out = np.zeros((len(o), 3))
+    hit, p, n, warp, wo, pid_h = _hits(scene, o, d)
+    if hit.size == 0:
+        return out
+    prims = scene.primitives
+    cloth = np.array([pr.material == "cloth" for pr in prims])[pid_h]
+    albedo = np.array([0.0 if pr.material == "cloth" else pr.albedo for pr in prims])[pid_h]
+    rad = _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng)
+    if scene.environment is not None:
+        frame = _local(n, warp)
+        rad += environment_radiance(
+            scene.environment, prims, fabric, p, n, frame,
+            np.einsum("mij,mj->mi", frame, wo), cloth, albedo, rng,
+            off=1e-4 * scene.scale, eps=1e-6 * scene.scale, batch=BRDF_BATCH)
+    out[hit] = rad
     return out
 
 

@@ -24,6 +24,10 @@ Named scenes (:data:`SCENES`, built by :func:`make_scene`):
     around the cylinder (the azimuthal direction), so ``n x warp`` runs along the axis.
     Caps: warp tangential (around the axis, concentric circles), so ``n x warp`` is radial
     (inward on the top cap); at the exact centre the warp falls back to +x.
+The curtain and the cylinder are also lit by a dim sky (:class:`reports.envlight.
+EnvironmentLight`, sampled with the fabric's importance sampling and MIS), so their shadows
+are not black; the sphere and the patch have the key light alone.
+
 ``sphere``
     The lit sphere of Disney's BRDF Explorer: a unit sphere on black, lit by one point
     light from the upper left front.  Warp along the lines of latitude (east, about the
@@ -42,13 +46,14 @@ import dataclasses
 from dataclasses import dataclass
 
 from reports.cameras import OrthographicCamera, PinholeCamera
+from reports.envlight import EnvironmentLight
 from reports.lights import DirectionalLight, PointLight
 from reports.primitives import Curtain, Cylinder, Plane, Rectangle, Sphere
 from reports.vec3 import unit as _unit
 
 __all__ = [
     "Rectangle", "Sphere", "Cylinder", "Curtain", "Plane",
-    "PinholeCamera", "OrthographicCamera", "PointLight", "DirectionalLight",
+    "PinholeCamera", "OrthographicCamera", "PointLight", "DirectionalLight", "EnvironmentLight",
     "Scene", "SCENES", "make_scene",
 ]
 
@@ -62,6 +67,7 @@ class Scene:
     light: object
     name: str = ""
     scale: float = 1.0  # typical size, sets ray epsilons
+    environment: EnvironmentLight | None = None   # the sky; None: black (key light only)
 
     def replace(self, **changes):
         """A copy with some fields changed."""
@@ -74,7 +80,7 @@ def _curtain():
                     Plane(axis=2, offset=-0.8, albedo=0.4)),
         camera=PinholeCamera(position=(0.6, 1.4, 4.2), target=(0.0, 1.15, 0.0), fov=38.0),
         light=PointLight(position=(-1.8, 3.0, 2.6), intensity=24.0, target=(0.0, 1.0, 0.0)),
-        name="curtain", scale=2.4)
+        name="curtain", scale=2.4, environment=EnvironmentLight())
 
 
 def _cylinder():
@@ -83,7 +89,7 @@ def _cylinder():
                     Plane(axis=1, offset=0.0, albedo=0.4)),
         camera=PinholeCamera(position=(0.0, 1.7, 3.4), target=(0.0, 0.55, 0.0), fov=36.0),
         light=PointLight(position=(-1.6, 2.8, 2.2), intensity=14.0, target=(0.0, 0.6, 0.0)),
-        name="cylinder", scale=1.2)
+        name="cylinder", scale=1.2, environment=EnvironmentLight())
 
 
 def _sphere():

@@ -107,7 +107,7 @@ def test_a_killed_worker_has_its_table_rescheduled_and_resumed(tmp_path):
     jobs = jobs_from_inputs([str(d)], preset=PRESET, free=FREE + ("gamma_v1",), ties=(),
                             fit={"check_every": 25, "max_steps": 3000})
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None, silence_logs=50) as cluster:
+                                  dashboard_address=":0", silence_logs=50) as cluster:
         state = {}
         killer = threading.Thread(target=_kill_when_checkpointed,
                                   args=(cluster, out, "t1", state))

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import drjit as dr  # optional dependency: this module is imported only by reports.mitsuba.register()
 import mitsuba as mi  # optional dependency, as drjit
@@ -120,6 +121,14 @@ def _wide(x):
     return mi.Float64(x) if dr.is_jit_v(x) else x
 
 
+class _Vec(NamedTuple):
+    """Components of a direction (in double precision)."""
+
+    x: object
+    y: object
+    z: object
+
+
 def _narrow(x):
     """x back in the variant's precision."""
     return mi.Float(x) if dr.is_jit_v(x) else x
@@ -146,7 +155,7 @@ def _fresnel(eta2, c):
 def _sample_terms(th, ca, sa, light, view, k):
     """One tangent sample: (surface, volume / A, P) of MODEL.md, cos(theta_i) / cos^2(theta_d)
     and M, P included."""
-    (ti, bi, zi), (to, bo, zo) = (tuple(map(_wide, w)) for w in (light, view))
+    (ti, bi, zi), (to, bo, zo) = light, view
     si, xi = ti * ca + zi * sa, zi * ca - ti * sa
     sr, xr = to * ca + zo * sa, zo * ca - to * sa
     ci, cr = dr.sqrt(xi * xi + bi * bi), dr.sqrt(xr * xr + bo * bo)
@@ -200,7 +209,9 @@ def eval_cos(k: Consts, light, view, rot_c, rot_s):
     (MODEL.md's f_r multiplied by n . wi), 0 where either direction is at or below the
     horizon or Q <= 0.
     """
-    axes_l, axes_v = thread_axes(light, rot_c, rot_s), thread_axes(view, rot_c, rot_s)
+    rc, rs = _wide(rot_c), _wide(rot_s)
+    axes_l, axes_v = (thread_axes(_Vec(*map(_wide, (w.x, w.y, w.z))), rc, rs)
+                      for w in (light, view))
     rgb = [0.0, 0.0, 0.0]
     q = 1.0
     if k.reweighting:

@@ -15,7 +15,11 @@ microcyl's ``wo`` and ``wi``. ``eval`` returns :math:`f_r(\omega_i, \omega_o)\co
 :func:`brdf.sampling.sample` does and returns ``(BSDFSample3f, f_r cos / pdf)``. The warp
 follows the surface's first tangent ``dp_du`` projected onto the tangent plane, as microcyl's
 renderer has the warp follow each primitive's tangent; ``rotation`` turns it further about n.
-The BSDF is one-sided (``FrontSide``); wrap it in Mitsuba's ``twosided`` for cloth seen from
+Mitsuba counts a draw of weight 0 as no draw, so the plugin's ``pdf`` is the density of
+the draws of nonzero weight: :func:`brdf.sampling.pdf` where :math:`f_r\cos\theta_i > 0`, 0
+elsewhere (below the horizon, where lobes spill, and where the model's f_r vanishes above it,
+as it does for velvet seen at grazing angles: every tangent sample then faces away from the
+light or the viewer). The BSDF is one-sided (``FrontSide``); wrap it in Mitsuba's ``twosided`` for cloth seen from
 both sides.
 
 :func:`plugin_dict` and :func:`fabric_from_dict` need no Mitsuba: they turn a
@@ -63,8 +67,8 @@ def plugin_dict(fabric: brdf.Fabric, preset: str | None = None) -> dict:
     Examples
     --------
     >>> d = plugin_dict(brdf.fabric("velvet"))
-    >>> d["type"], d["fabric"], d["offsets2"], d["albedo1"]["value"]
-    ('microcylinder', 'velvet', '-90, -55, 55, 90', [0.015, 0.006, 0.0])
+    >>> d["type"], d["fabric"], d["offsets2"], d["lengths2"]
+    ('microcylinder', 'velvet', '-90, -55, 55, 90', '0.5, 0, 0.5')
     >>> fabric_from_dict(d).threads == brdf.fabric("velvet").threads
     True
     """
@@ -74,14 +78,19 @@ def plugin_dict(fabric: brdf.Fabric, preset: str | None = None) -> dict:
         for key in THREAD_KEYS:
             v = getattr(t, key)
             if key == "albedo":
-                v = {"type": "rgb", "value": [round(float(c), 12) for c in v]}
+                v = {"type": "rgb", "value": [float(c) for c in v]}
             elif key in ("offsets", "lengths"):
-                v = ", ".join(f"{float(x):g}" if float(x) == round(float(x), 6) else repr(float(x))
-                              for x in v)
+                v = ", ".join(_number(x) for x in v)
             out[f"{key}{j}"] = v
     for key, v in fabric.options.items():
         out[key] = math.degrees(v) if key == "rotation" else v
     return out
+
+
+def _number(x) -> str:
+    """The shortest text that reads back as the float x ("55", "1.33")."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def _floats(key, value) -> tuple:

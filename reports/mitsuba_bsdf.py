@@ -75,6 +75,14 @@ def _make_class():
         def _frame(self, si):
             return _warp(si, self.k.rotation)
 
+        def eval_pdf(self, ctx, si, wo, active=True):
+            """f_r cos and the density of valid draws: 0 where f_r cos is 0 (module notes)."""
+            c, s = self._frame(si)
+            f = kern.eval_cos(self.k, wo, si.wi, c, s)
+            on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection)
+            p = dr.select(on & (dr.max(f) > 0.0), kern.pdf(self.k, wo, si.wi, c, s), 0.0)
+            return dr.select(on, f, 0.0), p
+
         def eval(self, ctx, si, wo, active=True):
             c, s = self._frame(si)
             value = kern.eval_cos(self.k, wo, si.wi, c, s)
@@ -82,12 +90,7 @@ def _make_class():
             return dr.select(on, value, 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
-            c, s = self._frame(si)
-            on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection)
-            return dr.select(on, kern.pdf(self.k, wo, si.wi, c, s), 0.0)
-
-        def eval_pdf(self, ctx, si, wo, active=True):
-            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+            return self.eval_pdf(ctx, si, wo, active)[1]
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             c, s = self._frame(si)
@@ -95,7 +98,7 @@ def _make_class():
             p = kern.pdf(self.k, wo, si.wi, c, s)
             f = kern.eval_cos(self.k, wo, si.wi, c, s)
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection) & (p > 0.0) \
-                & (si.wi.z > 0.0)
+                & (dr.max(f) > 0.0)
             bs = dr.zeros(mi.BSDFSample3f)
             bs.wo = wo
             bs.pdf = dr.select(on, p, 0.0)

@@ -253,8 +253,8 @@ def pdf(k: Consts, light, view, rot_c, rot_s):
     r"""Density (1/sr) of :func:`sample`'s light directions for the viewer ``view``.
 
     The mixture of :func:`brdf.sampling.pdf`, term by term, restricted to the upper
-    hemisphere (Mitsuba's convention: 0 where either direction is at or below the horizon;
-    the draws that land there are returned with weight 0).
+    hemisphere (0 where either direction is at or below the horizon; the plugin also sets
+    it to 0 where f_r is 0, see :mod:`reports.mitsuba`).
     """
     total = (1.0 - sum(k.thread_p)) / math.pi * dr.maximum(light.z, 0.0)
     axes_l, axes_v = thread_axes(light, rot_c, rot_s), thread_axes(view, rot_c, rot_s)

@@ -254,13 +254,15 @@ def test_mitsuba_chi2(llvm, name, theta, tmp_path, monkeypatch):
     sample, pdf = BSDFAdapter("microcylinder", {"type": "microcylinder", "fabric": name},
                               wi=wi)
     test = ChiSquareTest(SphericalDomain(), sample, pdf, sample_dim=3, sample_count=200_000,
-                         res=51, ires=int(os.environ.get("IRES", 16)), seed=zlib.crc32(name.encode()) % 1000)
+                         res=51, ires=16, seed=zlib.crc32(name.encode()) % 1000)
     assert test.run(0.01, test_count=len(CHI2_CASES), quiet=True), test.messages
 
 
 # -- microcyl export and the README --------------------------------------------------------
-def _fit_folder(tmp_path):
+@pytest.fixture(scope="module")
+def fit_folder(tmp_path_factory):
     """A real (short) fit of velvet with a variant and a tie, written by fit_fabric."""
+    tmp_path = tmp_path_factory.mktemp("fit")
     from analysis.fit import fit_fabric, fit_spec
     from gonio.table import Table
     fab = brdf.fabric("velvet", masking=False, rotation=0.25)
@@ -276,8 +278,8 @@ def _fit_folder(tmp_path):
     return out, res
 
 
-def test_export_cli_writes_the_medians(tmp_path):
-    out, res = _fit_folder(tmp_path)
+def test_export_cli_writes_the_medians(fit_folder, tmp_path):
+    out, res = fit_folder
     target = tmp_path / "fabric.json"
     env = dict(os.environ, PYTHONPATH=str(REPO))
     p = subprocess.run([sys.executable, "-m", "reports", "export", str(out), "-o", str(target)],
@@ -298,9 +300,9 @@ def test_export_cli_writes_the_medians(tmp_path):
     assert "Traceback" not in bad.stderr
 
 
-def test_export_dict_loads_in_mitsuba(tmp_path, scalar):
+def test_export_dict_loads_in_mitsuba(fit_folder, scalar):
     mi = scalar
-    out, _ = _fit_folder(tmp_path)
+    out, _ = fit_folder
     from analysis.fit import median_fabric
     med = median_fabric(out)
     bsdf = mi.load_dict(json.loads(json.dumps(plugin_dict(med.fabric))))

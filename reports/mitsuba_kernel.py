@@ -164,12 +164,13 @@ def _sample_terms(th, ca, sa, light, view, k):
     ui_x, ui_y = dr.select(zero_i, 1.0, xi / ci_s), dr.select(zero_i, 0.0, bi / ci_s)
     ur_x, ur_y = dr.select(zero_r, 1.0, xr / cr_s), dr.select(zero_r, 0.0, bo / cr_s)
     hp = _narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0, 1.0))
+    cc, ss = ci * cr, si * sr
+    c2d = _narrow(1.0 + cc + ss)                           # 2 cos^2(theta_d)
+    th2 = dr.square(_narrow(dr.atan2(si * cr + ci * sr, cc - ss)))   # (theta_i + theta_r)^2
+    ss = _narrow(ss)
     si, xi, ci, sr, xr, cr, ui_x, ur_x = map(_narrow, (si, xi, ci, sr, xr, cr, ui_x, ur_x))
     ti, zi, to, zo = map(_narrow, (ti, zi, to, zo))
     cphi = 2.0 * hp - 1.0                                  # cos(phi_d)
-    cc, ss = ci * cr, si * sr
-    c2d = 1.0 + cc + ss                                    # 2 cos^2(theta_d)
-    th2 = dr.square(dr.atan2(si * cr + ci * sr, cc - ss))  # (theta_i + theta_r)^2
     ok = c2d > 0.0
     c2d = dr.select(ok, c2d, 1.0)
     geo = dr.select(ok, 2.0 * ci / c2d, 0.0)               # cos(theta_i) / cos^2(theta_d)

@@ -19,8 +19,8 @@ Mitsuba counts a draw of weight 0 as no draw, so the plugin's ``pdf`` is the den
 the draws of nonzero weight: :func:`brdf.sampling.pdf` where :math:`f_r\cos\theta_i > 0`, 0
 elsewhere (below the horizon, where lobes spill, and where the model's f_r vanishes above it,
 as it does for velvet seen at grazing angles: every tangent sample then faces away from the
-light or the viewer). The BSDF is one-sided (``FrontSide``); wrap it in Mitsuba's ``twosided`` for cloth seen from
-both sides.
+light or the viewer). The BSDF is one-sided (``FrontSide``); wrap it in Mitsuba's
+``twosided`` for cloth seen from both sides.
 
 :func:`plugin_dict` and :func:`fabric_from_dict` need no Mitsuba: they turn a
 :class:`brdf.Fabric` into the plugin's dictionary and back (``microcyl export`` writes one for a
@@ -195,8 +195,8 @@ def register() -> None:
 
     variant = mi.variant()
     if variant is None or not variant.endswith("_rgb") or "polarized" in variant:
-        raise ValueError(f"the {PLUGIN_NAME} BSDF needs an RGB variant ({', '.join(RGB_VARIANTS)}); "
-                         f"the variant set is {variant!r}")
+        raise ValueError(f"the {PLUGIN_NAME} BSDF needs an RGB variant "
+                         f"({', '.join(RGB_VARIANTS)}); the variant set is {variant!r}")
     from reports import mitsuba_bsdf   # imports mitsuba and drjit at its top
 
     mi.register_bsdf(PLUGIN_NAME, lambda props: mitsuba_bsdf.bsdf_class()(props))

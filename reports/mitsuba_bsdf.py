@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import math
 
-import drjit as dr  # optional dependency: this module is imported only by reports.mitsuba.register()
-import mitsuba as mi  # optional dependency, as drjit
+# optional dependencies: this module is imported only by reports.mitsuba.register()
+import drjit as dr
+import mitsuba as mi
 
 from reports import mitsuba_kernel as kern
 from reports.mitsuba import fabric_from_dict

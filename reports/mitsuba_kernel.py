@@ -25,8 +25,9 @@ import dataclasses
 import math
 from typing import NamedTuple
 
-import drjit as dr  # optional dependency: this module is imported only by reports.mitsuba.register()
-import mitsuba as mi  # optional dependency, as drjit
+# optional dependencies: this module is imported only by reports.mitsuba.register()
+import drjit as dr
+import mitsuba as mi
 
 from brdf import sampling
 from brdf.terms import SIGMA_U

@@ -195,7 +195,8 @@ def llvm():
         p = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True,
                            timeout=120)
         ok = p.returncode == 0 and p.stdout.strip() == "3.5"
-        why = (p.stderr.strip().splitlines() or [f"exit status {p.returncode}"])[-1]
+        lines = p.stderr.strip().splitlines() or [f"exit status {p.returncode}"]
+        why = next((ln for ln in lines if "LLVM ERROR" in ln or "LLVM" in ln), lines[-1])
     except subprocess.TimeoutExpired:
         ok, why = False, "the probe timed out"
     if not ok:

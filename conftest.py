@@ -1,7 +1,14 @@
 """Root pytest configuration: applies to the tests and to every package's doctests."""
 
+import importlib.util
+
 import numpy as np
 import pytest
+
+#: These import Mitsuba at their top (an optional dependency at run time, imported only by
+#: reports.mitsuba.register()): their doctests are collected only where it is installed.
+collect_ignore = [] if importlib.util.find_spec("mitsuba") else [
+    "reports/mitsuba_kernel.py", "reports/mitsuba_bsdf.py"]
 
 
 @pytest.fixture(autouse=True)

@@ -1,0 +1,110 @@
+"""The fabric of a fit's posterior medians: what ``microcyl export`` writes for a renderer.
+
+A fit folder holds ``results.json`` (each free parameter's median) and ``fit_config.json``
+(the preset, the options, the spec: fixed values and ties). :func:`median_fabric` puts them
+together: free parameters at their medians, tied ones from their sources, fixed ones at the
+values the fit held them at, tangent offsets scaled by ``tangent_scale`` as the fit's model
+scales them (clipped to +-90 degrees).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+
+import brdf
+from analysis.fit.checkpoint import CONFIG_FILE
+from analysis.fit.results import read_results
+from brdf import schema
+
+__all__ = ["MedianFabric", "median_fabric"]
+
+
+@dataclasses.dataclass(frozen=True)
+class MedianFabric:
+    """A fit's median fabric.
+
+    Attributes
+    ----------
+    fabric : brdf.Fabric
+        Named after the preset the fit started from, with the fit's options.
+    preset : str
+    values : dict
+        Every parameter's value (natural units: degrees for gammas): medians of the free
+        ones, the rest fixed or tied.
+    free : tuple of str
+        The fit's free parameters.
+    converged : bool or None
+        The fit's verdict (``results.json``).
+    """
+
+    fabric: brdf.Fabric
+    preset: str
+    values: dict
+    free: tuple
+    converged: bool | None
+
+
+def _config(folder: Path) -> dict:
+    path = folder / CONFIG_FILE
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        cfg = doc["config"]
+        spec = cfg["spec"]
+        extra = cfg["extra"]
+        return {"preset": extra["fabric"], "options": dict(extra.get("options") or {}),
+                "params": spec["params"], "ties": spec.get("ties", {}),
+                "free": tuple(spec["free"])}
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the fit's configuration ({exc.strerror or exc}); "
+                         f"is {folder} a `microcyl fit` output folder?") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{path}: not a `microcyl fit` configuration (missing or bad "
+                         f"{exc})") from None
+
+
+def median_fabric(fit_dir) -> MedianFabric:
+    """The fabric at the posterior medians of the fit in ``fit_dir``.
+
+    Parameters
+    ----------
+    fit_dir : path
+        A ``microcyl fit`` output folder (``results.json`` and ``fit_config.json``).
+
+    Returns
+    -------
+    MedianFabric
+
+    Raises
+    ------
+    ValueError
+        A missing or corrupt file (named), a preset or parameter the files do not explain, or
+        medians that make no valid fabric.
+    """
+    folder = Path(fit_dir)
+    results = read_results(folder / "results.json")
+    cfg = _config(folder)
+    medians = results.get("parameters", {})
+    values = {name: float(p["default"]) for name, p in cfg["params"].items()}
+    missing = [n for n in cfg["free"] if n not in medians]
+    if missing:
+        raise ValueError(f"{folder / 'results.json'}: no median for free parameter(s) "
+                         f"{', '.join(missing)}")
+    values.update({n: float(medians[n]["median"]) for n in cfg["free"]})
+    for target, (source, kind) in cfg["ties"].items():
+        values[target] = values[source] if kind == "equal" else 1.0 - values[source]
+    threads = []
+    for j, t in enumerate(brdf.preset_threads(cfg["preset"]), start=1):
+        change = {q: values[f"{q}{j}"] for q in schema.SCALAR_PARAMS if f"{q}{j}" in values}
+        rgb = [f"albedo{j}_{c}" for c in schema.RGB_CHANNELS]
+        if all(k in values for k in rgb):
+            change["albedo"] = tuple(values[k] for k in rgb)
+        scale = values.get(f"tangent_scale{j}", 1.0)
+        if scale != 1.0:
+            change["offsets"] = tuple(np.clip(np.asarray(t.offsets) * scale, -90, 90).tolist())
+        threads.append(t.replace(**change))
+    fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+    return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))

@@ -1,0 +1,326 @@
+r"""The microcylinder model in Dr.Jit: f_r cos, the sampler's density and its draws.
+
+The same equations as :mod:`brdf.kernel` and :mod:`brdf.shading` (MODEL.md, term by term),
+written with Dr.Jit operations so that they run in every Mitsuba 3 RGB variant: on Python
+floats in ``scalar_rgb``, on JIT arrays (one lane a direction pair) in ``llvm_ad_rgb`` and
+``cuda_ad_rgb``. The loops over the tangent samples are unrolled in Python: their number is a
+constant of the fabric (:class:`Consts`). Directions are in microcyl's local frame (n = +z, the
+warp along +x turned by the rotation angle); ``light`` is microcyl's wi (Mitsuba's ``wo``),
+``view`` its wo (Mitsuba's ``si.wi``).
+
+Three formulas differ from the NumPy kernel in form only, for float32: theta_i + theta_r comes
+from ``atan2`` of its sine and cosine (``arccos`` of a cosine near 1 loses the angle's digits);
+:math:`\cos^2(\phi_d/2) = |\hat u_i + \hat u_r|^2 / 4` from the unit azimuth vectors (no
+cancellation in :math:`1 + \cos\phi_d`); and the transmission
+:math:`1 - F_r = 2cg\,[(c + g)^{-2} + \eta^2 (\eta^2 c + g)^{-2}]` (no cancellation near
+grazing incidence).
+
+This module imports Mitsuba and Dr.Jit at its top: it is imported only through
+:func:`reports.mitsuba.register` (both are optional at run time).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import NamedTuple
+
+# optional dependencies: this module is imported only by reports.mitsuba.register()
+import drjit as dr
+import mitsuba as mi
+
+from brdf import sampling
+from brdf.terms import SIGMA_U
+
+__all__ = ["Consts", "consts", "eval_cos", "pdf", "sample"]
+
+_K_U = -0.5 / SIGMA_U**2            # u(x) = exp(_K_U x^2)
+_GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
+_HALF_PI = 0.5 * math.pi
+_COS_MIN = 1e-12                    # as brdf.sampling: the 1/cos(theta) density stays finite
+
+
+@dataclasses.dataclass(frozen=True)
+class ThreadConsts:
+    """One thread's constants (Python floats): distinct tangent offsets and parameters."""
+
+    ca: tuple           # cos of the distinct tangent offsets
+    sa: tuple           # their sin
+    weight: tuple       # their weights (sum 1)
+    eta: float
+    kd: float
+    gamma_s: float      # radians
+    gamma_v: float      # radians
+    area: float
+    albedo: tuple       # RGB
+
+
+@dataclasses.dataclass(frozen=True)
+class Consts:
+    """Everything the kernel needs of a :class:`brdf.Fabric`, as Python floats.
+
+    ``comp_*`` is the sampler's flat component table (component 0 the cosine-weighted
+    hemisphere, then per thread, tangent offset and lobe) and ``comp_pmf`` its probabilities.
+    """
+
+    threads: tuple
+    masking: bool
+    reweighting: bool
+    transmission: str
+    gap: str
+    rotation: float     # radians
+    thread_p: tuple     # probability of each thread's lobes (brdf.sampling.lobe_probabilities)
+    lobe_p: tuple       # (2, 3): surface, volume, isotropic within each thread
+    comp_pmf: tuple
+    comp_thread: tuple
+    comp_ca: tuple
+    comp_sa: tuple
+    comp_kind: tuple    # -1 cosine, 0 surface, 1 volume, 2 isotropic
+    comp_sigma: tuple   # standard deviation of the longitudinal Gaussian, radians
+
+
+def consts(fabric) -> Consts:
+    """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric`)."""
+    threads = tuple(
+        ThreadConsts(tuple(map(float, c.ca)), tuple(map(float, c.sa)),
+                     tuple(map(float, c.weight)), float(t.eta), float(t.kd), float(c.gamma_s),
+                     float(c.gamma_v), float(t.area), tuple(map(float, t.albedo)))
+        for t, c in zip(fabric.threads, fabric._const))
+    thread_p, lobe_p = sampling.lobe_probabilities(fabric)
+    pmf, jj, ca, sa, kind, sig = [1.0 - float(thread_p.sum())], [0], [1.0], [0.0], [-1], [1.0]
+    for j, th in enumerate(threads):
+        if thread_p[j] == 0.0:
+            continue
+        for c, s, w in zip(th.ca, th.sa, th.weight):
+            for k in range(3):
+                pmf.append(float(thread_p[j] * w * lobe_p[j, k]))
+                jj.append(j)
+                ca.append(c)
+                sa.append(s)
+                kind.append(k)
+                sig.append(2.0 * (th.gamma_s if k == 0 else th.gamma_v))
+    opts = fabric.options
+    return Consts(threads, opts["masking"], opts["reweighting"], opts["transmission"],
+                  opts["gap"], float(opts["rotation"]), tuple(map(float, thread_p)),
+                  tuple(tuple(map(float, r)) for r in lobe_p), tuple(pmf), tuple(jj),
+                  tuple(ca), tuple(sa), tuple(kind), tuple(sig))
+
+
+# -- frames --------------------------------------------------------------------------------
+def thread_axes(w, c, s):
+    """(w . t0, w . b, w . n) of both threads for the rotation (cos, sin) = (c, s).
+
+    Thread 1: t0 = (c, s, 0), b = n x t0; thread 2 is thread 1 turned 90 degrees about n.
+    """
+    t = w.x * c + w.y * s
+    b = w.y * c - w.x * s
+    return (t, b, w.z), (b, -t, w.z)
+
+
+def _wide(x):
+    """x in double precision (JIT variants; Python floats are doubles already)."""
+    return mi.Float64(x) if dr.is_jit_v(x) else x
+
+
+class _Vec(NamedTuple):
+    """Components of a direction (in double precision)."""
+
+    x: object
+    y: object
+    z: object
+
+
+def _narrow(x):
+    """x back in the variant's precision."""
+    return mi.Float(x) if dr.is_jit_v(x) else x
+
+
+# -- f_r cos -------------------------------------------------------------------------------
+def _blend(a, b, cos_delta):
+    r"""Pair visibility :math:`(1 - u)ab + u\min(a, b)`, :math:`u = e^{-\delta^2/2\sigma_u^2}`."""
+    d = dr.acos(dr.clip(cos_delta, -1.0, 1.0))
+    u = dr.exp(_K_U * d * d)
+    prod = a * b
+    return prod + u * (dr.minimum(a, b) - prod)
+
+
+def _fresnel(eta2, c):
+    """Unpolarized Fresnel reflectance F_r and transmission 1 - F_r at incidence cosine c."""
+    g = dr.sqrt(eta2 - 1.0 + c * c)
+    e2c = eta2 * c
+    rs, rp = (c - g) / (c + g), (e2c - g) / (e2c + g)
+    a, b = c + g, e2c + g
+    return 0.5 * (rs * rs + rp * rp), 2.0 * c * g * (1.0 / (a * a) + eta2 / (b * b))
+
+
+def _sample_terms(th, ca, sa, light, view, k):
+    """One tangent sample: (surface, volume / A, P) of MODEL.md, cos(theta_i) / cos^2(theta_d)
+    and M, P included."""
+    (ti, bi, zi), (to, bo, zo) = light, view
+    si, xi = ti * ca + zi * sa, zi * ca - ti * sa
+    sr, xr = to * ca + zo * sa, zo * ca - to * sa
+    ci, cr = dr.sqrt(xi * xi + bi * bi), dr.sqrt(xr * xr + bo * bo)
+    zero_i, zero_r = ci == 0.0, cr == 0.0                  # along the tangent: phi := 0
+    ci_s, cr_s = dr.select(zero_i, 1.0, ci), dr.select(zero_r, 1.0, cr)
+    ui_x, ui_y = dr.select(zero_i, 1.0, xi / ci_s), dr.select(zero_i, 0.0, bi / ci_s)
+    ur_x, ur_y = dr.select(zero_r, 1.0, xr / cr_s), dr.select(zero_r, 0.0, bo / cr_s)
+    hp = _narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0, 1.0))
+    cc, ss = ci * cr, si * sr
+    c2d = _narrow(1.0 + cc + ss)                           # 2 cos^2(theta_d)
+    th2 = dr.square(_narrow(dr.atan2(si * cr + ci * sr, cc - ss)))   # (theta_i + theta_r)^2
+    ss = _narrow(ss)
+    si, xi, ci, sr, xr, cr, ui_x, ur_x = map(_narrow, (si, xi, ci, sr, xr, cr, ui_x, ur_x))
+    ti, zi, to, zo = map(_narrow, (ti, zi, to, zo))
+    cphi = 2.0 * hp - 1.0                                  # cos(phi_d)
+    ok = c2d > 0.0
+    c2d = dr.select(ok, c2d, 1.0)
+    geo = dr.select(ok, 2.0 * ci / c2d, 0.0)               # cos(theta_i) / cos^2(theta_d)
+    if k.masking:
+        geo *= _blend(dr.maximum(ui_x, 0.0), dr.maximum(ur_x, 0.0), cphi)
+    p = 1.0
+    if k.reweighting:
+        irho_i = dr.rsqrt(zi * zi + ti * ti)
+        irho_r = dr.rsqrt(zo * zo + to * to)
+        p = _blend(dr.maximum(xi, 0.0) * irho_i, dr.maximum(xr, 0.0) * irho_r,
+                   (xi * xr + ss) * irho_i * irho_r)
+        geo *= p
+    cg = dr.sqrt(0.5 * c2d * hp)                           # cos_g
+    eta2 = th.eta * th.eta
+    fr, tr = _fresnel(eta2, cg)
+    if k.transmission == "half_angle":
+        ft = tr * tr
+    else:
+        ft = _fresnel(eta2, ci)[1] * _fresnel(eta2, cr)[1]
+    gs = dr.exp(th2 * (-0.125 / th.gamma_s**2)) * (_GAUSS_NORM / th.gamma_s)
+    gv = dr.exp(th2 * (-0.125 / th.gamma_v**2)) * ((1.0 - th.kd) * _GAUSS_NORM / th.gamma_v)
+    csum = ci + cr
+    surf = fr * dr.sqrt(hp) * gs * geo
+    vol = ft * (gv + th.kd) * geo / dr.select(csum > 0.0, csum, 1.0)
+    return surf, vol, p
+
+
+def eval_cos(k: Consts, light, view, rot_c, rot_s):
+    r"""f_r(wi, wo) cos(theta_i), RGB, for the light direction ``light`` (microcyl's wi) and the
+    viewer ``view`` (its wo), unit mi.Vector3f in the local frame (n = +z).
+
+    ``rot_c``, ``rot_s``: cos and sin of the warp's angle from +x (the fabric's rotation and
+    any per-hit turn). Returns an mi.Color3f, 1/sr times the cosine (dimensionless per sr):
+
+    .. math:: f_r \cos\theta_i = \frac{a_1 S_1 + a_2 S_2}{Q}
+
+    (MODEL.md's f_r multiplied by n . wi), 0 where either direction is at or below the
+    horizon or Q <= 0.
+    """
+    rc, rs = _wide(rot_c), _wide(rot_s)
+    axes_l, axes_v = (thread_axes(_Vec(*map(_wide, (w.x, w.y, w.z))), rc, rs)
+                      for w in (light, view))
+    rgb = [0.0, 0.0, 0.0]
+    q = 1.0
+    if k.reweighting:
+        gap = light.z if k.gap == "incident" else view.z
+        q = (1.0 - k.threads[0].area - k.threads[1].area) * gap
+    for j, th in enumerate(k.threads):
+        surf = vol = pmean = 0.0
+        for ca, sa, w in zip(th.ca, th.sa, th.weight):
+            s, v, p = _sample_terms(th, ca, sa, axes_l[j], axes_v[j], k)
+            surf, vol, pmean = surf + w * s, vol + w * v, pmean + w * p
+        if k.reweighting:
+            q = q + th.area * pmean
+        for ch in range(3):
+            rgb[ch] = rgb[ch] + th.area * (surf + th.albedo[ch] * vol)
+    ok = (light.z > 0.0) & (view.z > 0.0) & (q > 0.0)
+    inv = dr.select(ok, 1.0 / dr.select(ok, q, 1.0), 0.0)
+    return mi.Color3f(rgb[0] * inv, rgb[1] * inv, rgb[2] * inv)
+
+
+# -- the sampler (brdf/sampling.py) --------------------------------------------------------
+def _ndtr(x):
+    """Standard normal CDF."""
+    return 0.5 * (1.0 + dr.erf(x * (1.0 / math.sqrt(2.0))))
+
+
+def _ndtri(p):
+    """Standard normal quantile."""
+    return math.sqrt(2.0) * dr.erfinv(dr.clip(2.0 * p - 1.0, -1.0, 1.0))
+
+
+def _theta_r(axes_v, ca, sa):
+    """Longitudinal angle of the viewer about the tangent (ca, sa) of one thread."""
+    to, bo, zo = axes_v
+    sr, xr = to * ca + zo * sa, zo * ca - to * sa
+    return dr.atan2(sr, dr.sqrt(xr * xr + bo * bo))
+
+
+def pdf(k: Consts, light, view, rot_c, rot_s):
+    r"""Density (1/sr) of :func:`sample`'s light directions for the viewer ``view``.
+
+    The mixture of :func:`brdf.sampling.pdf`, term by term, restricted to the upper
+    hemisphere (0 where either direction is at or below the horizon; the plugin also sets
+    it to 0 where f_r is 0, see :mod:`reports.mitsuba`).
+    """
+    total = (1.0 - sum(k.thread_p)) / math.pi * dr.maximum(light.z, 0.0)
+    axes_l, axes_v = thread_axes(light, rot_c, rot_s), thread_axes(view, rot_c, rot_s)
+    for j, th in enumerate(k.threads):
+        if k.thread_p[j] == 0.0:
+            continue
+        ti, bi, zi = axes_l[j]
+        acc = 0.0
+        for ca, sa, w in zip(th.ca, th.sa, th.weight):
+            si, xi = ti * ca + zi * sa, zi * ca - ti * sa
+            cth = dr.maximum(dr.sqrt(xi * xi + bi * bi), _COS_MIN)
+            mu = -_theta_r(axes_v[j], ca, sa)
+            th_i = dr.atan2(si, cth)
+            dens = 0.5 * k.lobe_p[j][2]
+            for lobe, gamma in ((0, th.gamma_s), (1, th.gamma_v)):
+                sig = 2.0 * gamma
+                mass = _ndtr((_HALF_PI - mu) / sig) - _ndtr((-_HALF_PI - mu) / sig)
+                z = (th_i - mu) / sig
+                dens += k.lobe_p[j][lobe] * dr.exp(-0.5 * z * z) * (_GAUSS_NORM / sig) / (
+                    mass * cth)
+            pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
+            acc += w * dens * pphi
+        total += k.thread_p[j] * acc
+    ok = (light.z > 0.0) & (view.z > 0.0)
+    return dr.select(ok, total, 0.0)
+
+
+def _take(table, index):
+    """table[index] for a tuple of Python numbers: an index per lane."""
+    if isinstance(index, int):
+        return table[index]
+    return dr.gather(mi.Float, mi.Float(table), index)
+
+
+def sample(k: Consts, dist, view, u1, u2, rot_c, rot_s):
+    """A light direction (mi.Vector3f, local frame) for the viewer ``view``.
+
+    ``dist`` is an ``mi.DiscreteDistribution`` of ``k.comp_pmf``; ``u1`` picks the component,
+    ``u2`` (mi.Point2f) the longitudinal angle (x) and the azimuth (y), as
+    :func:`brdf.sampling.sample` does with its rescaled first and its second number.
+    """
+    idx = dist.sample(u1)
+    idx = int(idx) if isinstance(u1, float) else idx
+    j, ca, sa = _take(k.comp_thread, idx), _take(k.comp_ca, idx), _take(k.comp_sa, idx)
+    kind, sig = _take(k.comp_kind, idx), _take(k.comp_sigma, idx)
+    second = j > 0.5
+    # thread 1: t0 = (c, s, 0), b = (-s, c, 0); thread 2: t0 = (-s, c, 0), b = (-c, -s, 0)
+    t0x, t0y = dr.select(second, -rot_s, rot_c), dr.select(second, rot_c, rot_s)
+    bx, by = dr.select(second, -rot_c, -rot_s), dr.select(second, -rot_s, rot_c)
+    t = mi.Vector3f(ca * t0x, ca * t0y, sa)
+    nt = mi.Vector3f(-sa * t0x, -sa * t0y, ca)
+    b = mi.Vector3f(bx, by, 0.0)
+    mu = -dr.atan2(dr.dot(view, t), dr.sqrt(dr.square(dr.dot(view, nt))
+                                            + dr.square(dr.dot(view, b))))
+    v = u2.x
+    lo = _ndtr((-_HALF_PI - mu) / sig)
+    mass = _ndtr((_HALF_PI - mu) / sig) - lo
+    th = dr.clip(mu + sig * _ndtri(lo + v * mass), -_HALF_PI, _HALF_PI)
+    iso = kind > 1.5
+    s = dr.select(iso, 2.0 * v - 1.0, dr.sin(th))
+    c = dr.select(iso, 2.0 * dr.sqrt(dr.maximum(v * (1.0 - v), 0.0)), dr.cos(th))
+    if k.masking:
+        phi = dr.asin(dr.clip(2.0 * u2.y - 1.0, -1.0, 1.0))
+    else:
+        phi = math.pi * (2.0 * u2.y - 1.0)
+    wi = s * t + c * (dr.cos(phi) * nt + dr.sin(phi) * b)
+    return dr.select(kind < -0.5, mi.warp.square_to_cosine_hemisphere(u2), wi)

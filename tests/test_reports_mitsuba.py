@@ -1,0 +1,330 @@
+"""reports.mitsuba: the Mitsuba 3 BSDF 'microcylinder' against brdf.Fabric (eval in float32,
+sample and pdf), Mitsuba's own chi-square test of its sampler, the warp along dp_du, and
+``microcyl export`` run as a user runs it.
+
+Tests that need Mitsuba skip when it is not installed; those of the JIT variant skip when no
+usable LLVM is found (Dr.Jit needs a shared libLLVM; on Debian LLVM 14 and 15 fail with
+"Cannot select fmaximum", libllvm19 works with DRJIT_LIBLLVM_PATH set to its libLLVM-19.so;
+.ci/run sets it).
+"""
+
+import importlib.util
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import brdf
+from reports.mitsuba import fabric_from_dict, plugin_dict
+
+REPO = Path(__file__).resolve().parents[1]
+HAVE_MITSUBA = importlib.util.find_spec("mitsuba") is not None
+needs_mitsuba = pytest.mark.skipif(not HAVE_MITSUBA, reason="mitsuba is not installed "
+                                   "(pip install mitsuba; it is in pyproject's dependencies)")
+
+#: Variants by the plugin's keys (rotation in degrees).
+VARIANTS = [{}, {"masking": False}, {"reweighting": False},
+            {"tangent_sampling": "control_points"}, {"tangent_samples": 5},
+            {"transmission": "longitudinal"}, {"gap": "outgoing"}, {"rotation": 40.0},
+            {"masking": False, "reweighting": False}]
+#: Tolerance of eval against Fabric.eval: relative to the pair's largest channel.
+RTOL = 1e-5
+
+
+def _id(v):
+    return "-".join(f"{k}={x}" for k, x in v.items()) or "default"
+
+
+def _hemi(rng, n):
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2])
+    return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32)
+
+
+def _reference(name, variant, light, view):
+    """f_r cos(theta_i) of brdf.Fabric in float64 at the float32 directions."""
+    fab = brdf.fabric(name, **{k: (math.radians(v) if k == "rotation" else v)
+                               for k, v in variant.items()})
+    light, view = light.astype(np.float64), view.astype(np.float64)
+    return fab.eval(light, view) * light[:, 2:3]
+
+
+def _worst(out, ref):
+    """Largest |out - ref| relative to the pair's largest channel (inf where ref is 0 and out
+    is not)."""
+    err, scale = np.abs(out - ref), ref.max(axis=1, keepdims=True)
+    rel = np.divide(err, scale, out=np.where(err > 0, np.inf, 0.0), where=scale > 0)
+    return float(rel.max())
+
+
+# -- without Mitsuba ---------------------------------------------------------------------
+@pytest.mark.parametrize("name", brdf.PRESETS)
+def test_plugin_dict_round_trip(name):
+    fab = brdf.fabric(name, masking=False, tangent_samples=7, rotation=0.3, gap="outgoing")
+    d = json.loads(json.dumps(plugin_dict(fab)))
+    back = fabric_from_dict(d)
+    assert back.threads == fab.threads
+    assert back.options == pytest.approx(fab.options)
+    assert d["rotation"] == pytest.approx(math.degrees(0.3))
+
+
+def test_fabric_from_dict_keys_and_errors():
+    fab = fabric_from_dict({"type": "microcylinder", "fabric": "velvet", "albedo2": 0.4,
+                            "offsets1": "-80, -40", "kd2": 0.25})
+    assert fab.threads[1].albedo == (0.4, 0.4, 0.4) and fab.threads[1].kd == 0.25
+    assert fab.threads[0].offsets == (-80.0, -40.0) and fab.threads[0].eta == 1.46
+    with pytest.raises(ValueError, match="unknown microcylinder parameter.*'eta3'"):
+        fabric_from_dict({"fabric": "velvet", "eta3": 1.5})
+    with pytest.raises(ValueError, match="unknown fabric 'denim'"):
+        fabric_from_dict({"fabric": "denim"})
+    with pytest.raises(ValueError, match="offsets1 must be numbers"):
+        fabric_from_dict({"offsets1": "a, b"})
+
+
+# -- scalar_rgb --------------------------------------------------------------------------
+@pytest.fixture
+def scalar():
+    mi = pytest.importorskip("mitsuba", reason="mitsuba is not installed")
+    mi.set_variant("scalar_rgb")
+    from reports import mitsuba as plugin
+    plugin.register()
+    return mi
+
+
+def _scalar_eval(mi, bsdf, light, view, dp_du=None):
+    ctx = mi.BSDFContext()
+    out = np.empty((light.shape[0], 3))
+    for k, (l, v) in enumerate(zip(light, view)):
+        si = mi.SurfaceInteraction3f()
+        si.sh_frame = mi.Frame3f(mi.Vector3f(1, 0, 0), mi.Vector3f(0, 1, 0), mi.Vector3f(0, 0, 1))
+        if dp_du is not None:
+            si.dp_du = mi.Vector3f(*dp_du)
+        si.wi = mi.Vector3f(*map(float, v))
+        out[k] = np.array(bsdf.eval(ctx, si, mi.Vector3f(*map(float, l))))
+    return out
+
+
+CASES = [(p, v) for p in brdf.PRESETS for v in VARIANTS]
+
+
+@needs_mitsuba
+@pytest.mark.parametrize("name,variant", CASES, ids=[f"{p}-{_id(v)}" for p, v in CASES])
+def test_scalar_eval_matches_fabric(scalar, name, variant):
+    mi = scalar
+    rng = np.random.default_rng(zlib.crc32(f"{name}{variant}".encode()))
+    n = 200 if not variant else 60
+    light, view = _hemi(rng, n), _hemi(rng, n)
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": name, **variant})
+    out = _scalar_eval(mi, bsdf, light, view)
+    ref = _reference(name, variant, light, view)
+    assert _worst(out, ref) < RTOL
+
+
+@needs_mitsuba
+def test_warp_follows_dp_du(scalar):
+    """dp_du along local +y turns the warp by 90 degrees; below the horizon eval is 0."""
+    mi = scalar
+    rng = np.random.default_rng(5)
+    light, view = _hemi(rng, 40), _hemi(rng, 40)
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": "silk_shot", "rotation": 10.0})
+    out = _scalar_eval(mi, bsdf, light, view, dp_du=(0.0, 2.0, 0.3))
+    ref = _reference("silk_shot", {"rotation": 100.0}, light, view)
+    assert _worst(out, ref) < RTOL
+    below = light * np.array([1, 1, -1], dtype=np.float32)
+    assert np.all(_scalar_eval(mi, bsdf, below, view) == 0)
+
+
+@needs_mitsuba
+@pytest.mark.parametrize("name", brdf.PRESETS)
+def test_scalar_sample_weight_and_pdf(scalar, name):
+    """sample's weight is f_r cos / pdf, its pdf brdf.sampling.pdf where f_r cos > 0 and 0
+    elsewhere (below the horizon; where the model's f_r vanishes above it)."""
+    mi = scalar
+    fab = brdf.fabric(name)
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": name})
+    ctx = mi.BSDFContext()
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    view = _hemi(rng, 1)[0]
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(*map(float, view))
+    got = []
+    for u in rng.random((150, 3)):
+        bs, w = bsdf.sample(ctx, si, float(u[0]), mi.Point2f(float(u[1]), float(u[2])))
+        got.append((np.array(bs.wo), bs.pdf, np.array(w), bsdf.pdf(ctx, si, bs.wo)))
+    wo = np.array([g[0] for g in got], dtype=np.float64)
+    f = fab.eval(wo, view.astype(np.float64)) * np.maximum(wo[:, 2:3], 0.0)
+    up = f.max(axis=1) > 0
+    assert up.mean() > 0.25         # lobes spill below the surface (velvet: over half)
+    pdf_ref = fab.pdf(view.astype(np.float64), wo)
+    np.testing.assert_allclose([g[1] for g in got], np.where(up, pdf_ref, 0.0), rtol=1e-5)
+    np.testing.assert_allclose([g[3] for g in got], np.where(up, pdf_ref, 0.0), rtol=1e-5)
+    w_ref = np.where(up[:, None], f / pdf_ref[:, None], 0.0)
+    np.testing.assert_allclose([g[2] for g in got], w_ref, rtol=1e-4, atol=1e-9)
+
+
+@needs_mitsuba
+def test_register_needs_an_rgb_variant():
+    import mitsuba as mi
+    from reports import mitsuba as plugin
+    mi.set_variant("scalar_spectral")
+    try:
+        with pytest.raises(ValueError, match="needs an RGB variant"):
+            plugin.register()
+    finally:
+        mi.set_variant("scalar_rgb")
+
+
+# -- llvm_ad_rgb -------------------------------------------------------------------------
+_PROBE = ("import mitsuba as mi, drjit as dr; mi.set_variant('llvm_ad_rgb'); "
+          "x = dr.maximum(mi.Float([1, 2]), mi.Float([1.5, 0])); print(float(dr.sum(x)[0]))")
+
+
+@pytest.fixture(scope="module")
+def llvm():
+    """mitsuba in llvm_ad_rgb, after a probe in a subprocess (an unusable LLVM aborts)."""
+    if not HAVE_MITSUBA:
+        pytest.skip("mitsuba is not installed")
+    try:
+        p = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True,
+                           timeout=120)
+        ok = p.returncode == 0 and p.stdout.strip() == "3.5"
+        lines = p.stderr.strip().splitlines() or [f"exit status {p.returncode}"]
+        why = next((ln for ln in lines if "LLVM ERROR" in ln or "LLVM" in ln), lines[-1])
+    except subprocess.TimeoutExpired:
+        ok, why = False, "the probe timed out"
+    if not ok:
+        pytest.skip(f"no usable LLVM for Dr.Jit ({why}); install libllvm19 and set "
+                    f"DRJIT_LIBLLVM_PATH to its libLLVM-19.so (LLVM 14 and 15 fail)")
+    import mitsuba as mi
+    mi.set_variant("llvm_ad_rgb")
+    from reports import mitsuba as plugin
+    plugin.register()
+    yield mi
+    mi.set_variant("scalar_rgb")
+
+
+#: Every preset with the defaults, and every variant on a preset of few tangent samples
+#: (LLVM compiles a kernel per fabric: the 32-sample ones take seconds).
+LLVM_CASES = [(p, {}) for p in brdf.PRESETS] + [
+    (["silk_crepe_de_chine", "polyester_satin_charmeuse_back", "silk_shot"][k % 3], v)
+    for k, v in enumerate(VARIANTS[1:])]
+
+
+@needs_mitsuba
+@pytest.mark.parametrize("name,variant", LLVM_CASES,
+                         ids=[f"{p}-{_id(v)}" for p, v in LLVM_CASES])
+def test_llvm_eval_matches_fabric_float32(llvm, name, variant):
+    mi, dr = llvm, pytest.importorskip("drjit")
+    rng = np.random.default_rng(zlib.crc32(f"llvm{name}{variant}".encode()))
+    n = 10_000
+    light, view = _hemi(rng, n), _hemi(rng, n)
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": name, **variant})
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(view[:, 0], view[:, 1], view[:, 2])
+    out = bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(light[:, 0], light[:, 1], light[:, 2]))
+    out = np.asarray(out.numpy(), dtype=np.float64).T
+    assert mi.Float is dr.llvm.ad.Float                  # float32 lanes
+    assert _worst(out, _reference(name, variant, light, view)) < RTOL
+
+
+CHI2_CASES = [(p, th) for p in brdf.PRESETS for th in (30.0, 75.0)]
+
+
+@needs_mitsuba
+@pytest.mark.slow
+@pytest.mark.parametrize("name,theta", CHI2_CASES, ids=[f"{p}-{t:g}" for p, t in CHI2_CASES])
+def test_mitsuba_chi2(llvm, name, theta, tmp_path, monkeypatch):
+    """Mitsuba's own chi-square test of sample against pdf through BSDFAdapter. The pdf
+    grows like 1/cos(theta) toward each tangent sample (brdf.sampling), so the cells are
+    integrated with ires=16 (the default 4 overestimates them by ~1%)."""
+    mi = llvm
+    monkeypatch.chdir(tmp_path)                 # a failed test writes chi2_data.py here
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+    t = math.radians(theta)
+    dr = pytest.importorskip("drjit")
+    # opaque: one kernel for both incidences (a literal viewer would compile one each)
+    wi = dr.opaque(mi.Vector3f, [math.sin(t) * math.cos(0.4), math.sin(t) * math.sin(0.4),
+                                 math.cos(t)])
+    sample, pdf = BSDFAdapter("microcylinder", {"type": "microcylinder", "fabric": name},
+                              wi=wi)
+    test = ChiSquareTest(SphericalDomain(), sample, pdf, sample_dim=3, sample_count=200_000,
+                         res=51, ires=16, seed=zlib.crc32(name.encode()) % 1000)
+    assert test.run(0.01, test_count=len(CHI2_CASES), quiet=True), test.messages
+
+
+# -- microcyl export and the README --------------------------------------------------------
+@pytest.fixture(scope="module")
+def fit_folder(tmp_path_factory):
+    """A real (short) fit of velvet with a variant and a tie, written by fit_fabric."""
+    tmp_path = tmp_path_factory.mktemp("fit")
+    from analysis.fit import fit_fabric, fit_spec
+    from gonio.table import Table
+    fab = brdf.fabric("velvet", masking=False, rotation=0.25)
+    rng = np.random.default_rng(2)
+    wi = brdf.directions.from_angles(rng.uniform(0, 1.3, 300), rng.uniform(-3, 3, 300))
+    wo = brdf.directions.from_angles(rng.uniform(0, 1.3, 300), rng.uniform(-3, 3, 300))
+    f = fab.eval(wi, wo)
+    table = Table(wi, wo, f * (1 + 0.05 * rng.normal(size=f.shape)), sigma=0.05 * f + 1e-5)
+    spec = fit_spec(fab, "gamma_s1,kd1", ["kd2=kd1"], None)
+    out = tmp_path / "fit"
+    res = fit_fabric(table, fab, spec, out, max_steps=100, ensembles=2, progress=False,
+                     config_extra={"fabric": "velvet", "options": fab.options})
+    return out, res
+
+
+def test_export_cli_writes_the_medians(fit_folder, tmp_path):
+    out, res = fit_folder
+    target = tmp_path / "fabric.json"
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    p = subprocess.run([sys.executable, "-m", "reports", "export", str(out), "-o", str(target)],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert f"wrote {target}" in p.stderr and "velvet: medians of gamma_s1, kd1" in p.stdout
+    doc = json.loads(target.read_text())
+    assert doc["type"] == "microcylinder" and doc["fabric"] == "velvet"
+    assert doc["gamma_s1"] == pytest.approx(res.summary["gamma_s1"]["median"])
+    assert doc["kd1"] == doc["kd2"] == pytest.approx(res.summary["kd1"]["median"])
+    assert doc["gamma_v1"] == 12.0 and doc["masking"] is False
+    assert doc["rotation"] == pytest.approx(math.degrees(0.25))
+    assert [f.name for f in tmp_path.iterdir() if f.name.startswith(".")] == []
+    bad = subprocess.run([sys.executable, "-m", "reports", "export", str(tmp_path), "-o",
+                          str(target)], cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=120)
+    assert bad.returncode == 1 and "results.json" in bad.stderr
+    assert "Traceback" not in bad.stderr
+
+
+def test_export_dict_loads_in_mitsuba(fit_folder, scalar):
+    mi = scalar
+    out, _ = fit_folder
+    from analysis.fit import median_fabric
+    med = median_fabric(out)
+    bsdf = mi.load_dict(json.loads(json.dumps(plugin_dict(med.fabric))))
+    rng = np.random.default_rng(9)
+    light, view = _hemi(rng, 20), _hemi(rng, 20)
+    got = _scalar_eval(mi, bsdf, light, view)
+    ref = med.fabric.eval(light.astype(float), view.astype(float)) * light[:, 2:3]
+    assert _worst(got, ref) < RTOL
+
+
+def test_readme_mitsuba_example(scalar, tmp_path, monkeypatch):
+    """The README's "Mitsuba 3" example (a ```py block, kept out of test_readme's run because
+    the main venv may lack Mitsuba) runs and renders a non-black image."""
+    text = (REPO / "README.md").read_text()
+    block = re.search(r"## Mitsuba 3.*?```py\n(.*?)```", text, flags=re.S)
+    assert block, "README has no Mitsuba 3 example"
+    monkeypatch.chdir(tmp_path)
+    # Mitsuba resolves relative paths against the folder it was first imported in
+    code = block.group(1).replace('"velvet.exr"', repr(str(tmp_path / "velvet.exr")))
+    ns = {}
+    exec(compile(code, "README Mitsuba block", "exec"), ns)
+    img = np.asarray(ns["image"])
+    assert img.shape[-1] == 3 and np.isfinite(img).all() and img.mean() > 0
+    assert (tmp_path / "velvet.exr").exists()      # written asynchronously by Mitsuba

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from brdf.frames import flat_pairs
-from brdf.shading import SHADE_BLOCK, combine_rgb, thread_shade
+from brdf.shading import SHADE_BLOCK, combine_rgb, inverse_denominator, thread_shade
 
 if TYPE_CHECKING:                    # brdf.fabric imports this module
     from brdf.fabric import Fabric
@@ -131,7 +131,6 @@ class Prepared:
             sl = slice(c0, c0 + step)
             pmeans = [None if g.pmean is None else g.pmean[sl] for g in self._geoms]
             q = self.fabric._q(pmeans, a1, a2, self._zi[sl], self._zo[sl])
-            denom = q * self._zi[sl]
-            inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
+            inv = inverse_denominator(q, self._zi[sl])
             combine_rgb(shades[:, 0, :, sl], shades[:, 1, :, sl], area, alb, inv,
                         vals[:, sl])

@@ -2,6 +2,7 @@
 
 import itertools
 import math
+import re
 
 import numpy as np
 import pytest
@@ -390,3 +391,19 @@ def test_tiny_components_everywhere_stay_finite():
         for got in (f.eval(wi, wo), f.eval_threads(wi, wo).sum(axis=-2),
                     f.prepare(wi, wo).eval()):
             assert np.all(np.isfinite(got)) and np.all(got >= 0)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"area": [-1.0, 0.3]}, "area must be a finite number with 0.0 <= area <= 1.0; got -1.0"),
+    ({"eta": [np.nan, 1.4]}, "eta must be a finite number with 1.0 < eta; got nan"),
+    ({"kd": [[0.3, 0.3], [5.0, 0.1]]}, "kd must be a finite number with 0.0 <= kd <= 1.0; "
+                                       "got 5.0 (at index (1, 0))"),
+    ({"area": [0.6, 0.6]}, "areas must sum to at most 1"),
+    ({"gamma_v": [0.0, 3.0]}, "gamma_v must be a finite angle > 0 degrees"),
+    ({"albedo": [[1, 1, -1], [1, 1, 1]]}, "albedo must be one or three finite numbers >= 0"),
+    ({"gamma_s": "wide"}, "gamma_s must be a numeric array; got 'wide'"),
+])
+def test_prepared_eval_refuses_parameters_outside_their_ranges(kwargs, words):
+    prep = brdf.fabric("linen_plain").prepare([0.0, 0.0, 1.0], [0.0, 0.6, 0.8])
+    with pytest.raises(ValueError, match=re.escape(words)):
+        prep.eval(**kwargs)

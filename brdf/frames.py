@@ -276,19 +276,20 @@ def directions_to_plane(wi, wo, azimuth=0.0, *, atol=1e-9) -> tuple[np.ndarray, 
     return out[0], out[1]
 
 
-def flat_pairs(wi, wo):
+def flat_pairs(wi, wo, names=("wi", "wo")):
     """Validate, broadcast, flatten and normalize direction pairs.
 
     Returns wi, wo (n, 3) unit (bad entries replaced), the leading shape, and the masks of
-    bad (zero or non-finite) pairs and of pairs at or below the horizon.
+    bad (zero or non-finite) pairs and of pairs at or below the horizon. ``names`` are the
+    parameters' names in error messages.
     """
-    wi = as_directions("wi", wi)
-    wo = as_directions("wo", wo)
+    wi = as_directions(names[0], wi)
+    wo = as_directions(names[1], wo)
     try:
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
     except ValueError:
-        raise ValueError(f"wi and wo must broadcast; got shapes {wi.shape} and {wo.shape}") \
-            from None
+        raise ValueError(f"{names[0]} and {names[1]} must broadcast; got shapes {wi.shape} "
+                         f"and {wo.shape}") from None
     wi = np.broadcast_to(wi, shape + (3,)).reshape(-1, 3)
     wo = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
     wi, bad_i = normalize(wi)

@@ -9,15 +9,20 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf import validate
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
+from gonio.numtext import is_number, parse_number
 from gonio.table import Table
 
-__all__ = ["read_csv", "write_csv", "read_rows", "CsvRows", "ANGLES"]
+__all__ = ["read_csv", "write_csv", "read_rows", "CsvRows", "ANGLES", "ANGLE_RANGES"]
 
 ANGLES = ("theta_i", "phi_i", "theta_o", "phi_o")
+#: Accepted angles in degrees: theta is a polar angle (beyond 90 below the horizon, where
+#: f_r = 0), phi an azimuth, either way round (a spreadsheet's 0..360 or -180..180).
+ANGLE_RANGES = {"theta": (0.0, 180.0), "phi": (-360.0, 360.0)}
 _KEY = re.compile(r"^([A-Za-z_][\w.\-]*)\s*:\s?(.*)$")
 _VALUE_SETS = (("r", "g", "b"), ("value",))
 _SIGMA_SETS = (("sigma_r", "sigma_g", "sigma_b"), ("sigma",))
@@ -32,6 +37,11 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
     path : str or os.PathLike
     digits : int
         Significant digits printed for every number (angles in degrees, f_r in 1/sr).
+
+    Raises
+    ------
+    ValueError
+        An empty table, or ``digits`` not an integer >= 1.
 
     Notes
     -----
@@ -48,8 +58,12 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
     >>> print(p.read_text().splitlines()[-2:])
     ['theta_i,phi_i,theta_o,phi_o,value', '0,0,36.8698976,0,0.25']
     """
-    if digits < 1:
-        raise ValueError(f"write_csv: digits must be >= 1; got {digits}")
+    digits = validate.integer("digits", digits, lo=1)
+    if not isinstance(table, Table):
+        raise TypeError(f"write_csv: table must be a gonio.Table; got {type(table).__name__}")
+    if len(table) == 0:
+        raise ValueError("write_csv: table is empty (0 rows); a CSV table holds at least one "
+                         "row, as read_csv requires")
     fmt = f"%.{digits}g"
     grey = bool(np.array_equal(table.values[:, 0], table.values[:, 1], equal_nan=True)
                 and np.array_equal(table.values[:, 0], table.values[:, 2], equal_nan=True)
@@ -77,9 +91,9 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
                              for x in row) + "\n")
 
 
-def _parse_float(text: str) -> float:
-    text = text.strip()
-    return float("nan") if text == "" else float(text)
+def _parse_value(text: str) -> float:
+    """A value or sigma field: a number, nan or inf; an empty field is NaN (missing)."""
+    return float("nan") if text == "" else parse_number(text, nonfinite=True)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,7 +141,7 @@ def read_rows(path) -> CsvRows:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")   # a spreadsheet's byte-order mark
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}
@@ -181,19 +195,9 @@ def read_csv(path) -> Table:
     if header is None:
         raise FormatError(path, "no header row (expected theta_i,phi_i,theta_o,phi_o,r,g,b)")
     _check_header(path, text.header_line, header)
-    rows = []
-    for lineno, fields in text.rows:
-        try:
-            row = [_parse_float(x) for x in fields]
-        except ValueError:
-            bad = next(x for x in fields if not _is_float(x))
-            raise FormatError(path, f"line {lineno}: {bad!r} is not a number") from None
-        if not all(np.isfinite(row[header.index(a)]) for a in ANGLES):
-            raise FormatError(path, f"line {lineno}: angles must be finite numbers")
-        rows.append(row)
-    if not rows:
+    if not text.rows:
         raise FormatError(path, "no data rows after the header")
-    data = np.array(rows, dtype=np.float64)
+    data = _numbers(path, header, text.rows)
     col = {name: data[:, k] for k, name in enumerate(header)}
     ang = [np.radians(col[a]) for a in ANGLES]
     values = (np.stack([col[c] for c in "rgb"], axis=1) if "r" in col
@@ -208,12 +212,29 @@ def read_csv(path) -> Table:
     return Table(from_angles(ang[0], ang[1]), from_angles(ang[2], ang[3]), values, sigma, meta)
 
 
-def _is_float(x: str) -> bool:
-    try:
-        _parse_float(x)
-    except ValueError:
-        return False
-    return True
+def _numbers(path, header, rows) -> np.ndarray:
+    """The data rows as an (n, columns) array: angles strictly decimal, finite and in range
+    (one vectorized check), values and sigma numbers, nan, inf or empty (NaN)."""
+    is_angle = [c in ANGLES for c in header]
+    out = np.empty((len(rows), len(header)))
+    for k, (lineno, fields) in enumerate(rows):
+        for j, x in enumerate(fields):
+            try:
+                out[k, j] = parse_number(x) if is_angle[j] else _parse_value(x)
+            except ValueError as exc:
+                if is_angle[j] and is_number(x, nonfinite=True):
+                    exc = f"angles must be finite numbers; got {x!r}"
+                raise FormatError(path, f"line {lineno}: {exc}, in column {header[j]}") \
+                    from None
+    for name in ANGLES:
+        lo, hi = ANGLE_RANGES[name[:-2]]
+        col = out[:, header.index(name)]
+        bad = ~((col >= lo) & (col <= hi))
+        if bad.any():
+            lineno, fields = rows[int(np.argmax(bad))]
+            raise FormatError(path, f"line {lineno}: {name} = {fields[header.index(name)]} is "
+                                    f"outside [{lo:g}, {hi:g}] degrees")
+    return out
 
 
 def _check_header(path, lineno, header):

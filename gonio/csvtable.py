@@ -17,7 +17,8 @@ from gonio.jsonplain import plain
 from gonio.numtext import is_number, parse_number
 from gonio.table import Table
 
-__all__ = ["read_csv", "write_csv", "read_rows", "CsvRows", "ANGLES", "ANGLE_RANGES"]
+__all__ = ["read_csv", "write_csv", "read_rows", "parse_columns", "CsvRows", "ANGLES",
+           "ANGLE_RANGES"]
 
 ANGLES = ("theta_i", "phi_i", "theta_o", "phi_o")
 #: Accepted angles in degrees: theta is a polar angle (beyond 90 below the horizon, where
@@ -197,7 +198,7 @@ def read_csv(path) -> Table:
     _check_header(path, text.header_line, header)
     if not text.rows:
         raise FormatError(path, "no data rows after the header")
-    data = _numbers(path, header, text.rows)
+    data = parse_columns(path, header, text.rows)
     col = {name: data[:, k] for k, name in enumerate(header)}
     ang = [np.radians(col[a]) for a in ANGLES]
     values = (np.stack([col[c] for c in "rgb"], axis=1) if "r" in col
@@ -212,28 +213,41 @@ def read_csv(path) -> Table:
     return Table(from_angles(ang[0], ang[1]), from_angles(ang[2], ang[3]), values, sigma, meta)
 
 
-def _numbers(path, header, rows) -> np.ndarray:
-    """The data rows as an (n, columns) array: angles strictly decimal, finite and in range
-    (one vectorized check), values and sigma numbers, nan, inf or empty (NaN)."""
-    is_angle = [c in ANGLES for c in header]
-    out = np.empty((len(rows), len(header)))
+def parse_columns(path, header, rows, columns=None) -> np.ndarray:
+    """The data rows' ``columns`` (default: all of ``header``) as an (n, k) array.
+
+    Angles are decimal numbers (:mod:`gonio.numtext`), finite and within
+    :data:`ANGLE_RANGES` (one vectorized check); other columns numbers, nan, inf or empty
+    (NaN). ``rows`` are :attr:`CsvRows.rows`.
+
+    Raises
+    ------
+    FormatError
+        Naming the file, the line and the column of the first bad field.
+    """
+    columns = list(header if columns is None else columns)
+    idx = [header.index(c) for c in columns]
+    is_angle = [c in ANGLES for c in columns]
+    out = np.empty((len(rows), len(columns)))
     for k, (lineno, fields) in enumerate(rows):
-        for j, x in enumerate(fields):
+        for j, (c, angle) in enumerate(zip(idx, is_angle)):
+            x = fields[c]
             try:
-                out[k, j] = parse_number(x) if is_angle[j] else _parse_value(x)
+                out[k, j] = parse_number(x) if angle else _parse_value(x)
             except ValueError as exc:
-                if is_angle[j] and is_number(x, nonfinite=True):
+                if angle and is_number(x, nonfinite=True):
                     exc = f"angles must be finite numbers; got {x!r}"
-                raise FormatError(path, f"line {lineno}: {exc}, in column {header[j]}") \
+                raise FormatError(path, f"line {lineno}: {exc}, in column {columns[j]}") \
                     from None
-    for name in ANGLES:
+    for j, name in enumerate(columns):
+        if not is_angle[j]:
+            continue
         lo, hi = ANGLE_RANGES[name[:-2]]
-        col = out[:, header.index(name)]
-        bad = ~((col >= lo) & (col <= hi))
+        bad = ~((out[:, j] >= lo) & (out[:, j] <= hi))
         if bad.any():
             lineno, fields = rows[int(np.argmax(bad))]
-            raise FormatError(path, f"line {lineno}: {name} = {fields[header.index(name)]} is "
-                                    f"outside [{lo:g}, {hi:g}] degrees")
+            raise FormatError(path, f"line {lineno}: {name} = {fields[idx[j]]} is outside "
+                                    f"[{lo:g}, {hi:g}] degrees")
     return out
 
 

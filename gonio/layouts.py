@@ -15,6 +15,7 @@ import numpy as np
 
 from brdf.frames import from_angles, half_diff_to_directions, plane_to_directions, to_angles
 from gonio.geometry import HORIZON_EPS, Geometry
+from gonio.numtext import parse_number
 
 __all__ = ["full_grid", "plane", "rusinkiewicz", "merl", "pairs", "pairs_from_angles",
            "PLANE_AZIMUTHS"]
@@ -38,7 +39,7 @@ def _build(kind, params, wi, wo, coords, rotation) -> Geometry:
 
 def _step(name, value, upper=90.0) -> float:
     try:
-        v = float(value)
+        v = parse_number(value.strip(" \t")) if isinstance(value, str) else float(value)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number of degrees; got {value!r}") from None
     if not (math.isfinite(v) and 0 < v <= upper):
@@ -148,7 +149,7 @@ def plane(azimuth="warp", theta_o_step: float = 5.0,
             az = PLANE_AZIMUTHS[key]
         else:
             try:
-                az = float(key)
+                az = parse_number(key)
             except ValueError:
                 raise ValueError(f"plane azimuth must be warp, weft, 45 or degrees; "
                                  f"got {azimuth!r}") from None

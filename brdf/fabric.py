@@ -95,7 +95,11 @@ class Fabric:
     """
 
     def __init__(self, threads: Sequence[Thread], *, name: str | None = None, **options):
-        threads = tuple(threads)
+        try:
+            threads = tuple(threads)
+        except TypeError:
+            raise ValueError(f"threads must be two brdf.Thread objects (warp, weft); got "
+                             f"{threads!r}") from None
         if len(threads) != 2 or not all(isinstance(t, Thread) for t in threads):
             raise ValueError(f"threads must be two brdf.Thread objects (warp, weft); got "
                              f"{len(threads)} item(s)")

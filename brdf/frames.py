@@ -62,10 +62,14 @@ def to_angles(w) -> tuple[np.ndarray, np.ndarray]:
     (45.0, 90.0)
     """
     w = as_directions("w", w)
-    r = np.linalg.norm(w, axis=-1)
+    with np.errstate(over="ignore", under="ignore"):
+        r = np.linalg.norm(w, axis=-1)
+    if not np.all((r > 2.0 ** -500) & (r < 2.0 ** 500)):   # huge, tiny, zero or not finite
+        w, bad = normalize(w)          # scaled first: huge or tiny vectors keep their angles
+        r = np.where(bad, np.nan, 1.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         theta = np.arccos(np.clip(w[..., 2] / r, -1.0, 1.0))
-    return theta, np.arctan2(w[..., 1], w[..., 0])
+    return theta, np.where(np.isnan(r), np.nan, np.arctan2(w[..., 1], w[..., 0]))
 
 
 def as_directions(name: str, w) -> np.ndarray:
@@ -91,7 +95,7 @@ def normalize(w) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    w : ndarray, shape (..., 3)
+    w : array_like, shape (..., 3)
 
     Returns
     -------
@@ -106,6 +110,7 @@ def normalize(w) -> tuple[np.ndarray, np.ndarray]:
     >>> u[0], bad
     (array([0., 0., 1.]), array([False,  True]))
     """
+    w = as_directions("w", w)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         # Scale by the largest component first so that huge finite vectors do not overflow.
         big = np.max(np.abs(w), axis=-1)

@@ -208,7 +208,7 @@ def reweighting(sd: Sides, ti, zi, to, zo, ss, k, weight):
         The weighted mean of P over the samples (for Q).
     """
     rho_i, rho_o = np.sqrt(zi * zi + ti * ti), np.sqrt(zo * zo + to * to)
-    if min(rho_i.min(), rho_o.min()) < _TINY:   # squares may underflow, 1/rho overflow
+    if rho_i.size and min(rho_i.min(), rho_o.min()) < _TINY:   # squares may underflow, 1/rho overflow
         rho_i, rho_o = np.hypot(zi, ti), np.hypot(zo, to)    # > 0 above the horizon
         ui, vi, ur, vr = sd.xi / rho_i, sd.si / rho_i, sd.xr / rho_o, sd.sr / rho_o
         cpsi = ui * ur + vi * vr
@@ -261,7 +261,7 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, with_masking=True
     carries the factor cos(theta_i) = 0 (wi side) or is finite (wo side).
     """
     sd = longitudinal(ti, bi, zi, to, bo, zo, ca, sa)
-    tiny = min(sd.ci.min(), sd.cr.min()) < _TINY
+    tiny = sd.ci.size > 0 and min(sd.ci.min(), sd.cr.min()) < _TINY
     degenerate = False               # some cos theta = 0 (a direction along a sample)
     if tiny:                         # x^2 + y^2 may have underflowed: cos theta by hypot
         sd = sd._replace(ci=np.hypot(sd.xi, bi), cr=np.hypot(sd.xr, bo))
@@ -269,7 +269,7 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, with_masking=True
     th2, c2d, cc, ss = half_difference(sd)
     cphi, frame = azimuth(sd, bi, bo, cc, degenerate, tiny)
     ci_k = sd.ci
-    if c2d.min() == 0.0:            # theta_i = -theta_r = +-pi/2: the term is 0 (Notes)
+    if c2d.size and c2d.min() == 0.0:            # theta_i = -theta_r = +-pi/2: the term is 0 (Notes)
         zero = c2d == 0.0
         np.copyto(c2d, 1.0, where=zero)
         np.copyto(ci_k := sd.ci.copy(), 0.0, where=zero)

@@ -79,9 +79,17 @@ class _ShadeParams(NamedTuple):
         return _ShadeParams(*(a[sl] for a in self))
 
 
+#: eta and the gammas (radians) are taken within these bounds (2^-500..2^500, about
+#: 3e-151..3e150), where eta^2 and 1/gamma^2 stay finite: no change for any sane value, and
+#: the limits (F_r -> 1, a flat or a needle lobe) beyond.
+PARAM_CLAMP = (2.0 ** -500, 2.0 ** 500)
+
+
 def _shade_params(eta, kd, gamma_s, gamma_v) -> _ShadeParams:
-    """Row constants from 1-D arrays (nb,) of eta, k_d and the gammas (radians)."""
+    """Row constants from 1-D arrays (nb,) of eta, k_d and the gammas (radians), each
+    within :data:`PARAM_CLAMP`."""
     c3 = (slice(None), None, None)
+    eta, gamma_s, gamma_v = (np.clip(x, *PARAM_CLAMP) for x in (eta, gamma_s, gamma_v))
     s_scale = GAUSS_NORM / gamma_s
     s_scale *= 0.5
     return _ShadeParams((eta * eta)[c3], (-0.125 / (gamma_s * gamma_s))[c3],

@@ -188,9 +188,11 @@ def read_alta(path) -> Table:
 
 
 def _default_param(table: Table) -> str:
-    """COS_TH when every row has wi = wo (to 1e-9), else SPHERICAL_TL_PL_TV_PV."""
+    """COS_TH when every row has wi = wo (to 1e-9) above the horizon, else
+    SPHERICAL_TL_PL_TV_PV."""
     off = np.max(np.abs(table.wi - table.wo), axis=1)
-    return "COS_TH" if np.all(off <= 1e-9) else "SPHERICAL_TL_PL_TV_PV"
+    back = np.all(off <= 1e-9) and np.all(table.wi[:, 2] >= 0)
+    return "COS_TH" if back else "SPHERICAL_TL_PL_TV_PV"
 
 
 def _check_param(table: Table, param: str) -> None:
@@ -203,6 +205,9 @@ def _check_param(table: Table, param: str) -> None:
         if np.any(off > 1e-9):
             raise ValueError(f"write_alta: row {int(np.argmax(off > 1e-9))} has wi != wo; a "
                              "1-D ALTA COS_TH slice holds back-scatter (theta_d = 0) rows only")
+        if np.any(table.wi[:, 2] < 0):
+            raise ValueError(f"write_alta: row {int(np.argmax(table.wi[:, 2] < 0))} lies below "
+                             "the horizon; COS_TH holds cosines in [0, 1]")
     if param == "RUSIN_TH_TD_PD" and not table.meta.get("isotropic"):
         bad = np.abs(phi_h(table.wi, table.wo)) > 1e-9
         if np.any(bad):

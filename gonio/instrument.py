@@ -207,7 +207,10 @@ class Instrument:
         object.__setattr__(self, "floor", floor)
         if self.noise not in NOISE_MODELS:
             raise ValueError(f"noise must be one of {', '.join(NOISE_MODELS)}; got {self.noise!r}")
-        ref = float(self.snr_reference)
+        try:
+            ref = float(self.snr_reference)
+        except (TypeError, ValueError):
+            ref = math.nan
         if not (math.isfinite(ref) and ref > 0):
             raise ValueError(f"snr_reference must be a positive f_r in 1/sr; "
                              f"got {self.snr_reference!r}")

@@ -166,8 +166,10 @@ def read_alta(path) -> Table:
     ------
     FormatError
         A binary ALTA file, an unknown ``#PARAM_IN``, a ``#DIM`` or ``#PARAM_OUT`` that does
-        not match, a row with the wrong number of fields or a non-number (its line number
-        is given), COS_TH outside [0, 1], or no data.
+        not match, a row with the wrong number of fields or a field that is not a number
+        (:mod:`gonio.numtext`; nan and inf only as values), a coordinate outside
+        :data:`COORDINATE_RANGES` (its line and coordinate are given), or no data. A UTF-8
+        byte-order mark is skipped.
     """
     path = Path(path)
     head, comments, data = _split(path)

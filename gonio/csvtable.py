@@ -188,7 +188,9 @@ def read_csv(path) -> Table:
     Raises
     ------
     FormatError
-        No header, unknown or missing columns, or a bad row (its line number is given).
+        No header, unknown or missing columns, or a bad row (its line number is given, and
+        for a bad field its column): a field that is not a decimal number (nan, inf or empty
+        only as values, :mod:`gonio.numtext`), or an angle outside :data:`ANGLE_RANGES`.
     """
     path = Path(path)
     text = read_rows(path)

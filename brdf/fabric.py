@@ -11,7 +11,7 @@ from brdf import sampling, schema, validate
 from brdf.curve import SAMPLING_METHODS
 from brdf.frames import flat_pairs
 from brdf.kernel import thread_geometry
-from brdf.shading import combine_rgb, thread_shade
+from brdf.shading import combine_rgb, inverse_denominator, thread_shade
 from brdf.prepared import Prepared
 from brdf.thread import Thread
 
@@ -95,7 +95,11 @@ class Fabric:
     """
 
     def __init__(self, threads: Sequence[Thread], *, name: str | None = None, **options):
-        threads = tuple(threads)
+        try:
+            threads = tuple(threads)
+        except TypeError:
+            raise ValueError(f"threads must be two brdf.Thread objects (warp, weft); got "
+                             f"{threads!r}") from None
         if len(threads) != 2 or not all(isinstance(t, Thread) for t in threads):
             raise ValueError(f"threads must be two brdf.Thread objects (warp, weft); got "
                              f"{len(threads)} item(s)")
@@ -176,7 +180,9 @@ class Fabric:
         ndarray, shape (..., 3)
             f_r per RGB channel, 1/sr. Zero where either direction is at or below the
             horizon; NaN in the entries of zero or non-finite vectors. Non-unit vectors are
-            normalized.
+            normalized. Finite for every direction above the horizon: MODEL.md's f_r grows
+            like 1/(n . wi) toward it (f_r (n . wi) has a limit), and saturates where
+            Q (n . wi) < :data:`brdf.shading.DENOM_MIN` (about 1e-301).
 
         Raises
         ------
@@ -252,8 +258,7 @@ class Fabric:
     def _combine(self, geoms, shades, zi, zo, split):
         t1, t2 = self._threads
         q = self._q([g.pmean for g in geoms], t1.area, t2.area, zi, zo)
-        denom = q * zi
-        inv = np.divide(1.0, denom, out=np.zeros_like(zi), where=denom > 0)
+        inv = inverse_denominator(q, zi)
         if split:
             parts = [t.area * (s[0][:, None] + np.asarray(t.albedo) * s[1][:, None])
                      for t, s in zip(self._threads, shades)]

@@ -62,10 +62,14 @@ def to_angles(w) -> tuple[np.ndarray, np.ndarray]:
     (45.0, 90.0)
     """
     w = as_directions("w", w)
-    r = np.linalg.norm(w, axis=-1)
+    with np.errstate(over="ignore", under="ignore"):
+        r = np.linalg.norm(w, axis=-1)
+    if not np.all((r > 2.0 ** -500) & (r < 2.0 ** 500)):   # huge, tiny, zero or not finite
+        w, bad = normalize(w)          # scaled first: huge or tiny vectors keep their angles
+        r = np.where(bad, np.nan, 1.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         theta = np.arccos(np.clip(w[..., 2] / r, -1.0, 1.0))
-    return theta, np.arctan2(w[..., 1], w[..., 0])
+    return theta, np.where(np.isnan(r), np.nan, np.arctan2(w[..., 1], w[..., 0]))
 
 
 def as_directions(name: str, w) -> np.ndarray:
@@ -91,7 +95,7 @@ def normalize(w) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    w : ndarray, shape (..., 3)
+    w : array_like, shape (..., 3)
 
     Returns
     -------
@@ -106,6 +110,7 @@ def normalize(w) -> tuple[np.ndarray, np.ndarray]:
     >>> u[0], bad
     (array([0., 0., 1.]), array([False,  True]))
     """
+    w = as_directions("w", w)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         # Scale by the largest component first so that huge finite vectors do not overflow.
         big = np.max(np.abs(w), axis=-1)
@@ -276,19 +281,20 @@ def directions_to_plane(wi, wo, azimuth=0.0, *, atol=1e-9) -> tuple[np.ndarray, 
     return out[0], out[1]
 
 
-def flat_pairs(wi, wo):
+def flat_pairs(wi, wo, names=("wi", "wo")):
     """Validate, broadcast, flatten and normalize direction pairs.
 
     Returns wi, wo (n, 3) unit (bad entries replaced), the leading shape, and the masks of
-    bad (zero or non-finite) pairs and of pairs at or below the horizon.
+    bad (zero or non-finite) pairs and of pairs at or below the horizon. ``names`` are the
+    parameters' names in error messages.
     """
-    wi = as_directions("wi", wi)
-    wo = as_directions("wo", wo)
+    wi = as_directions(names[0], wi)
+    wo = as_directions(names[1], wo)
     try:
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
     except ValueError:
-        raise ValueError(f"wi and wo must broadcast; got shapes {wi.shape} and {wo.shape}") \
-            from None
+        raise ValueError(f"{names[0]} and {names[1]} must broadcast; got shapes {wi.shape} "
+                         f"and {wo.shape}") from None
     wi = np.broadcast_to(wi, shape + (3,)).reshape(-1, 3)
     wo = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
     wi, bad_i = normalize(wi)

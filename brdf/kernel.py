@@ -62,6 +62,9 @@ __all__ = ["ThreadGeometry", "Sides", "thread_geometry", "longitudinal", "half_d
            "azimuth", "masking", "reweighting", "pair_blend"]
 
 _K_U = -0.5 / SIGMA_U**2          # u(x) = exp(_K_U x^2)
+#: Below this a cosine or an in-plane length is "tiny": its square may underflow (2^-500,
+#: about 3e-151), so the blocks take the slower careful forms (hypot, ratios before products).
+_TINY = 2.0 ** -500
 
 
 class ThreadGeometry(NamedTuple):
@@ -136,12 +139,14 @@ def half_difference(sd: Sides):
     return th2, c2d, cc, ss
 
 
-def azimuth(sd: Sides, bi, bo, cc, degenerate: bool):
+def azimuth(sd: Sides, bi, bo, cc, degenerate: bool, tiny: bool = False):
     r"""cos(phi_d) (clipped to [-1, 1]) and the directions' (x, cos theta) used for M.
 
     :math:`\cos\phi_d = (x_i x_r + y_i y_r) / (\cos\theta_i\cos\theta_r)`. With
     ``degenerate`` (some direction along a tangent sample, cos theta = 0) its azimuth is taken
-    as 0, atan2(0, 0) = 0 in MODEL.md: (x, y) / cos theta := (1, 0) there.
+    as 0, atan2(0, 0) = 0 in MODEL.md: (x, y) / cos theta := (1, 0) there. With ``tiny``
+    (some cos theta below 2^-500, whose product may underflow) each direction's (x, y) is
+    divided by its own cos theta first.
 
     Returns
     -------
@@ -150,6 +155,12 @@ def azimuth(sd: Sides, bi, bo, cc, degenerate: bool):
         The components M(w) = max(x, 0) / cos(theta) is formed from.
     """
     xi, ci, xr, cr = sd.xi, sd.ci, sd.xr, sd.cr
+    if tiny:
+        (xi, yi), (xr, yr) = _unit_xy(xi, bi, ci), _unit_xy(xr, bo, cr)
+        cphi = xi * xr + yi * yr
+        one = np.ones_like(cphi)
+        np.clip(cphi, -1.0, 1.0, out=cphi)
+        return cphi, (xi, one, xr, one)
     if degenerate:
         zi_, zr_ = ci == 0.0, cr == 0.0
         xi, ci = np.where(zi_, 1.0, xi), np.where(zi_, 1.0, ci)
@@ -162,6 +173,13 @@ def azimuth(sd: Sides, bi, bo, cc, degenerate: bool):
         cphi /= cc
     np.clip(cphi, -1.0, 1.0, out=cphi)
     return cphi, (xi, ci, xr, cr)
+
+
+def _unit_xy(x, y, c):
+    """(x, y) / c with c = hypot(x, y); (1, 0) where c = 0 (MODEL.md's atan2(0, 0) = 0)."""
+    zero = c == 0.0
+    safe = np.where(zero, 1.0, c)
+    return np.where(zero, 1.0, x / safe), np.where(zero, 0.0, y / safe)
 
 
 def masking(frame, cphi, k):
@@ -189,15 +207,22 @@ def reweighting(sd: Sides, ti, zi, to, zo, ss, k, weight):
     ndarray, shape (C,)
         The weighted mean of P over the samples (for Q).
     """
-    irho_i = 1.0 / np.sqrt(zi * zi + ti * ti)
-    irho_o = 1.0 / np.sqrt(zo * zo + to * to)
-    pi = np.maximum(sd.xi, 0.0)
-    pi *= irho_i
-    pr = np.maximum(sd.xr, 0.0)
-    pr *= irho_o
-    cpsi = sd.xi * sd.xr
-    cpsi += ss
-    cpsi *= irho_i * irho_o
+    rho_i, rho_o = np.sqrt(zi * zi + ti * ti), np.sqrt(zo * zo + to * to)
+    if rho_i.size and min(rho_i.min(), rho_o.min()) < _TINY:   # squares may underflow, 1/rho overflow
+        rho_i, rho_o = np.hypot(zi, ti), np.hypot(zo, to)    # > 0 above the horizon
+        ui, vi, ur, vr = sd.xi / rho_i, sd.si / rho_i, sd.xr / rho_o, sd.sr / rho_o
+        cpsi = ui * ur + vi * vr
+        pi, pr = np.maximum(ui, 0.0), np.maximum(ur, 0.0)
+    else:
+        irho_i = 1.0 / rho_i
+        irho_o = 1.0 / rho_o
+        pi = np.maximum(sd.xi, 0.0)
+        pi *= irho_i
+        pr = np.maximum(sd.xr, 0.0)
+        pr *= irho_o
+        cpsi = sd.xi * sd.xr
+        cpsi += ss
+        cpsi *= irho_i * irho_o
     np.clip(cpsi, -1.0, 1.0, out=cpsi)
     return pair_blend(pi, pr, cpsi, k) @ weight
 
@@ -236,11 +261,15 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, with_masking=True
     carries the factor cos(theta_i) = 0 (wi side) or is finite (wo side).
     """
     sd = longitudinal(ti, bi, zi, to, bo, zo, ca, sa)
+    tiny = sd.ci.size > 0 and min(sd.ci.min(), sd.cr.min()) < _TINY
+    degenerate = False               # some cos theta = 0 (a direction along a sample)
+    if tiny:                         # x^2 + y^2 may have underflowed: cos theta by hypot
+        sd = sd._replace(ci=np.hypot(sd.xi, bi), cr=np.hypot(sd.xr, bo))
+        degenerate = sd.ci.min() == 0.0 or sd.cr.min() == 0.0
     th2, c2d, cc, ss = half_difference(sd)
-    degenerate = sd.ci.min() == 0.0 or sd.cr.min() == 0.0
-    cphi, frame = azimuth(sd, bi, bo, cc, degenerate)
+    cphi, frame = azimuth(sd, bi, bo, cc, degenerate, tiny)
     ci_k = sd.ci
-    if c2d.min() == 0.0:            # theta_i = -theta_r = +-pi/2: the term is 0 (Notes)
+    if c2d.size and c2d.min() == 0.0:            # theta_i = -theta_r = +-pi/2: the term is 0 (Notes)
         zero = c2d == 0.0
         np.copyto(c2d, 1.0, where=zero)
         np.copyto(ci_k := sd.ci.copy(), 0.0, where=zero)

@@ -7,8 +7,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from brdf import schema
 from brdf.frames import flat_pairs
-from brdf.shading import SHADE_BLOCK, combine_rgb, thread_shade
+from brdf.shading import SHADE_BLOCK, combine_rgb, inverse_denominator, thread_shade
 
 if TYPE_CHECKING:                    # brdf.fabric imports this module
     from brdf.fabric import Fabric
@@ -75,7 +76,10 @@ class Prepared:
         Raises
         ------
         ValueError
-            If a parameter's last axis is not 2 (per thread).
+            If a parameter's last axis is not 2 (per thread), an element lies outside its
+            range in :mod:`brdf.schema` (eta > 1, k_d and area in [0, 1], gammas > 0,
+            albedo >= 0, all finite), or a parameter set's areas sum above 1; checked on the
+            whole batch before any shading.
         """
         fab = self.fabric
         th = fab.threads
@@ -83,18 +87,22 @@ class Prepared:
         def param(name, value, default):
             if value is None:
                 return np.asarray(default, dtype=np.float64)
-            v = np.asarray(value, dtype=np.float64)
+            try:
+                v = np.asarray(value, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise ValueError(f"{name} must be a numeric array; got {value!r}") from None
             want = np.shape(default)
             if v.shape[v.ndim - len(want):] != want:
                 raise ValueError(f"{name} must have shape (..., {', '.join(map(str, want))}); "
                                  f"got {v.shape}")
-            return v
+            return schema.THREAD[name].check_array(v)
 
         eta = param("eta", eta, [t.eta for t in th])
         kd = param("kd", kd, [t.kd for t in th])
         gs = np.radians(param("gamma_s", gamma_s, [t.gamma_s for t in th]))
         gv = np.radians(param("gamma_v", gamma_v, [t.gamma_v for t in th]))
         area = param("area", area, [t.area for t in th])
+        schema.check_area_sums(area)
         alb = param("albedo", albedo, [t.albedo for t in th])
         batch = np.broadcast_shapes(eta.shape[:-1], kd.shape[:-1], gs.shape[:-1],
                                     gv.shape[:-1], area.shape[:-1], alb.shape[:-2])
@@ -131,7 +139,6 @@ class Prepared:
             sl = slice(c0, c0 + step)
             pmeans = [None if g.pmean is None else g.pmean[sl] for g in self._geoms]
             q = self.fabric._q(pmeans, a1, a2, self._zi[sl], self._zo[sl])
-            denom = q * self._zi[sl]
-            inv = np.divide(1.0, denom, out=np.zeros(np.shape(denom)), where=denom > 0)
+            inv = inverse_denominator(q, self._zi[sl])
             combine_rgb(shades[:, 0, :, sl], shades[:, 1, :, sl], area, alb, inv,
                         vals[:, sl])

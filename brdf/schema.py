@@ -29,6 +29,7 @@ from brdf import validate
 
 __all__ = ["ParamInfo", "THREAD_PARAMS", "THREAD", "THREAD_FIELDS", "SCALAR_PARAMS",
            "FABRIC_PARAMS", "FABRIC", "AREA_SUM_MAX", "RGB_CHANNELS", "check_areas",
+           "check_area_sums",
            "parameter_table"]
 
 #: Channel suffixes of an RGB parameter (the albedo A).
@@ -115,6 +116,33 @@ class ParamInfo:
         return validate.real(self.name, value, lo=self.lo, hi=self.hi, lo_open=self.lo_open,
                              hi_open=self.hi_open, what=self.what)
 
+    def check_array(self, arr: np.ndarray) -> np.ndarray:
+        """``arr`` (float64, any shape) if every element lies in the validated range: one
+        vectorized test; the message names the first element outside it and its index.
+
+        Examples
+        --------
+        >>> THREAD["kd"].check_array(np.array([[0.3, 5.0]]))
+        Traceback (most recent call last):
+            ...
+        ValueError: kd must be a finite number with 0.0 <= kd <= 1.0; got 5.0 (at index (0, 1))
+        """
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(arr)
+            if self.lo is not None:
+                ok &= arr > self.lo if self.lo_open else arr >= self.lo
+            if self.hi is not None:
+                ok &= arr < self.hi if self.hi_open else arr <= self.hi
+        if not ok.all():
+            where = np.unravel_index(int(np.argmin(ok)), arr.shape)
+            try:
+                self.check(float(arr[where]))
+            except ValueError as exc:
+                index = tuple(int(i) for i in where)
+                raise ValueError(f"{exc} (at index {index[0] if len(index) == 1 else index})") \
+                    from None
+        return arr
+
     def contains(self, x: float) -> bool:
         """Whether the number ``x`` lies in the validated range."""
         try:
@@ -189,6 +217,15 @@ def check_areas(area1: float, area2: float) -> None:
     if total > AREA_SUM_MAX + _AREA_SUM_SLACK:
         raise ValueError(f"area: the threads' areas must sum to at most {AREA_SUM_MAX:g}; got "
                          f"{area1} + {area2} = {total:g}")
+
+
+def check_area_sums(area: np.ndarray) -> None:
+    """Vectorized :func:`check_areas` over area pairs on the last axis (shape (..., 2))."""
+    total = area[..., 0] + area[..., 1]
+    bad = total > AREA_SUM_MAX + _AREA_SUM_SLACK
+    if bad.any():
+        where = np.unravel_index(int(np.argmax(bad)), total.shape)
+        check_areas(float(area[where][0]), float(area[where][1]))
 
 
 def parameter_table() -> str:

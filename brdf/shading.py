@@ -16,7 +16,7 @@ import numpy as np
 from brdf.kernel import ThreadGeometry
 
 __all__ = ["thread_shade", "combine_rgb", "fresnel2_into", "surface_term", "volume_term",
-           "GAUSS_NORM", "SHADE_BLOCK"]
+           "inverse_denominator", "GAUSS_NORM", "SHADE_BLOCK", "DENOM_MIN"]
 
 GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
 
@@ -25,6 +25,11 @@ GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
 #: 1 MiB L2 each, 32 MiB L3): blocks of 2^14..2^15, which stay in L2, lost more to the ~25
 #: NumPy calls a block costs than they gained; 2^18 was no faster.
 SHADE_BLOCK = 1 << 17
+
+#: The least Q (n . wi) that f_r is divided by, 2^-1000 (about 9.3e-302). MODEL.md's f_r grows
+#: like 1/(n . wi) at grazing incidence (the thread-frame cos(theta_i) in S_j does not vanish
+#: with n . wi); below this the exact value would leave the float64 range, so it saturates.
+DENOM_MIN = 2.0 ** -1000
 
 
 def _fresnel_from_cos(eta2, c, c2):
@@ -74,9 +79,17 @@ class _ShadeParams(NamedTuple):
         return _ShadeParams(*(a[sl] for a in self))
 
 
+#: eta and the gammas (radians) are taken within these bounds (2^-500..2^500, about
+#: 3e-151..3e150), where eta^2 and 1/gamma^2 stay finite: no change for any sane value, and
+#: the limits (F_r -> 1, a flat or a needle lobe) beyond.
+PARAM_CLAMP = (2.0 ** -500, 2.0 ** 500)
+
+
 def _shade_params(eta, kd, gamma_s, gamma_v) -> _ShadeParams:
-    """Row constants from 1-D arrays (nb,) of eta, k_d and the gammas (radians)."""
+    """Row constants from 1-D arrays (nb,) of eta, k_d and the gammas (radians), each
+    within :data:`PARAM_CLAMP`."""
     c3 = (slice(None), None, None)
+    eta, gamma_s, gamma_v = (np.clip(x, *PARAM_CLAMP) for x in (eta, gamma_s, gamma_v))
     s_scale = GAUSS_NORM / gamma_s
     s_scale *= 0.5
     return _ShadeParams((eta * eta)[c3], (-0.125 / (gamma_s * gamma_s))[c3],
@@ -234,6 +247,19 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
         _shade_block(g, weight, par.rows(rows), transmission, surf[rows, pairs],
                      vol[rows, pairs], work)
     return out
+
+
+def inverse_denominator(q, zi) -> np.ndarray:
+    r""":math:`1 / (Q\, n\cdot w_i)` (broadcast), 0 where Q or n . wi is not positive.
+
+    The product is taken as at least :data:`DENOM_MIN`, so that f_r stays finite for every
+    direction above the horizon, however close to it (n . wi = 1e-200 gives about 1e200 / sr
+    times the cosine-weighted value, as MODEL.md's equation does).
+    """
+    denom = np.multiply(q, zi)
+    ok = (np.asarray(q) > 0) & (zi > 0)
+    return np.divide(1.0, np.maximum(denom, DENOM_MIN), out=np.zeros(np.shape(denom)),
+                     where=np.broadcast_to(ok, np.shape(denom)))
 
 
 def combine_rgb(surf, vol, area, albedo, inv, out):

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from brdf.validate import array
+
 __all__ = ["SIGMA_U", "fresnel", "gaussian", "u", "visibility", "pair_weight",
            "transmission"]
 
@@ -48,8 +50,8 @@ def fresnel(eta, cos_i):
     >>> float(fresnel(1.5, 0.0))
     1.0
     """
-    eta = np.asarray(eta, dtype=np.float64)
-    c = np.asarray(cos_i, dtype=np.float64)
+    eta = array("eta", eta)
+    c = array("cos_i", cos_i)
     eta2 = eta * eta
     g = np.sqrt(eta2 - 1.0 + c * c)
     rs = (c - g) / (c + g)
@@ -78,8 +80,8 @@ def gaussian(gamma, x):
     >>> round(float(gaussian(1.0, 0.0) * np.sqrt(2 * np.pi)), 12)
     1.0
     """
-    gamma = np.asarray(gamma, dtype=np.float64)
-    x = np.asarray(x, dtype=np.float64)
+    gamma = array("gamma", gamma)
+    x = array("x", x)
     return np.exp(-x * x / (2.0 * gamma * gamma)) / (gamma * np.sqrt(2.0 * np.pi))
 
 
@@ -103,7 +105,8 @@ def u(x, sigma=SIGMA_U):
     >>> float(u(0.0)), round(float(u(SIGMA_U)), 12) == round(float(np.exp(-0.5)), 12)
     (1.0, True)
     """
-    x = np.asarray(x, dtype=np.float64)
+    x = array("x", x)
+    sigma = array("sigma", sigma)
     return np.exp(-x * x / (2.0 * sigma * sigma))
 
 
@@ -125,7 +128,7 @@ def visibility(cos_angle):
     >>> visibility([-0.5, 0.25])
     array([0.  , 0.25])
     """
-    return np.maximum(np.asarray(cos_angle, dtype=np.float64), 0.0)
+    return np.maximum(array("cos_angle", cos_angle), 0.0)
 
 
 def pair_weight(m_i, m_o, delta):
@@ -150,9 +153,9 @@ def pair_weight(m_i, m_o, delta):
     >>> round(float(pair_weight(0.5, 0.8, np.pi)), 6)   # u(pi) ~ 0: the product
     0.4
     """
-    m_i = np.asarray(m_i, dtype=np.float64)
-    m_o = np.asarray(m_o, dtype=np.float64)
-    w = u(delta)
+    m_i = array("m_i", m_i)
+    m_o = array("m_o", m_o)
+    w = u(array("delta", delta))
     return (1.0 - w) * m_i * m_o + w * np.minimum(m_i, m_o)
 
 
@@ -181,6 +184,9 @@ def transmission(eta, cos_g, cos_theta_i, cos_theta_r, method="half_angle"):
     >>> round(float(transmission(1.5, 1.0, 1.0, 1.0)), 12)
     0.9216
     """
+    eta, cos_g = array("eta", eta), array("cos_g", cos_g)
+    cos_theta_i = array("cos_theta_i", cos_theta_i)
+    cos_theta_r = array("cos_theta_r", cos_theta_r)
     if method == "half_angle":
         return (1.0 - fresnel(eta, cos_g)) ** 2
     if method == "longitudinal":

@@ -73,7 +73,7 @@ def _rgb(info: schema.ParamInfo, value) -> tuple[float, float, float]:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         arr = None
-    if arr is None or arr.shape not in ((), (3,)) \
+    if arr is None or arr.shape not in ((), (1,), (3,)) \
             or not all(info.contains(a) for a in arr.ravel()):
         raise ValueError(f"{info.name} must be {info.what}; got {value!r}")
-    return tuple(float(a) for a in np.broadcast_to(arr, (3,)))
+    return tuple(float(a) for a in np.broadcast_to(arr.ravel() if arr.ndim else arr, (3,)))

@@ -5,7 +5,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-__all__ = ["choice", "real", "flag", "integer"]
+import numpy as np
+
+__all__ = ["choice", "real", "flag", "integer", "array"]
 
 
 def choice(name: str, value, allowed: Sequence[str]) -> str:
@@ -67,3 +69,18 @@ def integer(name: str, value, *, lo: int) -> int:
     if v < lo:
         raise ValueError(f"{name} must be an integer >= {lo}; got {value!r}")
     return v
+
+
+def array(name: str, value) -> np.ndarray:
+    """``value`` as a float64 array; ValueError naming ``name`` if it is not numeric.
+
+    Examples
+    --------
+    >>> array("eta", [1.5, 2]).tolist()
+    [1.5, 2.0]
+    """
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number or an array of real numbers; got "
+                         f"{value!r}") from None

@@ -17,10 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf import validate
 from gonio.alta_params import DIMENSION, WRITABLE, from_params, phi_h, to_params
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing
+from gonio.numtext import parse_number
 from gonio.table import Table
 
 __all__ = ["read_alta", "write_alta"]
@@ -28,9 +30,28 @@ __all__ = ["read_alta", "write_alta"]
 _KEYS = ("DIM", "PARAM_IN", "PARAM_OUT", "VS", "FORMAT")
 
 
+def _ranges(*names):
+    """(name, lo, hi) of each coordinate: polar angles [0, pi], azimuths [-2 pi, 2 pi]."""
+    return tuple((n, 0.0, np.pi) if n.startswith("theta") else (n, -2 * np.pi, 2 * np.pi)
+                 for n in names)
+
+
+#: Accepted coordinates of each #PARAM_IN: (name, lo, hi), radians (COS_TH a cosine,
+#: CARTESIAN unit-vector components).
+COORDINATE_RANGES = {
+    "COS_TH": (("COS_TH", 0.0, 1.0),),
+    "RUSIN_TH_TD_PD": _ranges("theta_h", "theta_d", "phi_d"),
+    "SPHERICAL_TL_PL_TV_PV": _ranges("theta_l", "phi_l", "theta_v", "phi_v"),
+    "RUSIN_TH_PH_TD_PD": _ranges("theta_h", "phi_h", "theta_d", "phi_d"),
+    "CARTESIAN": tuple((n, -1.0, 1.0) for n in ("V.x", "V.y", "V.z", "L.x", "L.y", "L.z")),
+}
+
+
 def _split(path: Path):
     """Header dict, comments and (line number, text) data lines of an ALTA text file."""
     raw = path.read_bytes()
+    if raw.startswith(b"\xef\xbb\xbf"):     # a UTF-8 byte-order mark (spreadsheets, editors)
+        raw = raw[3:]
     head, comments, data = {}, [], []
     for lineno, line in enumerate(raw.decode("utf-8", errors="replace").splitlines(), 1):
         s = line.strip()
@@ -71,10 +92,12 @@ def _check_header(path: Path, head: dict) -> tuple[str, int, int]:
     return param, DIMENSION[param], int(vs[0])
 
 
-def _rows(path: Path, data, n_in: int, vs: int) -> np.ndarray:
-    """Parse the data lines into an (n, columns) array, checking the column count."""
+def _rows(path: Path, data, n_in: int, vs: int) -> tuple[np.ndarray, list[int]]:
+    """Parse the data lines into an (n, columns) array and their line numbers, checking the
+    column count and that each field is a number (:mod:`gonio.numtext`: coordinates
+    finite decimals, values and intervals also nan or inf)."""
     allowed = {0: (0,), 1: (1, 3), 2: (2, 6)}[vs]
-    rows = []
+    rows, lines = [], []
     for lineno, s in data:
         fields = s.split()
         extra = len(fields) - n_in - 3
@@ -84,12 +107,32 @@ def _rows(path: Path, data, n_in: int, vs: int) -> np.ndarray:
                                     + (f", #VS {vs} interval" if vs else "")
                                     + f"), got {len(fields)}")
         try:
-            rows.append([float(x) for x in fields] + [np.nan] * (allowed[-1] - extra))
-        except ValueError:
-            raise FormatError(path, f"line {lineno}: not a number in {s[:60]!r}") from None
+            row = [parse_number(x, nonfinite=k >= n_in) for k, x in enumerate(fields)]
+        except ValueError as exc:
+            raise FormatError(path, f"line {lineno}: not a number in {s[:60]!r}: {exc}") \
+                from None
+        rows.append(row + [np.nan] * (allowed[-1] - extra))
+        lines.append(lineno)
     if not rows:
         raise FormatError(path, "no data rows")
-    return np.array(rows)
+    return np.array(rows), lines
+
+
+def _check_coordinates(path: Path, param: str, x: np.ndarray, lines: list[int]) -> None:
+    """Refuse coordinates outside :data:`COORDINATE_RANGES` (one vectorized test), naming
+    the line and the coordinate; CARTESIAN vectors must not be zero."""
+    names, lo, hi = zip(*COORDINATE_RANGES[param])
+    lo, hi = np.array(lo), np.array(hi)
+    bad = ~((x >= lo - 1e-9) & (x <= hi + 1e-9))
+    if bad.any():
+        k, j = np.unravel_index(int(np.argmax(bad)), bad.shape)
+        raise FormatError(path, f"line {lines[k]}: {names[j]} = {x[k, j]:g} is outside "
+                                f"[{lo[j]:g}, {hi[j]:g}] (#PARAM_IN {param}, coordinate {j + 1})")
+    if param == "CARTESIAN":
+        zero = np.all(x[:, :3] == 0, axis=1) | np.all(x[:, 3:] == 0, axis=1)
+        if zero.any():
+            raise FormatError(path, f"line {lines[int(np.argmax(zero))]}: a zero vector "
+                                    "(#PARAM_IN CARTESIAN holds unit vectors V, L)")
 
 
 def _sigma(extra: np.ndarray, vs: int):
@@ -123,17 +166,17 @@ def read_alta(path) -> Table:
     ------
     FormatError
         A binary ALTA file, an unknown ``#PARAM_IN``, a ``#DIM`` or ``#PARAM_OUT`` that does
-        not match, a row with the wrong number of fields or a non-number (its line number
-        is given), COS_TH outside [0, 1], or no data.
+        not match, a row with the wrong number of fields or a field that is not a number
+        (:mod:`gonio.numtext`; nan and inf only as values), a coordinate outside
+        :data:`COORDINATE_RANGES` (its line and coordinate are given), or no data. A UTF-8
+        byte-order mark is skipped.
     """
     path = Path(path)
     head, comments, data = _split(path)
     param, n_in, vs = _check_header(path, head)
-    arr = _rows(path, data, n_in, vs)
+    arr, lines = _rows(path, data, n_in, vs)
     x = arr[:, :n_in]
-    if param == "COS_TH" and not np.all((x[:, 0] >= 0) & (x[:, 0] <= 1)):
-        bad = int(np.flatnonzero(~((x[:, 0] >= 0) & (x[:, 0] <= 1)))[0])
-        raise FormatError(path, f"data row {bad + 1}: COS_TH = {x[bad, 0]} outside [0, 1]")
+    _check_coordinates(path, param, x, lines)
     wi, wo = from_params(param, x)
     values = arr[:, n_in:n_in + 3]
     meta = {"source": f"ALTA {path.name}", "file_format": "alta", "file": str(path),
@@ -147,9 +190,11 @@ def read_alta(path) -> Table:
 
 
 def _default_param(table: Table) -> str:
-    """COS_TH when every row has wi = wo (to 1e-9), else SPHERICAL_TL_PL_TV_PV."""
+    """COS_TH when every row has wi = wo (to 1e-9) above the horizon, else
+    SPHERICAL_TL_PL_TV_PV."""
     off = np.max(np.abs(table.wi - table.wo), axis=1)
-    return "COS_TH" if np.all(off <= 1e-9) else "SPHERICAL_TL_PL_TV_PV"
+    back = np.all(off <= 1e-9) and np.all(table.wi[:, 2] >= 0)
+    return "COS_TH" if back else "SPHERICAL_TL_PL_TV_PV"
 
 
 def _check_param(table: Table, param: str) -> None:
@@ -162,6 +207,9 @@ def _check_param(table: Table, param: str) -> None:
         if np.any(off > 1e-9):
             raise ValueError(f"write_alta: row {int(np.argmax(off > 1e-9))} has wi != wo; a "
                              "1-D ALTA COS_TH slice holds back-scatter (theta_d = 0) rows only")
+        if np.any(table.wi[:, 2] < 0):
+            raise ValueError(f"write_alta: row {int(np.argmax(table.wi[:, 2] < 0))} lies below "
+                             "the horizon; COS_TH holds cosines in [0, 1]")
     if param == "RUSIN_TH_TD_PD" and not table.meta.get("isotropic"):
         bad = np.abs(phi_h(table.wi, table.wo)) > 1e-9
         if np.any(bad):
@@ -193,7 +241,8 @@ def write_alta(table: Table, path, param: str | None = None, digits: int = 17) -
     Raises
     ------
     ValueError
-        An empty table, an unknown ``param``, a COS_TH table with a row wi != wo, or a
+        An empty table or one without a row to keep, ``digits`` not an integer >= 1, an
+        unknown ``param``, a COS_TH table with a row wi != wo, or a
         RUSIN_TH_TD_PD table that is not isotropic-representable.
 
     Notes
@@ -201,13 +250,22 @@ def write_alta(table: Table, path, param: str | None = None, digits: int = 17) -
     With sigma, the header has ``#VS 2`` and each row ends with (sigma, sigma) per channel,
     R G B: the distances below and above the value, as ALTA reads them since 2017.
     """
+    digits = validate.integer("digits", digits, lo=1)
+    if not isinstance(table, Table):
+        raise TypeError(f"write_alta: table must be a gonio.Table; got {type(table).__name__}")
     if len(table) == 0:
         raise ValueError("write_alta: the table is empty")
+    if param is not None and not isinstance(param, str):
+        raise ValueError(f"write_alta: param must be one of {', '.join(WRITABLE)}; got {param!r}")
     param = _default_param(table) if param is None else param
     _check_param(table, param)
     keep = np.all(table.valid, axis=1)
     if table.sigma is not None:
         keep &= np.all(np.isfinite(table.sigma) & (table.sigma >= 0), axis=1)
+    if not keep.any():
+        raise ValueError(f"write_alta: every one of the table's {len(table)} rows has a missing "
+                         "value or sigma; an ALTA file holds measured rows only (read_alta "
+                         "refuses a file without data)")
     cols = [to_params(param, table.wi[keep], table.wo[keep]), table.values[keep]]
     if table.sigma is not None:
         s = table.sigma[keep]

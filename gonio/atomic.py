@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from pathlib import Path
@@ -33,6 +34,12 @@ def atomic_write(path, mode: str = "wb"):
     mode : {"wb", "w"}
         Binary or text (UTF-8, ``\\n`` line ends) mode.
 
+    Raises
+    ------
+    OSError
+        The file cannot be written (missing folder, no permission, a folder in its place,
+        disk full): the error names ``path``, never the temporary file.
+
     Yields
     ------
     file object, with an extra attribute ``tmp_path`` (a :class:`pathlib.Path`) for writers
@@ -58,19 +65,37 @@ def atomic_write(path, mode: str = "wb"):
     if mode not in ("wb", "w"):
         raise ValueError(f"atomic_write mode must be 'wb' or 'w'; got {mode!r}")
     path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "Is a directory, not a file to write", str(path))
     folder = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise _named(exc, path) from None
     tmp = Path(tmp)
+    in_body = False
     try:
         kwargs = {} if mode == "wb" else {"encoding": "utf-8", "newline": "\n"}
         with os.fdopen(fd, mode, **kwargs) as f:
             f.tmp_path = tmp
+            in_body = True
             yield f
+            in_body = False
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, file_mode())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             tmp.unlink()
+        if isinstance(exc, OSError) and (not in_body or str(tmp) in (exc.filename,
+                                                                      exc.filename2)):
+            raise _named(exc, path) from None
         raise
+
+
+def _named(exc: OSError, path: Path) -> OSError:
+    """``exc`` again, naming the user's ``path`` instead of the hidden temporary file."""
+    if exc.errno is None:
+        return OSError(f"{path}: cannot write: {exc}")
+    return OSError(exc.errno, f"cannot write: {exc.strerror}", str(path))

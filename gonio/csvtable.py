@@ -9,15 +9,21 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf import validate
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
+from gonio.numtext import is_number, parse_number
 from gonio.table import Table
 
-__all__ = ["read_csv", "write_csv", "read_rows", "CsvRows", "ANGLES"]
+__all__ = ["read_csv", "write_csv", "read_rows", "parse_columns", "CsvRows", "ANGLES",
+           "ANGLE_RANGES"]
 
 ANGLES = ("theta_i", "phi_i", "theta_o", "phi_o")
+#: Accepted angles in degrees: theta is a polar angle (beyond 90 below the horizon, where
+#: f_r = 0), phi an azimuth, either way round (a spreadsheet's 0..360 or -180..180).
+ANGLE_RANGES = {"theta": (0.0, 180.0), "phi": (-360.0, 360.0)}
 _KEY = re.compile(r"^([A-Za-z_][\w.\-]*)\s*:\s?(.*)$")
 _VALUE_SETS = (("r", "g", "b"), ("value",))
 _SIGMA_SETS = (("sigma_r", "sigma_g", "sigma_b"), ("sigma",))
@@ -32,6 +38,11 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
     path : str or os.PathLike
     digits : int
         Significant digits printed for every number (angles in degrees, f_r in 1/sr).
+
+    Raises
+    ------
+    ValueError
+        An empty table, or ``digits`` not an integer >= 1.
 
     Notes
     -----
@@ -48,8 +59,12 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
     >>> print(p.read_text().splitlines()[-2:])
     ['theta_i,phi_i,theta_o,phi_o,value', '0,0,36.8698976,0,0.25']
     """
-    if digits < 1:
-        raise ValueError(f"write_csv: digits must be >= 1; got {digits}")
+    digits = validate.integer("digits", digits, lo=1)
+    if not isinstance(table, Table):
+        raise TypeError(f"write_csv: table must be a gonio.Table; got {type(table).__name__}")
+    if len(table) == 0:
+        raise ValueError("write_csv: table is empty (0 rows); a CSV table holds at least one "
+                         "row, as read_csv requires")
     fmt = f"%.{digits}g"
     grey = bool(np.array_equal(table.values[:, 0], table.values[:, 1], equal_nan=True)
                 and np.array_equal(table.values[:, 0], table.values[:, 2], equal_nan=True)
@@ -77,9 +92,9 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
                              for x in row) + "\n")
 
 
-def _parse_float(text: str) -> float:
-    text = text.strip()
-    return float("nan") if text == "" else float(text)
+def _parse_value(text: str) -> float:
+    """A value or sigma field: a number, nan or inf; an empty field is NaN (missing)."""
+    return float("nan") if text == "" else parse_number(text, nonfinite=True)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,7 +142,7 @@ def read_rows(path) -> CsvRows:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")   # a spreadsheet's byte-order mark
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}
@@ -173,7 +188,9 @@ def read_csv(path) -> Table:
     Raises
     ------
     FormatError
-        No header, unknown or missing columns, or a bad row (its line number is given).
+        No header, unknown or missing columns, or a bad row (its line number is given, and
+        for a bad field its column): a field that is not a decimal number (nan, inf or empty
+        only as values, :mod:`gonio.numtext`), or an angle outside :data:`ANGLE_RANGES`.
     """
     path = Path(path)
     text = read_rows(path)
@@ -181,19 +198,9 @@ def read_csv(path) -> Table:
     if header is None:
         raise FormatError(path, "no header row (expected theta_i,phi_i,theta_o,phi_o,r,g,b)")
     _check_header(path, text.header_line, header)
-    rows = []
-    for lineno, fields in text.rows:
-        try:
-            row = [_parse_float(x) for x in fields]
-        except ValueError:
-            bad = next(x for x in fields if not _is_float(x))
-            raise FormatError(path, f"line {lineno}: {bad!r} is not a number") from None
-        if not all(np.isfinite(row[header.index(a)]) for a in ANGLES):
-            raise FormatError(path, f"line {lineno}: angles must be finite numbers")
-        rows.append(row)
-    if not rows:
+    if not text.rows:
         raise FormatError(path, "no data rows after the header")
-    data = np.array(rows, dtype=np.float64)
+    data = parse_columns(path, header, text.rows)
     col = {name: data[:, k] for k, name in enumerate(header)}
     ang = [np.radians(col[a]) for a in ANGLES]
     values = (np.stack([col[c] for c in "rgb"], axis=1) if "r" in col
@@ -208,12 +215,42 @@ def read_csv(path) -> Table:
     return Table(from_angles(ang[0], ang[1]), from_angles(ang[2], ang[3]), values, sigma, meta)
 
 
-def _is_float(x: str) -> bool:
-    try:
-        _parse_float(x)
-    except ValueError:
-        return False
-    return True
+def parse_columns(path, header, rows, columns=None) -> np.ndarray:
+    """The data rows' ``columns`` (default: all of ``header``) as an (n, k) array.
+
+    Angles are decimal numbers (:mod:`gonio.numtext`), finite and within
+    :data:`ANGLE_RANGES` (one vectorized check); other columns numbers, nan, inf or empty
+    (NaN). ``rows`` are :attr:`CsvRows.rows`.
+
+    Raises
+    ------
+    FormatError
+        Naming the file, the line and the column of the first bad field.
+    """
+    columns = list(header if columns is None else columns)
+    idx = [header.index(c) for c in columns]
+    is_angle = [c in ANGLES for c in columns]
+    out = np.empty((len(rows), len(columns)))
+    for k, (lineno, fields) in enumerate(rows):
+        for j, (c, angle) in enumerate(zip(idx, is_angle)):
+            x = fields[c]
+            try:
+                out[k, j] = parse_number(x) if angle else _parse_value(x)
+            except ValueError as exc:
+                if angle and is_number(x, nonfinite=True):
+                    exc = f"angles must be finite numbers; got {x!r}"
+                raise FormatError(path, f"line {lineno}: {exc}, in column {columns[j]}") \
+                    from None
+    for j, name in enumerate(columns):
+        if not is_angle[j]:
+            continue
+        lo, hi = ANGLE_RANGES[name[:-2]]
+        bad = ~((out[:, j] >= lo) & (out[:, j] <= hi))
+        if bad.any():
+            lineno, fields = rows[int(np.argmax(bad))]
+            raise FormatError(path, f"line {lineno}: {name} = {fields[idx[j]]} is outside "
+                                    f"[{lo:g}, {hi:g}] degrees")
+    return out
 
 
 def _check_header(path, lineno, header):

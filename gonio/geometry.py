@@ -126,7 +126,10 @@ class Geometry:
             if v.shape != (n,):
                 raise ValueError(f"Geometry coordinate {k!r} has {v.size} values; expected {n}")
             coords[k] = v
-        rotation = float(self.rotation)
+        try:
+            rotation = float(self.rotation)
+        except (TypeError, ValueError):
+            rotation = math.nan
         if not math.isfinite(rotation):
             raise ValueError(f"rotation must be a finite angle in radians; got {self.rotation!r}")
         index = np.arange(n) if self.index is None else np.array(self.index, np.int64).reshape(-1)

@@ -6,14 +6,15 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import numpy as np
-
-from gonio.csvtable import ANGLES, read_rows
+from gonio.csvtable import ANGLES, parse_columns, read_rows
 from gonio.errors import FormatError
 from gonio.geometry import SPEC_HELP, Geometry
 from gonio.layouts import PLANE_AZIMUTHS, full_grid, merl, pairs_from_angles, plane, rusinkiewicz
+from gonio.numtext import NUMBER_FORM, parse_number
 
 __all__ = ["from_spec", "read_pairs_csv", "SPEC_HELP"]
+
+_AZIMUTH = re.compile(r"[-+]?[0-9]+(\.[0-9]*)?")
 
 
 def read_pairs_csv(path) -> Geometry:
@@ -28,7 +29,8 @@ def read_pairs_csv(path) -> Geometry:
         The file cannot be read.
     ValueError
         No header, a header without the four angle columns, or a bad row (with its line
-        number): a :class:`gonio.FormatError` naming the file.
+        number and column: not a decimal number, or an angle outside
+        :data:`gonio.csvtable.ANGLE_RANGES`): a :class:`gonio.FormatError` naming the file.
     """
     path = Path(path)
     try:
@@ -41,15 +43,7 @@ def read_pairs_csv(path) -> Geometry:
     if missing:
         raise FormatError(path, f"line {text.header_line}: header lacks column(s) "
                                 f"{', '.join(missing)}; need {','.join(ANGLES)} (degrees)")
-    cols = [text.header.index(c) for c in ANGLES]
-    rows = []
-    for lineno, fields in text.rows:
-        try:
-            rows.append([float(fields[c]) for c in cols])
-        except ValueError:
-            raise FormatError(path, f"line {lineno}: not a number in "
-                                    f"{','.join(fields[c] for c in cols)!r}") from None
-    a = np.asarray(rows)
+    a = parse_columns(path, text.header, text.rows, ANGLES)
     return pairs_from_angles(*a.T, degrees=True, params={"file": str(path)})
 
 
@@ -75,9 +69,9 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
 
     def num(x, what):
         try:
-            return float(x)
+            return parse_number(x.strip(" \t"))
         except ValueError:
-            raise bad(f"{what} {x!r} is not a number") from None
+            raise bad(f"{what} {x!r} is not a number ({NUMBER_FORM})") from None
 
     try:
         if kind == "full":
@@ -93,7 +87,7 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
             if len(args) not in (2, 3):
                 raise bad("plane takes WHICH:STEP[:THETA_I,...]")
             which = args[0].lower()
-            if which not in PLANE_AZIMUTHS and not re.fullmatch(r"[-+]?\d+(\.\d*)?", which):
+            if which not in PLANE_AZIMUTHS and not _AZIMUTH.fullmatch(which):
                 raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
             step = num(args[1], "step")
             if len(args) == 3:
@@ -110,7 +104,7 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
             if len(args) > 1:
                 raise bad("merl takes at most a stride")
             if args:
-                if not re.fullmatch(r"\d+", args[0]):
+                if not re.fullmatch(r"[0-9]+", args[0]):
                     raise bad(f"stride {args[0]!r} is not a positive integer")
                 return merl(int(args[0]), rotation=rotation)
             return merl(rotation=rotation)

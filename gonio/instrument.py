@@ -42,6 +42,10 @@ __all__ = ["Instrument", "cap_quadrature", "cone_directions", "NOISE_MODELS"]
 
 #: Names of the noise models.
 NOISE_MODELS = ("multiplicative", "shot")
+#: Accepted snr and snr_reference (1/sr): within them v / snr, snr^2 and the Poisson rate
+#: snr^2 v / snr_reference stay finite for any f_r (beyond, the noise is no measurement).
+SNR_RANGE = (1e-3, 1e12)
+REFERENCE_RANGE = (1e-12, 1e12)
 
 #: Above this Poisson mean the normal approximation is drawn (numpy's Poisson has a ceiling).
 _POISSON_MAX = 1e7
@@ -149,7 +153,8 @@ class Instrument:
     cone_source, cone_detector : float
         Half-angles of the source and detector cones in degrees, in [0, 90); 0 is a point.
     snr : float or None
-        Signal-to-noise ratio of the multiplicative or shot noise; None or inf for none.
+        Signal-to-noise ratio of the multiplicative or shot noise, in :data:`SNR_RANGE`;
+        None or inf for none.
     floor : float
         Standard deviation of the additive Gaussian noise floor, in 1/sr (>= 0).
     noise : {"multiplicative", "shot"}
@@ -194,22 +199,29 @@ class Instrument:
                 snr = float(snr)
             except (TypeError, ValueError):
                 raise ValueError(f"snr must be a positive number or None; got {snr!r}") from None
-            if math.isnan(snr) or snr <= 0:
-                raise ValueError(f"snr must be a positive number or None; got {self.snr!r}")
+            if math.isnan(snr) or snr <= 0 or (math.isfinite(snr) and not
+                                                 SNR_RANGE[0] <= snr <= SNR_RANGE[1]):
+                raise ValueError(f"snr must be a number in [{SNR_RANGE[0]:g}, {SNR_RANGE[1]:g}], "
+                                 f"or None or inf for none; got {self.snr!r}")
             snr = None if math.isinf(snr) else snr
         object.__setattr__(self, "snr", snr)
         try:
             floor = float(self.floor)
         except (TypeError, ValueError):
             raise ValueError(f"floor must be a number >= 0 (1/sr); got {self.floor!r}") from None
-        if not (math.isfinite(floor) and floor >= 0):
-            raise ValueError(f"floor must be a finite number >= 0 (1/sr); got {self.floor!r}")
+        if not (math.isfinite(floor) and 0 <= floor <= REFERENCE_RANGE[1]):
+            raise ValueError(f"floor must be a finite number in [0, {REFERENCE_RANGE[1]:g}] "
+                             f"(1/sr); got {self.floor!r}")
         object.__setattr__(self, "floor", floor)
         if self.noise not in NOISE_MODELS:
             raise ValueError(f"noise must be one of {', '.join(NOISE_MODELS)}; got {self.noise!r}")
-        ref = float(self.snr_reference)
-        if not (math.isfinite(ref) and ref > 0):
-            raise ValueError(f"snr_reference must be a positive f_r in 1/sr; "
+        try:
+            ref = float(self.snr_reference)
+        except (TypeError, ValueError):
+            ref = math.nan
+        if not (math.isfinite(ref) and REFERENCE_RANGE[0] <= ref <= REFERENCE_RANGE[1]):
+            raise ValueError(f"snr_reference must be a positive f_r in 1/sr, in "
+                             f"[{REFERENCE_RANGE[0]:g}, {REFERENCE_RANGE[1]:g}]; "
                              f"got {self.snr_reference!r}")
         object.__setattr__(self, "snr_reference", ref)
         cap_quadrature(0.0, self.rings, self.azimuths)  # validates rings and azimuths

@@ -15,6 +15,7 @@ import numpy as np
 
 from brdf.frames import from_angles, half_diff_to_directions, plane_to_directions, to_angles
 from gonio.geometry import HORIZON_EPS, Geometry
+from gonio.numtext import parse_number
 
 __all__ = ["full_grid", "plane", "rusinkiewicz", "merl", "pairs", "pairs_from_angles",
            "PLANE_AZIMUTHS"]
@@ -38,12 +39,30 @@ def _build(kind, params, wi, wo, coords, rotation) -> Geometry:
 
 def _step(name, value, upper=90.0) -> float:
     try:
-        v = float(value)
+        v = parse_number(value.strip(" \t")) if isinstance(value, str) else float(value)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number of degrees; got {value!r}") from None
     if not (math.isfinite(v) and 0 < v <= upper):
         raise ValueError(f"{name} must be in (0, {upper:g}] degrees; got {value!r}")
     return v
+
+
+#: The most (wi, wo) pairs a grid layout builds (about 2 GB of float64 arrays): finer steps
+#: are refused before any allocation instead of exhausting memory.
+MAX_PAIRS = 20_000_000
+
+
+def _side(theta_step, phi_step) -> int:
+    """Directions of one side of a full grid: 1 + (n_theta - 1) n_phi."""
+    return 1 + (_range(theta_step, 90.0).size - 1) * _range(phi_step, 360.0).size
+
+
+def _check_size(kind, counts) -> None:
+    """ValueError if the product of ``counts`` exceeds :data:`MAX_PAIRS`."""
+    total = math.prod(int(c) for c in counts)
+    if total > MAX_PAIRS:
+        raise ValueError(f"{kind}: the steps give {total:,} direction pairs, more than "
+                         f"{MAX_PAIRS:,}; use coarser steps")
 
 
 def _range(step, stop) -> np.ndarray:
@@ -98,6 +117,7 @@ def full_grid(theta_step: float = 10.0, phi_step: float | None = None, *,
     pi_s = _step("phi_step", ti_s if phi_step is None else phi_step, 360.0)
     to_s = _step("theta_o_step", ti_s if theta_o_step is None else theta_o_step)
     po_s = _step("phi_o_step", pi_s if phi_o_step is None else phi_o_step, 360.0)
+    _check_size("full_grid", (_side(ti_s, pi_s), _side(to_s, po_s)))
     ti, pi_ = _hemisphere(ti_s, pi_s)
     to, po = _hemisphere(to_s, po_s)
     TI = np.repeat(ti, to.size)
@@ -148,7 +168,7 @@ def plane(azimuth="warp", theta_o_step: float = 5.0,
             az = PLANE_AZIMUTHS[key]
         else:
             try:
-                az = float(key)
+                az = parse_number(key)
             except ValueError:
                 raise ValueError(f"plane azimuth must be warp, weft, 45 or degrees; "
                                  f"got {azimuth!r}") from None
@@ -202,6 +222,8 @@ def rusinkiewicz(theta_h_step: float = 5.0, phi_h_step: float | None = None,
     ph_s = _step("phi_h_step", th_s if phi_h_step is None else phi_h_step, 360.0)
     td_s = _step("theta_d_step", th_s if theta_d_step is None else theta_d_step)
     pd_s = _step("phi_d_step", th_s if phi_d_step is None else phi_d_step, 360.0)
+    _check_size("rusinkiewicz", [_range(s, stop).size for s, stop in
+                                 ((th_s, 90.0), (ph_s, 360.0), (td_s, 90.0), (pd_s, 360.0))])
     axes = [np.radians(_range(th_s, 90.0)), np.radians(_range(ph_s, 360.0)),
             np.radians(_range(td_s, 90.0)), np.radians(_range(pd_s, 360.0))]
     TH, PH, TD, PD = (a.reshape(-1) for a in np.meshgrid(*axes, indexing="ij"))

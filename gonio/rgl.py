@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from brdf.frames import flat_pairs
+from brdf.shading import DENOM_MIN
 from gonio.errors import FormatError
 
 __all__ = ["read_tensor_file", "load_rgl", "RGLBRDF"]
@@ -250,13 +252,25 @@ class RGLBRDF:
         Returns
         -------
         numpy.ndarray, shape (..., 3)
-            RGB f_r times cos(theta of wo_m), in 1/sr; 0 where either is below the horizon.
+            RGB f_r times cos(theta of wo_m), in 1/sr; 0 where either is below the horizon,
+            NaN where either is zero or not finite (as ``brdf.Fabric.eval``).
+
+        Raises
+        ------
+        ValueError
+            If the arrays lack a last axis of 3 or do not broadcast.
         """
-        wi = np.array(wi_m, dtype=np.float64)
-        wo = np.array(wo_m, dtype=np.float64)
-        wi, wo = np.broadcast_arrays(wi, wo)
+        wi, wo, shape, bad, below = flat_pairs(wi_m, wo_m, ("wi_m", "wo_m"))
+        out = np.zeros(wi.shape)
+        ok = ~(bad | below)
+        if ok.any():
+            out[ok] = self._eval_mitsuba(wi[ok], wo[ok])
+        out[bad] = np.nan
+        return out.reshape(shape + (3,))
+
+    def _eval_mitsuba(self, wi, wo) -> np.ndarray:
+        """:meth:`eval_mitsuba` of unit (n, 3) pairs above the horizon."""
         wi, wo = wi.copy(), wo.copy()
-        active = (wi[..., 2] > 0) & (wo[..., 2] > 0)
         if self.reduction >= 2:
             sy = wi[..., 1].copy()
             sx = wi[..., 0].copy() if self.reduction == 4 else sy
@@ -277,7 +291,7 @@ class RGLBRDF:
                          for c in range(3)], axis=-1)
         if self.jacobian:
             spec = spec * (self._ndf.eval(u_m, []) / (4.0 * self._sigma.eval(u_wi, [])))[..., None]
-        return np.where(active[..., None], spec, 0.0)
+        return spec
 
     def eval(self, wi, wo) -> np.ndarray:
         """RGB f_r in 1/sr.
@@ -290,12 +304,23 @@ class RGLBRDF:
         Returns
         -------
         numpy.ndarray, shape (..., 3)
-            f_r in 1/sr, no cosine; 0 below the horizon.
+            f_r in 1/sr, no cosine; 0 below the horizon; NaN where a direction is zero or not
+            finite. Non-unit vectors are normalized; cos(theta of wi) is taken as at least
+            :data:`brdf.shading.DENOM_MIN` (f_r stays finite at grazing incidence).
+
+        Raises
+        ------
+        ValueError
+            If the arrays lack a last axis of 3 or do not broadcast.
         """
-        wi = np.asarray(wi, dtype=np.float64)
-        out = self.eval_mitsuba(wo, wi)
-        cos_i = wi[..., 2:3]
-        return np.where(cos_i > 0, out / np.where(cos_i > 0, cos_i, 1.0), 0.0)
+        wi, wo, shape, bad, below = flat_pairs(wi, wo)
+        out = np.zeros(wi.shape)
+        ok = ~(bad | below)
+        if ok.any():
+            w = wi[ok]
+            out[ok] = self._eval_mitsuba(wo[ok], w) / np.maximum(w[:, 2:3], DENOM_MIN)
+        out[bad] = np.nan
+        return out.reshape(shape + (3,))
 
 
 def load_rgl(path) -> RGLBRDF:

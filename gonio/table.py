@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from brdf.frames import to_angles
+from brdf.frames import normalize, to_angles
 
 __all__ = ["Table"]
 
 
 def _as_n3(name: str, value, n: int | None) -> np.ndarray:
-    arr = np.array(value, dtype=np.float64)   # a copy: the caller's arrays are never changed
+    try:
+        arr = np.array(value, dtype=np.float64)   # a copy: the caller's arrays are never changed
+    except (TypeError, ValueError):
+        raise ValueError(f"Table {name} must be a numeric array of shape (n, 3); got "
+                         f"{value!r}"[:200]) from None
     if arr.ndim == 1 and name in ("values", "sigma"):
         arr = np.repeat(arr[:, None], 3, axis=1)
     if arr.ndim != 2 or arr.shape[1] != 3:
@@ -58,16 +63,24 @@ class Table:
         n = wi.shape[0]
         wo = _as_n3("wo", self.wo, n)
         for name, w in (("wi", wi), ("wo", wo)):
-            norm = np.linalg.norm(w, axis=1, keepdims=True)
-            if not np.all(np.isfinite(norm) & (norm > 0)):
-                raise ValueError(f"Table {name} holds zero or non-finite directions")
-            w /= norm
+            with np.errstate(over="ignore", under="ignore"):
+                norm = np.linalg.norm(w, axis=1, keepdims=True)
+            if not np.all((norm > 2.0 ** -500) & (norm < 2.0 ** 500)):  # scale first
+                unit, bad = normalize(w)
+                if bad.any():
+                    raise ValueError(f"Table {name} holds zero or non-finite directions (row "
+                                     f"{int(np.argmax(bad))})")
+                w[...] = unit
+            else:
+                w /= norm
         values = _as_n3("values", self.values, n)
         sigma = None if self.sigma is None else _as_n3("sigma", self.sigma, n)
         object.__setattr__(self, "wi", wi)
         object.__setattr__(self, "wo", wo)
         object.__setattr__(self, "values", values)
         object.__setattr__(self, "sigma", sigma)
+        if not isinstance(self.meta, Mapping):
+            raise ValueError(f"Table meta must be a dict; got {type(self.meta).__name__}")
         object.__setattr__(self, "meta", dict(self.meta))
 
     def __len__(self) -> int:

@@ -2,6 +2,7 @@
 
 import itertools
 import math
+import re
 
 import numpy as np
 import pytest
@@ -331,3 +332,78 @@ def test_grazing_pairs_finite_without_warnings(options):
             g = fab.eval(w, opposite)
         assert np.all(np.isfinite(f)) and np.all(f >= 0)
         assert np.all(np.isfinite(g)) and np.all(g >= 0)
+
+
+# -- grazing incidence: n . wi far below sqrt(float64's smallest normal) ------------------------
+GRAZING = [(1.0, 0.0), (0.0, 1.0), (0.6, 0.8), (0.3, -0.95), (-0.8, 0.6)]
+
+
+@pytest.mark.parametrize("options", [{}, {"reweighting": False}, {"masking": False},
+                                     {"rotation": 0.7}, {"gap": "outgoing"}],
+                         ids=lambda o: "-".join(f"{k}={v}" for k, v in o.items()) or "default")
+@pytest.mark.parametrize("name", brdf.PRESETS)
+def test_tiny_normal_component_matches_the_limit(name, options):
+    """f_r at n.wi = 1e-200 and 1e-160 is finite and equals MODEL.md's value. Near the horizon
+    f_r = A / (n.wi) + B + O(n.wi): the cosine-weighted f_r (n.wi) = (a_1 S_1 + a_2 S_2) / Q
+    has a limit A (S_j carries the thread-frame cos(theta_i), not n.wi), so f_r grows like
+    1/(n.wi) where A > 0. A and B come from the spec transliteration at n.wi = 1e-5, 2e-5
+    and 3e-5 (a quadratic in n.wi through f_r (n.wi)); closer to the horizon its asin loses
+    the digits of cos(theta) of directions along a thread. With wi and wo exchanged f_r tends
+    to a finite value."""
+    fab = brdf.fabric(name).replace(**options)
+    wo = brdf.directions.from_angles(np.radians([30.0, 60.0]), np.array([[2.9], [0.4]]))
+    wo = wo.reshape(-1, 3)
+    xy = np.array(GRAZING)
+
+    def directions(z):
+        w = np.concatenate([xy, np.full((len(xy), 1), z)], axis=1)
+        return w / np.linalg.norm(w, axis=1, keepdims=True)
+
+    zs = np.array([1e-5, 2e-5, 3e-5])
+    lagrange0 = np.array([3.0, -3.0, 1.0])            # the quadratic through 3 points, at 0
+    lagrange1 = np.array([-2.5, 4.0, -1.5]) / zs[0]   # its slope at 0
+    idx = np.array(list(itertools.product(range(len(xy)), range(len(wo)))))
+    g = np.array([reference_eval(fab, directions(z)[idx[:, 0]], wo[idx[:, 1]]) * z
+                  for z in zs])
+    big, rest = np.tensordot(lagrange0, g, 1), np.tensordot(lagrange1, g, 1)
+    h = np.array([reference_eval(fab, wo[idx[:, 1]], directions(z)[idx[:, 0]]) for z in zs])
+    grows = np.abs(big) > 1e-6 * np.abs(g[0])        # else A is rounding noise
+    for z in (1e-200, 1e-160):
+        got = fab.eval(directions(z)[idx[:, 0]], wo[idx[:, 1]])
+        assert np.all(np.isfinite(got))
+        np.testing.assert_allclose((got * z)[grows], big[grows], rtol=1e-6)
+        np.testing.assert_allclose(got[~grows], rest[~grows], rtol=1e-5, atol=1e-12)
+        back = fab.eval(wo[idx[:, 1]], directions(z)[idx[:, 0]])
+        np.testing.assert_allclose(back, np.tensordot(lagrange0, h, 1), rtol=1e-6, atol=1e-12)
+
+
+def test_tiny_components_everywhere_stay_finite():
+    """Directions whose components underflow when squared, subnormal ones included, give
+    finite f_r from eval, eval_threads and prepare(...).eval, never NaN (wi = wo along a
+    thread, along the other in-plane axis, subnormal n . wi)."""
+    fab = brdf.fabric("polyester_satin_charmeuse").replace(reweighting=False)
+    tiny = [1e-200, 1e-310, 5e-324, 1e-160]
+    ws = [np.array(v, float) for z in tiny for v in ([1.0, 0.0, z], [0.0, 1.0, z],
+                                                     [z, 0.0, 1.0], [1.0, z, z])]
+    wi = np.array([a for a in ws for _ in ws])
+    wo = np.array([b for _ in ws for b in ws])
+    for f in (fab, brdf.fabric("velvet"), brdf.fabric("linen_plain")):
+        for got in (f.eval(wi, wo), f.eval_threads(wi, wo).sum(axis=-2),
+                    f.prepare(wi, wo).eval()):
+            assert np.all(np.isfinite(got)) and np.all(got >= 0)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"area": [-1.0, 0.3]}, "area must be a finite number with 0.0 <= area <= 1.0; got -1.0"),
+    ({"eta": [np.nan, 1.4]}, "eta must be a finite number with 1.0 < eta; got nan"),
+    ({"kd": [[0.3, 0.3], [5.0, 0.1]]}, "kd must be a finite number with 0.0 <= kd <= 1.0; "
+                                       "got 5.0 (at index (1, 0))"),
+    ({"area": [0.6, 0.6]}, "areas must sum to at most 1"),
+    ({"gamma_v": [0.0, 3.0]}, "gamma_v must be a finite angle > 0 degrees"),
+    ({"albedo": [[1, 1, -1], [1, 1, 1]]}, "albedo must be one or three finite numbers >= 0"),
+    ({"gamma_s": "wide"}, "gamma_s must be a numeric array; got 'wide'"),
+])
+def test_prepared_eval_refuses_parameters_outside_their_ranges(kwargs, words):
+    prep = brdf.fabric("linen_plain").prepare([0.0, 0.0, 1.0], [0.0, 0.6, 0.8])
+    with pytest.raises(ValueError, match=re.escape(words)):
+        prep.eval(**kwargs)

@@ -225,3 +225,43 @@ def test_alta_reference_reader_slice(shared_data, tmp_path):
     cart = np.array([_alta_to_cartesian("COS_TH", r[:1]) for r in rows])
     np.testing.assert_allclose(cart[:, 3:6], t.wi, atol=1e-9)
     np.testing.assert_allclose(cart[:, 0:3], t.wo, atol=1e-9)
+
+
+SPH = "#DIM 4 3\n#PARAM_IN SPHERICAL_TL_PL_TV_PV\n#PARAM_OUT RGB_COLOR\n"
+
+
+@pytest.mark.parametrize("text, pattern", [
+    (SPH + "4 0 0.5 3 1 2 3\n",
+     r"line 4: theta_l = 4 is outside \[0, 3.14159\] .*coordinate 1"),
+    (SPH + "0.5 0 0.5 7 1 2 3\n", r"line 4: phi_v = 7 is outside \[-6.28319, 6.28319\]"),
+    (SPH + "0.5 0 0.5 3_0 1 2 3\n", r"line 4: not a number .*'3_0' is not a number"),
+    (SPH + "0.5 nan 0.5 3 1 2 3\n", r"line 4: not a number .*'nan'"),
+    (SPH + "0.5 0 0.5 3 1 2 infinity\n", r"line 4: not a number .*'infinity'"),
+    ("#DIM 6 3\n#PARAM_IN CARTESIAN\n#PARAM_OUT RGB_COLOR\n0 0 0 0 0 1 1 2 3\n",
+     "line 4: a zero vector"),
+    ("#DIM 6 3\n#PARAM_IN CARTESIAN\n#PARAM_OUT RGB_COLOR\n0 0 2 0 0 1 1 2 3\n",
+     r"line 4: V.z = 2 is outside \[-1, 1\]"),
+    ("#DIM 1 3\n#PARAM_IN COS_TH\n#PARAM_OUT RGB_COLOR\n0.5 1 2 3\n1.5 1 2 3\n",
+     r"line 5: COS_TH = 1.5 is outside \[0, 1\]"),
+])
+def test_strict_numbers_and_coordinate_ranges(tmp_path, text, pattern):
+    p = tmp_path / "bad.alta"
+    p.write_text(text)
+    with pytest.raises(gonio.FormatError, match="bad.alta: " + pattern):
+        gonio.read_alta(p)
+
+
+def test_values_may_be_nan_or_inf_and_byte_order_mark(tmp_path):
+    p = tmp_path / "t.alta"
+    p.write_bytes(b"\xef\xbb\xbf" + (SPH + "0.5 0 0.5 3 NaN inf -1e-3\n").encode())
+    t = gonio.read_alta(p)
+    assert np.isnan(t.values[0, 0]) and t.values[0, 1] == np.inf and t.values[0, 2] == -1e-3
+
+
+def test_write_refuses_a_table_without_rows_to_keep(tmp_path):
+    t = gonio.Table([[0, 0, 1.0]], [[0.6, 0, 0.8]], [[np.nan, 1, 1]])
+    with pytest.raises(ValueError, match="every one of the table's 1 rows has a missing"):
+        gonio.write_alta(t, tmp_path / "t.alta")
+    with pytest.raises(ValueError, match="digits must be an integer >= 1"):
+        gonio.write_alta(t, tmp_path / "t.alta", digits=2.5)
+    assert list(tmp_path.iterdir()) == []

@@ -62,3 +62,32 @@ def test_exr_and_merl_writers_clean_up(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="disk full"):
         gonio.write(random_table(2), tmp_path / "t.exr")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_errors_name_the_users_path_not_the_temporary_file(tmp_path, monkeypatch):
+    """A missing folder, a folder in the file's place, a failing rename or an OSError about
+    the temporary file inside the writer: the error names the destination."""
+    (tmp_path / "d.csv").mkdir()
+    for target in (tmp_path / "missing" / "t.csv", tmp_path / "d.csv"):
+        with pytest.raises(OSError) as info:
+            gonio.write(random_table(0), target)
+        assert info.value.filename == str(target) and ".tmp" not in str(info.value)
+    dest = tmp_path / "t.csv"
+
+    def fail(src, dst):
+        raise PermissionError(13, "Permission denied", str(src), None, str(dst))
+
+    monkeypatch.setattr("gonio.atomic.os.replace", fail)
+    with pytest.raises(PermissionError, match="cannot write: Permission denied") as info:
+        gonio.write(random_table(0), dest)
+    assert info.value.filename == str(dest) and ".tmp" not in str(info.value)
+    monkeypatch.undo()
+    with pytest.raises(OSError) as info:
+        with atomic_write(dest) as f:
+            raise OSError(28, "No space left on device", str(f.tmp_path))
+    assert info.value.filename == str(dest)
+    with pytest.raises(FileNotFoundError) as info:      # the writer's own errors pass as they are
+        with atomic_write(dest):
+            open(tmp_path / "other.bin", "rb")
+    assert info.value.filename == str(tmp_path / "other.bin")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.csv"]

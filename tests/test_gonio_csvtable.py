@@ -71,3 +71,58 @@ def test_binary_garbage(tmp_path):
     p.write_bytes(b"\xff\xfe\x00garbage")
     with pytest.raises(gonio.FormatError, match="bin.csv"):
         gonio.read(p)
+
+
+HEAD = "theta_i,phi_i,theta_o,phi_o,r,g,b\n"
+
+
+@pytest.mark.parametrize("row, pattern", [
+    ("200,0,30,180,1,2,3", r"line 2: theta_i = 200 is outside \[0, 180\] degrees"),
+    ("30,0,-1,180,1,2,3", r"line 2: theta_o = -1 is outside"),
+    ("30,400,30,180,1,2,3", r"line 2: phi_i = 400 is outside \[-360, 360\]"),
+    ("3_0,0,30,180,1,2,3", r"line 2: '3_0' is not a number .*, in column theta_i"),
+    ("30,0,30,180,1,2_0,3", r"line 2: '2_0' is not a number .*, in column g"),
+    ("30,0,30,180,1,2,infinity", r"line 2: 'infinity' is not a number"),
+    ("30,0,inf,180,1,2,3", r"line 2: angles must be finite numbers; got 'inf', in column theta_o"),
+    ("30,0,1e400,180,1,2,3", r"line 2: theta_o = 1e400 is outside"),
+    ("30,0,\u0663\u0660,180,1,2,3", r"line 2: '\u0663\u0660' is not a number"),
+    ("30,0,0x1e,180,1,2,3", r"line 2: '0x1e' is not a number"),
+])
+def test_strict_numbers_and_angle_ranges(tmp_path, row, pattern):
+    """Only decimal numbers; nan/inf only as values; angles within their ranges (the file, the
+    line and the column are named)."""
+    p = tmp_path / "bad.csv"
+    p.write_text(HEAD + row + "\n", encoding="utf-8")
+    with pytest.raises(gonio.FormatError, match="bad.csv: " + pattern):
+        gonio.read_csv(p)
+
+
+def test_values_may_be_nan_inf_or_empty_and_spaces_are_stripped(tmp_path):
+    p = tmp_path / "t.csv"
+    p.write_text(HEAD + " 30 , -10 ,+45., .5e1 ,NaN,-inf,\n90,359.5,180,-360,1E-3,Inf,+inf\n")
+    t = gonio.read_csv(p)
+    np.testing.assert_allclose(np.degrees(t.angles[0]), [30, -10, 45, 5], atol=1e-12)
+    assert np.isnan(t.values[0, 0]) and t.values[0, 1] == -np.inf and np.isnan(t.values[0, 2])
+    assert t.values[1, 0] == 1e-3 and np.all(t.values[1, 1:] == np.inf)
+
+
+def test_byte_order_mark_is_read(tmp_path):
+    """A spreadsheet's UTF-8 byte-order mark before the header (or a comment) is not part of
+    the first column's name."""
+    row = "30,0,30,180,1,2,3\n"
+    for text in (HEAD + row, "# source: \"sheet\"\n" + HEAD + row):
+        p = tmp_path / "bom.csv"
+        p.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+        t = gonio.read_csv(p)
+        assert len(t) == 1 and t.values[0].tolist() == [1, 2, 3]
+    assert t.meta["source"] == "sheet"
+
+
+def test_empty_table_is_refused_before_writing(tmp_path):
+    empty = gonio.Table(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)))
+    for suffix in (".csv", ".alta", ".exr"):
+        with pytest.raises(ValueError, match="empty"):
+            gonio.write(empty, tmp_path / f"e{suffix}")
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(ValueError, match="digits must be an integer >= 1; got 0"):
+        gonio.write_csv(random_table(1), tmp_path / "t.csv", digits=0)

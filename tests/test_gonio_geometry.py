@@ -1,10 +1,12 @@
 """Tests of gonio.geometry: layouts, counts, angle ranges, conversions, spec parser."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
+import gonio
 from gonio import geometry as G
 from gonio import layouts as L
 from gonio.geometry import Geometry
@@ -323,3 +325,24 @@ def test_describe_is_plain():
     d = L.merl(45, rotation=0.5).describe()
     assert json.loads(json.dumps(d)) == d
     assert d["rotation_deg"] == pytest.approx(math.degrees(0.5))
+
+
+@pytest.mark.parametrize("spec, words", [
+    ("full:3_0", "step '3_0' is not a number"), ("full:nan", "step 'nan' is not a number"),
+    ("plane:warp:5:3_0", "theta_i '3_0' is not a number"),
+    ("merl:\u0663", "stride .* is not a positive integer"),
+    ("plane:\u0661\u0660:5", "plane .* is not warp"),
+])
+def test_spec_numbers_are_strict(spec, words):
+    with pytest.raises(ValueError, match=f"geometry spec {re.escape(repr(spec))}: {words}"):
+        gonio.from_spec(spec)
+
+
+def test_pairs_file_angles_are_checked(tmp_path):
+    p = tmp_path / "p.csv"
+    p.write_text("theta_i,phi_i,theta_o,phi_o,note\n30,0,30,180,x\n200,0,30,180,y\n")
+    with pytest.raises(ValueError, match=r"p.csv: line 3: theta_i = 200 is outside"):
+        gonio.from_spec(f"pairs:{p}")
+    p.write_text("\ufefftheta_i,phi_i,theta_o,phi_o\n30,0,3_0,180\n")
+    with pytest.raises(ValueError, match=r"p.csv: line 2: '3_0' is not a number.*theta_o"):
+        gonio.from_spec(f"pairs:{p}")

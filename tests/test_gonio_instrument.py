@@ -158,3 +158,13 @@ def test_describe_is_plain():
     d = Instrument(cone_source=1, cone_detector=2, snr=50, floor=0.001).describe()
     assert json.loads(json.dumps(d)) == d
     assert d["evaluations_per_pair"] == 144 and d["cone_unit"] == "deg"
+
+
+@pytest.mark.parametrize("kw, name", [({"snr": 1e-213}, "snr"), ({"snr": 1e200}, "snr"),
+                                      ({"floor": 1e300}, "floor"),
+                                      ({"snr_reference": 1e-300}, "snr_reference"),
+                                      ({"snr_reference": "x"}, "snr_reference")])
+def test_noise_parameters_whose_arithmetic_would_overflow_are_refused(kw, name):
+    """An snr of 1e-213 made sigma infinite, 1e200 raised OverflowError in snr ** 2."""
+    with pytest.raises(ValueError, match=f"^{name} must be"):
+        Instrument(**kw)

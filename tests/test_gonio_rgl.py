@@ -74,3 +74,21 @@ def test_bad_files(tmp_path, rgl_dir):
     tiny.write_bytes(good[:40])
     with pytest.raises(gonio.FormatError, match="tiny.bsdf"):
         gonio.load_rgl(tiny)
+
+
+def test_eval_of_bad_directions(rgl_dir):
+    """NaN, infinite or zero directions give NaN (as brdf.Fabric.eval), not an IndexError;
+    non-unit ones are normalized; grazing ones stay finite; bad shapes are a ValueError."""
+    felt = gonio.load_rgl(rgl_dir / "acrylic_felt_white_rgb.bsdf")
+    wo = np.array([0.0, 0.6, 0.8])
+    wi = np.array([[np.nan, 0, 1], [0, 0, np.inf], [0, 0, 0], [0.6, 0, 0.8], [3.0, 0, 4.0],
+                   [1.0, 0.0, 1e-200], [0.0, 0.0, -1.0]])
+    got = felt.eval(wi, wo)
+    assert np.isnan(got[:3]).all() and np.isnan(felt.eval(wo, wi)[:3]).all()
+    np.testing.assert_allclose(got[4], got[3], rtol=1e-13)
+    assert np.isfinite(got[5]).all() and (got[6] == 0).all()
+    assert np.isnan(felt.eval_mitsuba(wi, wo)[:3]).all()
+    with pytest.raises(ValueError, match="wi must have shape"):
+        felt.eval([0.0, 1.0], wo)
+    with pytest.raises(ValueError, match="wi_m and wo_m must broadcast"):
+        felt.eval_mitsuba(np.zeros((2, 3)), np.zeros((3, 3)))

@@ -31,6 +31,19 @@ class BatchInterrupted(KeyboardInterrupt):
 
 
 @contextlib.contextmanager
+def _quiet_dask():
+    """Dask's own log (comm timeouts under load, the noise of closing a cluster on Ctrl-C)
+    held back to CRITICAL for the batch: the batch reports its tables' errors itself."""
+    log = logging.getLogger("distributed")
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        log.setLevel(level)
+
+
+@contextlib.contextmanager
 def _client(workers: int | None, scheduler: str | None):
     """A Dask client: of a new LocalCluster, or connected to ``scheduler``."""
     # distributed is imported on use: it takes most of a second, and every `microcyl` verb
@@ -120,7 +133,7 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
                       initial=len(jobs) - len(todo)) as bar:
         say = (bar.write if progress else echo) if echo is not None else None
         if todo:
-            with _client(workers, scheduler) as client:
+            with _quiet_dask(), _client(workers, scheduler) as client:
                 _gather(client, todo, out, summary, names, bar, say)
         summary.write(names)
     return summary

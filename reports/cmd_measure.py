@@ -12,14 +12,18 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 
 import brdf
 import gonio
+from analysis.budget import (MEASURE_BYTES_PER_PAIR, check_memory, format_bytes,
+                             format_seconds, spec_pairs)
 from gonio import Instrument, measure
 from gonio.geometry import SPEC_HELP
 from gonio.geomspec import from_spec
 from gonio.instrument import NOISE_MODELS
+from reports import cliutil
 
 __all__ = ["register", "run"]
 
@@ -78,9 +82,7 @@ def _fabric_options(args) -> dict:
         if v is not None:
             opts[name] = _ON_OFF[v]
     if args.tangent_samples is not None:
-        if args.tangent_samples < 1:
-            raise ValueError(f"--tangent-samples must be a positive integer; "
-                             f"got {args.tangent_samples}")
+        cliutil.check_tangent_samples(args.tangent_samples)
         opts["tangent_samples"] = args.tangent_samples
     for name in ("tangent_sampling", "transmission", "gap"):
         v = getattr(args, name)
@@ -96,6 +98,26 @@ def _make_fabric(name: str, options: dict):
     return brdf.fabric(name, **options)
 
 
+#: Seconds per BRDF evaluation with 32 tangent samples (about 10 us measured on 2 cores).
+SECONDS_PER_EVALUATION = 1.2e-5
+
+
+def _check_size(args, instrument, fabric) -> None:
+    """Refuse a geometry that cannot fit in memory, before it is built; say how long a
+    measurement of more than a few seconds will take."""
+    n = spec_pairs(args.geometry)
+    if n is None:
+        return
+    what = f"--geometry {args.geometry} ({n:.3g} pairs)"
+    nbytes = n * MEASURE_BYTES_PER_PAIR
+    check_memory(what, nbytes, "use a coarser step")
+    points = len(instrument.source_rule[1]) * len(instrument.detector_rule[1])
+    seconds = n * points * SECONDS_PER_EVALUATION * fabric.options["tangent_samples"] / 32
+    if seconds > 5:
+        print(f"measure: {what} x {points} cone points: about {format_bytes(nbytes)} of "
+              f"memory and {format_seconds(seconds)}", file=sys.stderr, flush=True)
+
+
 def run(args) -> int:
     """Measure and write; every check on the input happens before the measurement."""
     out = Path(args.output)
@@ -109,8 +131,9 @@ def run(args) -> int:
                             snr=args.snr, floor=args.floor, noise=args.noise,
                             snr_reference=args.snr_reference, rings=args.cone_rings,
                             azimuths=args.cone_azimuths)
-    geometry = from_spec(args.geometry, rotation=math.radians(args.rotation))
     fabric = _make_fabric(args.fabric, _fabric_options(args))
+    _check_size(args, instrument, fabric)
+    geometry = from_spec(args.geometry, rotation=math.radians(args.rotation))
     table = measure(fabric, geometry, instrument, seed=args.seed)
     if "name" not in table.meta["source"]:
         table.meta["source"]["name"] = args.fabric

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import gonio
+from reports import cliutil
 
 
 def register(sub):
@@ -36,18 +37,16 @@ def _reader_options(p):
 
 
 def _read(args, path):
-    options = {k: getattr(args, k) for k in ("sample", "step", "stride")
-               if getattr(args, k) is not None}
-    return gonio.read(path, **options)
+    return cliutil.read_table(path, sample=args.sample, step=args.step, stride=args.stride)
 
 
 def run_convert(args):
-    table = _read(args, args.input)
     options = {}
     if getattr(args, "alta_param", None):
         if not str(args.output).lower().endswith(".alta"):
             raise ValueError("--alta-param applies to an .alta output only")
         options["param"] = args.alta_param
+    table = _read(args, args.input)
     gonio.write(table, args.output, **options)
     print(f"wrote {len(table)} rows to {args.output}")
     return 0

@@ -63,6 +63,9 @@ def format_bytes(n: float) -> str:
     >>> format_bytes(3 << 30), format_bytes(512)
     ('3.0 GB', '512 B')
     """
+    if not math.isfinite(n):
+        return "more than any machine has"
+    n = float(n)
     for unit in ("B", "KB", "MB", "GB", "TB", "PB"):
         if n < 1024 or unit == "PB":
             return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
@@ -107,16 +110,22 @@ def check_memory(what: str, nbytes: float, change: str) -> None:
         ``"{what} needs about X of memory; the limit is Y (how); {change}"``.
     """
     limit, how = memory_limit()
+    nbytes = float(nbytes) if nbytes < 1e300 else math.inf
     if not nbytes <= limit:
         raise ValueError(f"{what} needs about {format_bytes(nbytes)} of memory; the limit is "
                          f"{format_bytes(limit)} ({how}); {change}")
 
 
-def _n(step: float, stop: float) -> int:
-    return int(math.ceil(stop / step - 1e-9))
+def _n(step: float, stop: float) -> float:
+    return float(math.ceil(stop / step - 1e-9))
 
 
-def spec_pairs(spec: str) -> int | None:
+def _count(x: float) -> int | float:
+    """An exact int while it is one, else the float (inf past the float range)."""
+    return int(x) if x < 1e18 else x
+
+
+def spec_pairs(spec: str) -> int | float | None:
     """Number of direction pairs a geometry spec (``full:10``, ``rus:5``, ``merl:2``) makes,
     counted without building it; None when the spec is another kind or malformed (then
     :func:`gonio.from_spec` gives the error), or small by construction (``plane``, ``pairs``).
@@ -141,11 +150,11 @@ def spec_pairs(spec: str) -> int | None:
             return None
         side_i = 1 + (_n(ti, 90.0) - 1) * _n(pi, 360.0)
         side_o = 1 + (_n(to, 90.0) - 1) * _n(po, 360.0)
-        return side_i * side_o
+        return _count(side_i * side_o)
     if kind in ("rusinkiewicz", "rus") and len(v) in (1, 4):
         th, ph, td, pd = v * 4 if len(v) == 1 else v
-        return _n(th, 90.0) * _n(ph, 360.0) * _n(td, 90.0) * _n(pd, 360.0)
+        return _count(_n(th, 90.0) * _n(ph, 360.0) * _n(td, 90.0) * _n(pd, 360.0))
     if kind == "merl" and len(v) <= 1:
         s = v[0] if v else 1.0
-        return _n(s, 90.0) ** 2 * _n(s, 180.0)
+        return _count(_n(s, 90.0) ** 2 * _n(s, 180.0))
     return None

@@ -23,7 +23,7 @@ __all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_
            "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
 
-#: Largest --tangent-samples: the model converges long before (MODEL.md: 32 is within 1e-4).
+#: Largest --tangent-samples (the default is 32): a fixed cap on the work of each pair.
 MAX_TANGENT_SAMPLES = 4096
 #: Largest --ensembles: R-hat needs a few; each is a group of the one checkpoint.
 MAX_ENSEMBLES = 64
@@ -96,8 +96,8 @@ def add_cluster_options(p: argparse.ArgumentParser) -> None:
 def check_tangent_samples(n) -> None:
     """``--tangent-samples``: an integer in [1, MAX_TANGENT_SAMPLES]."""
     if not 1 <= n <= MAX_TANGENT_SAMPLES:
-        raise ValueError(f"--tangent-samples must be an integer in 1..{MAX_TANGENT_SAMPLES} "
-                         f"(32 is within 1e-4 of the converged model); got {n}")
+        raise ValueError(f"--tangent-samples must be an integer in 1..{MAX_TANGENT_SAMPLES}; "
+                         f"got {n}")
 
 
 def check_fit_options(args: argparse.Namespace) -> None:
@@ -157,7 +157,7 @@ def reader_options(path, **options) -> dict:
         step = given["step"]
         if not (math.isfinite(step) and 0 < step <= 90):
             raise ValueError(f"--step must be in (0, 90] degrees; got {step}")
-        n_o = math.ceil(90 / step - 1e-9) * math.ceil(360 / step - 1e-9)
+        n_o = float(math.ceil(90 / step - 1e-9)) * float(math.ceil(360 / step - 1e-9))
         pairs = _rgl_incident(path) * n_o
         check_memory(f"--step {step:g} ({pairs:.3g} pairs: {n_o:.3g} outgoing directions "
                      f"for each incident one)", pairs * RGL_BYTES_PER_PAIR,

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 import gonio
+from analysis.folderlock import output_lock
 from reports import cliutil
 
 
@@ -47,7 +50,8 @@ def run_convert(args):
             raise ValueError("--alta-param applies to an .alta output only")
         options["param"] = args.alta_param
     table = _read(args, args.input)
-    gonio.write(table, args.output, **options)
+    with output_lock(Path(args.output), "convert", inside=False):  # removes a killed run's
+        gonio.write(table, args.output, **options)                 # .OUT.*.tmp
     print(f"wrote {len(table)} rows to {args.output}")
     return 0
 

@@ -9,6 +9,7 @@ import pytest
 
 from analysis.fit import FabricModel, fit
 from analysis.fit.checkpoint import CONFIG_FILE
+from analysis.fit.driver import FitOptions, estimate_time
 from analysis.fit.optimize import point_estimate
 from analysis.fit.posterior import LogPosterior
 from analysis.likelihood import Likelihood
@@ -38,8 +39,13 @@ def test_a_start_that_cannot_be_evaluated_leaves_nothing(tmp_path):
     r2 = fit(table, spec, model, out_dir=tmp_path, max_steps=20, check_every=10,
              progress=False)
     assert np.isfinite(r2.best_logp) and r2.best_logp == pytest.approx(r.best_logp)
-    assert len(lines) == 1 and lines[0].startswith("fit: 180 values, 2 free parameters; "
-                                                   "about ") and "a step" in lines[0]
+    assert lines == []                  # seconds: not worth a line
+    opts = FitOptions(max_steps=1000).resolve(2)
+    lp = LogPosterior(spec, Likelihood(table), model)
+    seconds, line = estimate_time(lp, opts, 180, True)
+    assert line.startswith("fit: 180 values, 2 free parameters; about ") and "a step" in line
+    assert "for --max-steps 1000" in line and "the point estimate first" in line
+    assert 0 < seconds < 600
 
 
 def test_the_point_estimate_is_never_worse_than_its_start():

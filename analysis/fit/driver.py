@@ -29,6 +29,8 @@ from gonio.progress import progress_bar
 
 __all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time"]
 
+#: A fit that may take this many seconds or more says so before it starts (``notify``).
+ESTIMATE_MIN_S = 10.0
 #: Version of the sampler's configuration; a folder fitted by another version is refused.
 CONFIG_VERSION = 7
 
@@ -193,8 +195,9 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     config_extra : mapping, optional
         Also recorded in (and matched against) the stored configuration.
     notify : callable, optional
-        ``notify(line)`` is given the estimated time of the fit before it starts
-        (:func:`estimate_time`; not on a resume).
+        ``notify(line)`` is given the estimated time of the fit before it starts when it may
+        take ``ESTIMATE_MIN_S`` or more (:func:`estimate_time`; not on a resume), and a
+        point estimate that ends on bounds.
 
     Returns
     -------
@@ -229,10 +232,12 @@ def _check_memory(opts: FitOptions, ndim: int, n_used: int) -> None:
                  batch, "lower --walkers")
 
 
-def estimate_time(logpost, opts: FitOptions, n_used: int, optimize: bool) -> str:
+def estimate_time(logpost, opts: FitOptions, n_used: int,
+                  optimize: bool) -> tuple[float, str]:
     """One line: the time of a step (a batch of ``walkers / 2`` evaluations timed, twice for
     each ensemble, shared by the threads), of ``max_steps`` steps, and of the point estimate (a batch of ndim + 1
-    evaluations, the finite-difference gradient, timed: ~100 iterations a start)."""
+    evaluations, the finite-difference gradient, timed: ~100 iterations a start); returns
+    (the seconds at most, the line)."""
     def timed(k):
         batch = np.repeat(logpost.spec.start()[None], k, axis=0)
         t0 = time.perf_counter()
@@ -247,10 +252,11 @@ def estimate_time(logpost, opts: FitOptions, n_used: int, optimize: bool) -> str
             f"({opts.ensembles} ensembles x {opts.walkers} walkers), so up to "
             f"{format_seconds(step * opts.max_steps)} for --max-steps {opts.max_steps} "
             f"(convergence usually stops it sooner; --time-limit bounds it)")
+    est = 0.0
     if optimize:
         est = timed(logpost.spec.ndim + 1) * opts.n_starts * 100
         line += f"; the point estimate first, about {format_seconds(est)}"
-    return line
+    return est + step * opts.max_steps, line
 
 
 def _check_start(spec: ParamSpec, best, best_logp: float, notify=None) -> None:
@@ -289,7 +295,9 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
                       for s in np.random.SeedSequence(opts.seed).spawn(opts.ensembles + 1)]
     with threadpool_limits(limits=1, user_api="blas"):
         if notify is not None and ckpt is None:
-            notify(estimate_time(logpost, opts, lik.n_used, start is None))
+            seconds, line = estimate_time(logpost, opts, lik.n_used, start is None)
+            if seconds >= ESTIMATE_MIN_S:
+                notify(line)
         if start is None:
             best, best_logp, cov = optimize_start(logpost, opts.n_starts, rng_opt, opts.threads)
             _check_start(spec, best, best_logp, notify)

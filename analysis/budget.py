@@ -107,13 +107,13 @@ def check_memory(what: str, nbytes: float, change: str) -> None:
     Raises
     ------
     ValueError
-        ``"{what} needs about X of memory; the limit is Y (how); {change}"``.
+        ``"{what} would take about X of memory; the limit is Y (how); {change}"``.
     """
     limit, how = memory_limit()
     nbytes = float(nbytes) if nbytes < 1e300 else math.inf
     if not nbytes <= limit:
-        raise ValueError(f"{what} needs about {format_bytes(nbytes)} of memory; the limit is "
-                         f"{format_bytes(limit)} ({how}); {change}")
+        raise ValueError(f"{what} would take about {format_bytes(nbytes)} of memory; the "
+                         f"limit is {format_bytes(limit)} ({how}); {change}")
 
 
 def _n(step: float, stop: float) -> float:

@@ -16,14 +16,21 @@ space, for tables without sigma).
 
 from __future__ import annotations
 
+import math
 import re
+from typing import Mapping
 
 import numpy as np
 
 from brdf import schema
 
 __all__ = ["BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES",
-           "defaults_from_fabric", "parse_free", "parse_ties", "base_of"]
+           "defaults_from_fabric", "parse_free", "parse_ties", "base_of", "checked_defaults",
+           "checked_bounds", "checked_priors", "checked_ties", "resolve_ties", "checked_toml",
+           "PRIORS", "TOML_KEYS"]
+
+#: The priors a parameter may take.
+PRIORS = ("uniform", "log-uniform")
 
 #: Natural-unit (lo, hi, prior, unit, fallback default) of an entry derived from the schema.
 Entry = tuple[float, float, str, str, float]
@@ -114,9 +121,10 @@ def parse_free(free) -> tuple[str, ...]:
     >>> parse_free("eta1, albedo2")
     ('eta1', 'albedo2_r', 'albedo2_g', 'albedo2_b')
     """
-    items = [s.strip() for s in free.split(",")] if isinstance(free, str) else list(free)
+    items = _items(free, "free parameters", "names")
     out: list[str] = []
     for s in items:
+        s = s.strip()
         if not s:
             continue
         for name in ALIASES.get(s, (s,)):
@@ -128,6 +136,25 @@ def parse_free(free) -> tuple[str, ...]:
         raise ValueError(f"free parameters: none given ({free!r}); valid names: "
                          f"{', '.join(PARAM_NAMES)}")
     return tuple(out)
+
+
+def _items(value, what: str, allowed: str) -> list[str]:
+    """A comma-separated string, or a list/tuple of strings, as a list of strings; a
+    ValueError naming ``what`` for anything else (a number, a table, a list of numbers)."""
+    if value is None:
+        return []
+    if isinstance(value, str):
+        return value.split(",")
+    if not isinstance(value, (list, tuple)):
+        raise ValueError(f"{what}: expected a comma-separated string or a list of {allowed}; "
+                         f"got {type(value).__name__} {value!r:.60}")
+    out = []
+    for k, item in enumerate(value, start=1):
+        if not isinstance(item, str):
+            raise ValueError(f"{what}: item {k} is {type(item).__name__} {item!r:.60}; "
+                             f"expected {allowed}")
+        out.extend(item.split(","))
+    return out
 
 
 def parse_ties(ties) -> dict[str, tuple[str, str]]:
@@ -142,10 +169,8 @@ def parse_ties(ties) -> dict[str, tuple[str, str]]:
     >>> parse_ties(["eta2=eta1", "area2=1-area1"])
     {'eta2': ('eta1', 'equal'), 'area2': ('area1', 'complement')}
     """
-    if isinstance(ties, str):
-        ties = [t for t in ties.split(",")]
     out: dict[str, tuple[str, str]] = {}
-    for t in ties or ():
+    for t in _items(ties, "ties", "'a=b' or 'a=1-b' strings"):
         t = t.replace(" ", "")
         if not t:
             continue
@@ -158,7 +183,11 @@ def parse_ties(ties) -> dict[str, tuple[str, str]]:
                 raise unknown(name, "tied parameter")
         if target == source:
             raise ValueError(f"tie {t!r}: a parameter cannot be tied to itself")
-        out[target] = (source, "complement" if comp else "equal")
+        tie = (source, "complement" if comp else "equal")
+        if out.get(target, tie) != tie:
+            raise ValueError(f"tie {t!r}: {target} is already tied to {out[target][0]}; "
+                             f"tie each parameter once")
+        out[target] = tie
     return out
 
 
@@ -186,4 +215,131 @@ def defaults_from_fabric(fab) -> dict[str, float]:
             rgb = np.broadcast_to(np.asarray(getattr(th, name), float), (3,))
             for c, a in zip(schema.RGB_CHANNELS, rgb):
                 out[f"{name}{j}_{c}"] = float(a)
+    return out
+
+
+def _table(value, what: str) -> dict:
+    """A mapping keyed by parameter names (unknown names refused), as a dict."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise ValueError(f"{what}: expected a table of parameter names; got "
+                         f"{type(value).__name__} {value!r:.60}")
+    for name in value:
+        if name not in PARAM_NAMES:
+            raise unknown(name, f"parameter in {what}")
+    return dict(value)
+
+
+def _number(value, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{what} must be a number; got {type(value).__name__} {value!r:.60}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{what} must be finite; got {value!r}")
+    return v
+
+
+def checked_defaults(defaults) -> dict[str, float]:
+    """Start values: a mapping name -> finite number (a ValueError naming the first bad one)."""
+    return {n: _number(v, f"start value of {n}") for n, v in _table(defaults, "start").items()}
+
+
+def checked_bounds(bounds) -> dict[str, tuple[float, float]]:
+    """Bounds: a mapping name -> (lo, hi) of finite numbers."""
+    out = {}
+    for name, b in _table(bounds, "bounds").items():
+        if isinstance(b, (str, bytes, Mapping)) or not hasattr(b, "__len__") or len(b) != 2:
+            raise ValueError(f"bounds of {name} must be [lo, hi]; got {b!r:.60}")
+        out[name] = (_number(b[0], f"lower bound of {name}"),
+                     _number(b[1], f"upper bound of {name}"))
+    return out
+
+
+def checked_priors(priors) -> dict[str, str]:
+    """Priors: a mapping name -> "uniform" | "log-uniform"."""
+    out = _table(priors, "prior")
+    for name, v in out.items():
+        if v not in PRIORS:
+            raise ValueError(f"prior of {name} must be 'uniform' or 'log-uniform'; "
+                             f"got {v!r:.60}")
+    return out
+
+
+def checked_ties(ties) -> dict[str, tuple[str, str]]:
+    """Ties as {target: (source, kind)}: strings parsed (:func:`parse_ties`), a mapping of
+    that shape checked."""
+    if not isinstance(ties, Mapping):
+        return parse_ties(ties)
+    out = {}
+    for target, value in ties.items():
+        ok = (isinstance(value, (tuple, list)) and len(value) == 2
+              and value[1] in ("equal", "complement") and isinstance(value[0], str))
+        if not ok:
+            raise ValueError(f"tie of {target!r}: expected (source, 'equal' | 'complement'); "
+                             f"got {value!r:.60}")
+        for name in (target, value[0]):
+            if name not in PARAM_NAMES:
+                raise unknown(name, "tied parameter")
+        if target == value[0]:
+            raise ValueError(f"tie {target}={target}: a parameter cannot be tied to itself")
+        out[target] = (value[0], value[1])
+    return out
+
+
+def resolve_ties(free, ties: dict) -> dict[str, tuple[str, str]]:
+    """Orient each tie onto its free side (``a=b`` with only ``a`` free samples ``a`` and sets
+    ``b``) and refuse the contradictions: both sides free, neither side free, a parameter
+    tied twice.
+
+    Examples
+    --------
+    >>> resolve_ties(["eta2"], {"eta2": ("eta1", "equal")})
+    {'eta1': ('eta2', 'equal')}
+    """
+    out: dict[str, tuple[str, str]] = {}
+    for target, (source, kind) in ties.items():
+        tie = f"tie {target}={'1-' if kind == 'complement' else ''}{source}"
+        if target in free and source in free:
+            raise ValueError(f"{tie}: both {target} and {source} are listed free; a tied "
+                             f"parameter takes its source's value, so drop {target} from the "
+                             f"free parameters or drop the tie")
+        if target not in free and source not in free:
+            raise ValueError(f"{tie}: neither {target} nor {source} is free (a tie between "
+                             f"fixed parameters does nothing); free {source} or drop the tie")
+        if target in free:
+            target, source = source, target
+        if target in out:
+            raise ValueError(f"{tie}: {target} is already tied to {out[target][0]}; tie each "
+                             f"parameter once")
+        out[target] = (source, kind)
+    return out
+
+
+#: The keys of a TOML spec file and what each holds.
+TOML_KEYS = {"free": "a list of names", "tie": "a list of 'a=b' strings",
+             "bounds": "a table name = [lo, hi]", "prior": "a table name = 'uniform' | "
+             "'log-uniform'", "start": "a table name = value", "fabric": "a preset name"}
+
+
+def checked_toml(doc: Mapping) -> dict:
+    """The keys of a parsed TOML spec, each checked once (a ValueError naming the key):
+    ``free`` and ``tie`` as lists of strings, ``bounds``/``prior``/``start`` as checked
+    tables, ``fabric`` a string."""
+    extra = set(doc) - set(TOML_KEYS)
+    if extra:
+        raise ValueError(f"unknown keys {sorted(extra)}; allowed: {sorted(TOML_KEYS)}")
+    out = {}
+    for key, check in (("free", lambda v: list(parse_free(v))),
+                       ("tie", lambda v: [t for t in _items(v, "tie", "'a=b' strings")
+                                          if t.strip()]),
+                       ("bounds", checked_bounds), ("prior", checked_priors),
+                       ("start", checked_defaults)):
+        if key in doc:
+            try:
+                out[key] = check(doc[key])
+            except ValueError as exc:
+                raise ValueError(f"key {key!r} ({TOML_KEYS[key]}): {exc}") from None
+    if "fabric" in doc and not isinstance(doc["fabric"], str):
+        raise ValueError(f"key 'fabric' ({TOML_KEYS['fabric']}): got {doc['fabric']!r:.60}")
     return out

@@ -28,8 +28,10 @@ import numpy as np
 import scipy.special
 
 from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_PARAM_NAMES,
-                                 PARAM_NAMES, defaults_from_fabric, entry, parse_free,
-                                 parse_ties, unknown)
+                                 PARAM_NAMES, checked_bounds, checked_defaults,
+                                 checked_priors, checked_ties, checked_toml,
+                                 defaults_from_fabric, entry, parse_free, parse_ties,
+                                 resolve_ties, unknown)
 from brdf import schema
 
 __all__ = ["Param", "ParamSpec", "INTERNAL_LIMIT", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
@@ -128,8 +130,8 @@ class ParamSpec:
         Natural-unit defaults (e.g. :func:`defaults_from_fabric`); missing ones use the
         built-in fallbacks. Free parameters start here; fixed ones stay here.
     ties : str, sequence or mapping, optional
-        ``"eta2=eta1"`` (equal) or ``"area2=1-area1"`` (complement). A target that is also
-        listed as free is dropped from the free set.
+        ``"eta2=eta1"`` (equal) or ``"area2=1-area1"`` (complement); exactly one side of
+        each tie is free (when it is the target, the two are swapped).
     bounds : mapping name -> (lo, hi), optional
         Override bounds (natural units).
     priors : mapping name -> "uniform" | "log-uniform", optional
@@ -138,8 +140,9 @@ class ParamSpec:
     Raises
     ------
     ValueError
-        Unknown names (listing the valid ones), a tie whose source is itself tied, a free
-        parameter whose default lies outside its bounds, bad bounds or priors.
+        Unknown names (listing the valid ones), a tie with both sides free or neither, a
+        parameter tied twice, a free parameter whose default lies outside its bounds, bad
+        bounds, priors or start values (not numbers, not finite).
 
     Examples
     --------
@@ -155,32 +158,16 @@ class ParamSpec:
     def __init__(self, free, defaults: Mapping[str, float] | None = None, ties=None,
                  bounds: Mapping[str, Sequence[float]] | None = None,
                  priors: Mapping[str, str] | None = None):
-        defaults = dict(defaults or {})
-        for name in list(defaults) + list(bounds or {}) + list(priors or {}):
-            if name not in PARAM_NAMES:
-                raise unknown(name)
-        ties = parse_ties(ties) if not isinstance(ties, Mapping) else dict(ties)
+        defaults = checked_defaults(defaults)
+        bounds, priors = checked_bounds(bounds), checked_priors(priors)
         free = list(parse_free(free))
-        self.ties = {}
-        for target, (source, kind) in ties.items():
-            if target in free and source not in free:
-                target, source = source, target
-            self.ties[target] = (source, kind)
+        self.ties = resolve_ties(free, checked_ties(ties))
         free = [f for f in free if f not in self.ties]
-        for target, (source, _) in self.ties.items():
-            if source in self.ties:
-                raise ValueError(f"tie {target}={source}: {source} is itself tied; tie both "
-                                 f"to the same free parameter")
         self.params: dict[str, Param] = {}
         for name in PARAM_NAMES:
             lo, hi, prior, unit, fallback = entry(name)
-            if bounds and name in bounds:
-                b = tuple(float(x) for x in bounds[name])
-                if len(b) != 2:
-                    raise ValueError(f"bounds of {name} must be (lo, hi); got {bounds[name]!r}")
-                lo, hi = b
-            if priors and name in priors:
-                prior = priors[name]
+            lo, hi = bounds.get(name, (lo, hi))
+            prior = priors.get(name, prior)
             self.params[name] = Param(name, float(lo), float(hi), prior, unit,
                                       float(defaults.get(name, fallback)))
         self.free: tuple[str, ...] = tuple(free)
@@ -211,7 +198,10 @@ class ParamSpec:
         Raises
         ------
         ValueError
-            The file is not valid TOML or holds unknown keys (the message names the file).
+            The file is not valid TOML, holds unknown keys, a key of the wrong type (``tie =
+            [1]``, a table where a number belongs) or a contradiction (a tie with both sides
+            free): the message names the file and the key. The whole spec is checked here,
+            once, before any work.
         """
         path = Path(path)
         try:
@@ -219,21 +209,22 @@ class ParamSpec:
                 doc = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise ValueError(f"{path}: not valid TOML: {exc}") from None
-        allowed = {"free", "tie", "bounds", "prior", "start", "fabric"}
-        extra = set(doc) - allowed
-        if extra:
-            raise ValueError(f"{path}: unknown keys {sorted(extra)}; allowed: {sorted(allowed)}")
-        d = dict(defaults or {})
-        d.update({k: float(v) for k, v in doc.get("start", {}).items()})
-        fr = list(parse_free(doc["free"])) if "free" in doc else []
-        if free:
-            fr += [f for f in parse_free(free) if f not in fr]
-        tie_list = list(doc.get("tie", []))
-        if isinstance(ties, str):
-            ties = ties.split(",")
-        tie_list += list(ties or [])
-        return cls(fr, defaults=d, ties=tie_list, bounds=doc.get("bounds"),
-                   priors=doc.get("prior"))
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"{path}: not valid TOML (not UTF-8 text: {exc.reason})") from None
+        try:
+            doc = checked_toml(doc)
+            d = checked_defaults(defaults)
+            d.update(doc.get("start", {}))
+            fr = doc.get("free", [])
+            if free:
+                fr += [f for f in parse_free(free) if f not in fr]
+            if isinstance(ties, str):
+                ties = ties.split(",")
+            tie_list = doc.get("tie", []) + list(ties or [])
+            return cls(fr, defaults=d, ties=tie_list, bounds=doc.get("bounds"),
+                       priors=doc.get("prior"))
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
 
     # ------------------------------------------------------------------ accessors
     @property

@@ -8,14 +8,29 @@ import os
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 import brdf
+import gonio
+import gonio.rgl
+from analysis.budget import RGL_BYTES_PER_PAIR, check_memory
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
 __all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
-           "add_cluster_options"]
+           "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
+           "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
+
+#: Largest --tangent-samples (the default is 32): a fixed cap on the work of each pair.
+MAX_TANGENT_SAMPLES = 4096
+#: Largest --ensembles: R-hat needs a few; each is a group of the one checkpoint.
+MAX_ENSEMBLES = 64
+#: Reader options and the formats (by suffix, or the CUReT file name) they apply to.
+READER_OPTIONS = {"sample": (("abrdf.dat",), "a CUReT abrdf.dat"),
+                  "step": ((".bsdf",), "an RGL .bsdf"),
+                  "stride": ((".binary",), "a MERL .binary")}
 
 
 def _on_off(value: str) -> bool:
@@ -78,8 +93,37 @@ def add_cluster_options(p: argparse.ArgumentParser) -> None:
                    help="run on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
 
 
+def check_tangent_samples(n) -> None:
+    """``--tangent-samples``: an integer in [1, MAX_TANGENT_SAMPLES]."""
+    if not 1 <= n <= MAX_TANGENT_SAMPLES:
+        raise ValueError(f"--tangent-samples must be an integer in 1..{MAX_TANGENT_SAMPLES}; "
+                         f"got {n}")
+
+
+def check_fit_options(args: argparse.Namespace) -> None:
+    """The options of :func:`add_fit_options`, each checked by name before any work."""
+    checks = [
+        (args.seed >= 0, "--seed", args.seed, "a non-negative integer"),
+        (2 <= args.ensembles <= MAX_ENSEMBLES, "--ensembles", args.ensembles,
+         f"an integer in 2..{MAX_ENSEMBLES} (R-hat is computed across them)"),
+        (args.walkers is None or args.walkers >= 2, "--walkers", args.walkers,
+         "an even integer >= 2 x the number of free parameters"),
+        (args.max_steps >= 1, "--max-steps", args.max_steps, "a positive integer"),
+        (args.check_every >= 1, "--check-every", args.check_every, "a positive integer"),
+        (args.time_limit is None or (math.isfinite(args.time_limit) and args.time_limit > 0),
+         "--time-limit", args.time_limit, "a positive finite number of seconds"),
+        (math.isfinite(args.nu) and args.nu > 0, "--nu", args.nu,
+         "a positive finite number of degrees of freedom"),
+    ]
+    for ok, option, value, allowed in checks:
+        if not ok:
+            raise ValueError(f"{option} must be {allowed}; got {value}")
+
+
 def fit_kwargs(args: argparse.Namespace) -> dict:
-    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`."""
+    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`
+    (checked first: :func:`check_fit_options`)."""
+    check_fit_options(args)
     return {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
             "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
             "check_every": args.check_every, "time_limit": args.time_limit}
@@ -92,8 +136,53 @@ def split_ties(ties):
     return [t for item in ties for t in item.split(",") if t.strip().lower() != "none"]
 
 
+def reader_options(path, **options) -> dict:
+    """The reader options given (not None) for ``path``, each checked against its format:
+    ``--sample`` for a CUReT abrdf.dat, ``--step`` for an RGL .bsdf, ``--stride`` for a MERL
+    .binary; another is refused by name. An RGL ``--step`` too fine for the memory is refused
+    with its estimate."""
+    path = Path(path)
+    given = {k: v for k, v in options.items() if v is not None}
+    name, suffix = path.name.lower(), path.suffix.lower()
+    for key, value in given.items():
+        formats, what = READER_OPTIONS[key]
+        if name not in formats and suffix not in formats:
+            raise ValueError(f"--{key} applies to {what} only, not to {path.name}; drop it")
+    if "stride" in given and given["stride"] < 1:
+        raise ValueError(f"--stride must be a positive integer; got {given['stride']}")
+    if "sample" in given and not 1 <= given["sample"] <= 61:
+        raise ValueError(f"--sample must be a CUReT sample number in 1..61; got "
+                         f"{given['sample']}")
+    if "step" in given:
+        step = given["step"]
+        if not (math.isfinite(step) and 0 < step <= 90):
+            raise ValueError(f"--step must be in (0, 90] degrees; got {step}")
+        n_o = float(math.ceil(90 / step - 1e-9)) * float(math.ceil(360 / step - 1e-9))
+        pairs = _rgl_incident(path) * n_o
+        check_memory(f"--step {step:g} ({pairs:.3g} pairs: {n_o:.3g} outgoing directions "
+                     f"for each incident one)", pairs * RGL_BYTES_PER_PAIR,
+                     "use a coarser --step")
+    return given
+
+
+def _rgl_incident(path) -> int:
+    """The incident directions an RGL file is sampled at (89, the most, when unreadable:
+    the reader then says what is wrong)."""
+    try:
+        theta_i = np.asarray(gonio.rgl.read_tensor_file(path)["theta_i"], dtype=float)
+        return max(1, int(np.count_nonzero(theta_i < np.radians(89.9))))
+    except (OSError, ValueError, KeyError, TypeError):
+        return 89
+
+
+def read_table(path, **options):
+    """``gonio.read(path)`` with the reader options that apply (:func:`reader_options`)."""
+    return gonio.read(path, **reader_options(path, **options))
+
+
 def fabric_from_args(name: str, args: argparse.Namespace) -> brdf.Fabric:
     """The preset ``name`` with the variant flags of ``add_fabric_options``."""
+    check_tangent_samples(args.tangent_samples)
     return brdf.fabric(name, masking=args.masking, reweighting=args.reweighting,
                        tangent_samples=args.tangent_samples,
                        tangent_sampling=args.tangent_sampling,
@@ -102,7 +191,7 @@ def fabric_from_args(name: str, args: argparse.Namespace) -> brdf.Fabric:
 
 
 def parse_angle_pair(text: str) -> tuple[float, float]:
-    """Parse ``THETA,PHI`` in degrees (argparse type)."""
+    """Parse ``THETA,PHI`` in degrees (argparse type): theta in [0, 90], phi in [-360, 360]."""
     parts = text.split(",")
     try:
         if len(parts) != 2:
@@ -113,6 +202,10 @@ def parse_angle_pair(text: str) -> tuple[float, float]:
             f"expected THETA,PHI in degrees (e.g. 30,0), got {text!r}") from None
     if not (math.isfinite(theta) and math.isfinite(phi)):
         raise argparse.ArgumentTypeError(f"angles must be finite, got {text!r}")
+    if not (0 <= theta <= 90 and -360 <= phi <= 360):
+        raise argparse.ArgumentTypeError(
+            f"THETA must be in [0, 90] degrees (from the normal, the upper hemisphere) and PHI "
+            f"in [-360, 360]; got {text!r}")
     return theta, phi
 
 

@@ -10,20 +10,19 @@ checkpoint ``DIR/checkpoint.h5``; the same command run again resumes from it. Th
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import brdf
 from analysis.fit import fit_fabric, fit_spec
-from gonio import read
 from reports import cliutil
 
 __all__ = ["register", "run", "read_table", "format_summary"]
 
 
 def read_table(path, sample=None):
-    """Read a table with ``gonio.read`` (CUReT needs ``sample``)."""
-    opts = {} if sample is None else {"sample": sample}
-    return read(path, **opts)
+    """Read a table with ``gonio.read`` (CUReT needs ``sample``; refused for another format)."""
+    return cliutil.read_table(path, sample=sample)
 
 
 def register(sub):
@@ -56,8 +55,10 @@ def run(args) -> int:
     if args.fabric not in brdf.PRESETS:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")
+    fit_kw = cliutil.fit_kwargs(args)
     fab = cliutil.fabric_from_args(args.fabric, args)
     spec = _spec_from_args(args, fab)
+    cliutil.reader_options(args.table, sample=args.sample)
     out = cliutil.check_writable_dir(Path(args.output))
     table = read_table(args.table, args.sample)
     plots = None
@@ -65,8 +66,8 @@ def run(args) -> int:
         # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
         from reports.fitplots import write_fit_plots as plots
     result = fit_fabric(
-        table, fab, spec, out, plots=plots, progress=not args.no_progress,
-        **cliutil.fit_kwargs(args),
+        table, fab, spec, out, plots=plots, progress=not args.no_progress, **fit_kw,
+        notify=lambda line: print(line, file=sys.stderr, flush=True),
         config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
     print(format_summary(result))
     q = result.quality

@@ -18,6 +18,7 @@ import math
 import sys
 from pathlib import Path
 
+from reports import cliutil
 from reports.lights import PointLight
 
 __all__ = ["register", "run"]
@@ -63,6 +64,10 @@ def register(sub):
     p.set_defaults(func=run)
 
 
+#: Largest |--exposure| in stops: 2**64 already saturates any f_r; 2**1e308 overflows.
+MAX_EXPOSURE = 64
+
+
 def _fabric_options(args):
     opts = {}
     for name in ("masking", "reweighting"):
@@ -73,8 +78,7 @@ def _fabric_options(args):
             except ValueError:
                 raise ValueError(f"--{name} {value!r}: must be on or off") from None
     if args.tangent_samples is not None:
-        if args.tangent_samples < 1:
-            raise ValueError(f"--tangent-samples {args.tangent_samples}: must be at least 1")
+        cliutil.check_tangent_samples(args.tangent_samples)
         opts["tangent_samples"] = args.tangent_samples
     for name in ("tangent_sampling", "transmission", "gap"):
         value = getattr(args, name)
@@ -94,8 +98,11 @@ def run(args):
 
     scene = make_scene(args.scene)
     check_size(args.width, args.height, args.spp)
-    if not math.isfinite(args.exposure):
-        raise ValueError(f"--exposure {args.exposure}: must be a finite number of stops")
+    if not (math.isfinite(args.exposure) and abs(args.exposure) <= MAX_EXPOSURE):
+        raise ValueError(f"--exposure {args.exposure}: must be a number of stops in "
+                         f"[-{MAX_EXPOSURE}, {MAX_EXPOSURE}] (2**stops scales the PNG)")
+    if args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be a non-negative integer")
     out = Path(args.output)
     suffix = out.suffix.lower()
     if suffix not in (".exr", ".png"):

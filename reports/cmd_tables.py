@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import json
 import logging
+from pathlib import Path
 
 import numpy as np
 
 import gonio
+from analysis.folderlock import output_lock
+from reports import cliutil
 
 log = logging.getLogger("microcyl")
 
@@ -42,19 +45,18 @@ def _reader_options(p):
 
 
 def _read(args, path):
-    options = {k: getattr(args, k) for k in ("sample", "step", "stride")
-               if getattr(args, k) is not None}
-    return gonio.read(path, **options)
+    return cliutil.read_table(path, sample=args.sample, step=args.step, stride=args.stride)
 
 
 def run_convert(args):
-    table = _read(args, args.input)
     options = {}
     if getattr(args, "alta_param", None):
         if not str(args.output).lower().endswith(".alta"):
             raise ValueError("--alta-param applies to an .alta output only")
         options["param"] = args.alta_param
-    gonio.write(table, args.output, **options)
+    table = _read(args, args.input)
+    with output_lock(Path(args.output), "convert", inside=False):  # removes a killed run's
+        gonio.write(table, args.output, **options)                 # .OUT.*.tmp
     log.info(f"wrote {len(table)} rows to {args.output}")
     return 0
 

@@ -23,10 +23,14 @@ the mean of its samples; rays that hit nothing give 0.
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import functools
 import multiprocessing
 import os
 import signal
+import threading
+import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
@@ -193,10 +197,34 @@ def _tiles(width, height, tile):
 _CTX = {}
 
 
-def _init_worker(ctx):
+#: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h).
+_PR_SET_PDEATHSIG = 1
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Make this worker die with its parent, even a SIGKILLed one: PR_SET_PDEATHSIG on Linux,
+    else a daemon thread that polls the parent's pid every second."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        ok = libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        ok = False
+    if os.getppid() != parent:          # the parent died before the request took effect
+        os._exit(1)
+    if not ok:
+        def watch():
+            while os.getppid() == parent:
+                time.sleep(1.0)
+            os._exit(1)
+        threading.Thread(target=watch, daemon=True, name="parent-watchdog").start()
+
+
+def _init_worker(ctx, parent=None):
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent handles Ctrl-C
+    parent = os.getppid() if parent is None else parent
+    _exit_with_parent(parent)
     _CTX.clear()
-    _CTX.update(ctx, parent=os.getppid())
+    _CTX.update(ctx, parent=parent)
 
 
 def _render_tile(tile, ctx=None):
@@ -350,7 +378,7 @@ def _render_pool(image, tiles, ctx, workers, new_bar) -> None:
     methods = multiprocessing.get_all_start_methods()
     mp = multiprocessing.get_context("fork" if "fork" in methods else None)
     pool = ProcessPoolExecutor(workers, mp_context=mp, initializer=_init_worker,
-                               initargs=(ctx,))
+                               initargs=(ctx, os.getpid()))
     try:
         futures = [pool.submit(_render_tile, t) for t in tiles]
         with new_bar() as bar:

@@ -112,3 +112,38 @@ def test_from_toml(tmp_path):
     bad.write_text("free = [\n")
     with pytest.raises(ValueError, match="bad.toml: not valid TOML"):
         ParamSpec.from_toml(bad, defaults=D)
+
+
+def test_contradictory_ties_are_refused():
+    with pytest.raises(ValueError, match="tie eta2=eta1: both eta2 and eta1 are listed free"):
+        ParamSpec("eta1,eta2", defaults=D, ties="eta2=eta1")
+    with pytest.raises(ValueError, match="tie eta2=eta1: neither eta2 nor eta1 is free"):
+        ParamSpec("kd1", defaults=D, ties="eta2=eta1")
+    with pytest.raises(ValueError, match="eta2 is already tied to eta1"):
+        parse_ties("eta2=eta1,eta2=kd1")
+    with pytest.raises(ValueError, match="already tied"):
+        ParamSpec("eta1,kd1", defaults=D, ties="eta2=eta1,kd1=eta2")
+    with pytest.raises(ValueError, match=r"ties: item 1 is int 1"):
+        parse_ties([1])
+
+
+def test_from_toml_checks_every_key(tmp_path):
+    def spec(text):
+        p = tmp_path / "s.toml"
+        p.write_text(text)
+        return ParamSpec.from_toml(p, defaults=D)
+
+    assert spec('free = ["eta1"]\ntie = "eta2=eta1"\n').ties == {"eta2": ("eta1", "equal")}
+    for text, key in [('free = ["eta1"]\ntie = [1]\n', "'tie'"),
+                      ('free = 3\n', "'free'"),
+                      ('free = ["eta1"]\n[start]\neta1 = {a = 1}\n', "start value of eta1"),
+                      ('free = ["eta1"]\n[bounds]\neta1 = [1, {a = 2}]\n', "upper bound of eta1"),
+                      ('free = ["eta1"]\n[bounds]\neta1 = 3\n', "bounds of eta1"),
+                      ('free = ["eta1"]\nbounds = 3\n', "'bounds'"),
+                      ('free = ["eta1"]\n[prior]\neta1 = 2\n', "prior of eta1"),
+                      ('free = ["eta1"]\n[start]\netta = 2\n', "etta"),
+                      ('free = ["eta1", "eta2"]\ntie = ["eta2=eta1"]\n', "both eta2 and eta1"),
+                      ('fabric = 1\nfree = ["eta1"]\n', "'fabric'")]:
+        with pytest.raises(ValueError, match=key) as err:
+            spec(text)
+        assert "s.toml" in str(err.value)

@@ -43,7 +43,7 @@ def table_file(tmp_path, monkeypatch):
 def test_fit_writes_results_and_plots(table_file, tmp_path, capsys):
     out = tmp_path / "fit"
     args = ["fit", str(table_file), "--fabric", "silk_crepe_de_chine", "--free", "gamma_s1,kd1",
-            "--tie", "eta2=eta1", "--max-steps", "60", "--check-every", "30",
+            "--tie", "none", "--max-steps", "60", "--check-every", "30",
             "--no-progress", "-o", str(out)]
     assert main(args) == 0
     doc = json.loads((out / "results.json").read_text())

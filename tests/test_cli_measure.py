@@ -89,7 +89,7 @@ def test_unknown_fabric(tmp_path, written, capsys):
     (["--geometry", "full:0"], "theta_step"),
     (["--snr", "-5"], "snr"),
     (["--floor", "-1"], "floor"),
-    (["--cone-detector", "95"], "cone_detector"),
+    (["--cone-detector", "95"], "--cone-detector"),
     (["--seed", "-3"], "--seed"),
     (["--tangent-samples", "0"], "--tangent-samples"),
     (["--rotation", "nan"], "--rotation"),

@@ -35,7 +35,7 @@ def test_eval_prints_fr(capsys):
     (["eval", "velvet", "--wi", "30", "--wo", "30,180"], "expected THETA,PHI in degrees"),
     (["eval", "velvet", "--wi", "30,0", "--wo", "30,180", "--masking", "maybe"], "expected on or off"),
     (["eval", "velvet", "--wi", "30,0", "--wo", "30,180", "--tangent-samples", "0"],
-     "tangent_samples must be an integer >= 1; got 0"),
+     "--tangent-samples must be an integer in 1..4096; got 0"),
     (["eval", "velvet", "--wi", "30,0"], "the following arguments are required: --wo"),
     (["report", "--fabric", "denim"], "invalid choice: 'denim'"),
 ])

@@ -21,6 +21,7 @@ from typing import Callable
 from analysis.batch.jobs import BatchJob
 from analysis.batch.summary import BatchSummary
 from analysis.batch.worker import error_row, run_job
+from analysis.folderlock import output_lock
 from gonio.progress import progress_bar
 
 __all__ = ["run_batch", "BatchInterrupted", "describe_row"]
@@ -119,6 +120,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
         On Ctrl-C, after writing the summaries (every fit resumable from its checkpoint).
     ValueError
         Duplicate job names or a bad ``workers``.
+    FolderBusy
+        Another batch holds ``out_dir``'s lock (:func:`analysis.folderlock.output_lock`).
     """
     names = [j.name for j in jobs]
     if len(set(names)) != len(names):
@@ -126,16 +129,16 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
     if workers is not None and workers < 1:
         raise ValueError(f"workers must be >= 1; got {workers}")
     out = Path(out_dir).resolve()
-    out.mkdir(parents=True, exist_ok=True)
-    summary = BatchSummary(out)
-    todo = [j for j in jobs if not summary.done(j)]
-    with progress_bar(len(jobs), desc="fits", unit="table", enabled=progress,
-                      initial=len(jobs) - len(todo)) as bar:
-        say = (bar.write if progress else echo) if echo is not None else None
-        if todo:
-            with _quiet_dask(), _client(workers, scheduler) as client:
-                _gather(client, todo, out, summary, names, bar, say)
-        summary.write(names)
+    with output_lock(out, "batch"):
+        summary = BatchSummary(out)
+        todo = [j for j in jobs if not summary.done(j)]
+        with progress_bar(len(jobs), desc="fits", unit="table", enabled=progress,
+                          initial=len(jobs) - len(todo)) as bar:
+            say = (bar.write if progress else echo) if echo is not None else None
+            if todo:
+                with _quiet_dask(), _client(workers, scheduler) as client:
+                    _gather(client, todo, out, summary, names, bar, say)
+            summary.write(names)
     return summary
 
 

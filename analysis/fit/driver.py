@@ -16,6 +16,7 @@ from typing import Callable, Mapping
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from analysis.budget import FIT_BYTES_PER_VALUE, check_memory, format_seconds
 from analysis.fit.checkpoint import FitFolder, table_digest
 from analysis.fit.convergence import Criteria
 from analysis.fit.optimize import optimize_start
@@ -23,11 +24,13 @@ from analysis.fit.posterior import LogPosterior
 from analysis.fit.results import FitResult, summarize
 from analysis.fit.sampler import FitSampler
 from analysis.likelihood import Likelihood
-from analysis.params import ParamSpec
+from analysis.params import INTERNAL_LIMIT, ParamSpec
 from gonio.progress import progress_bar
 
-__all__ = ["fit", "FitOptions", "CONFIG_VERSION"]
+__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time"]
 
+#: A fit that may take this many seconds or more says so before it starts (``notify``).
+ESTIMATE_MIN_S = 10.0
 #: Version of the sampler's configuration; a folder fitted by another version is refused.
 CONFIG_VERSION = 7
 
@@ -61,18 +64,23 @@ class FitOptions:
         if adapt is None:
             adapt = 2 * self.check_every if self.laplace_move > 0 else 0
         checks = [
-            (self.ensembles >= 2, f"ensembles must be >= 2 (R-hat is computed across them); "
-                                  f"got {self.ensembles}"),
-            (walkers >= 2 * ndim, f"walkers must be >= 2 x ndim = {2 * ndim}; got {walkers}"),
-            (self.max_steps >= 1, f"max_steps must be >= 1; got {self.max_steps}"),
-            (self.check_every >= 1, f"check_every must be >= 1; got {self.check_every}"),
+            (self.ensembles >= 2, f"ensembles (--ensembles) must be >= 2 (R-hat is computed "
+                                  f"across them); got {self.ensembles}"),
+            (walkers >= 2 * ndim and walkers % 2 == 0,
+             f"walkers (--walkers) must be an even number >= 2 x ndim = {2 * ndim} ({ndim} "
+             f"free parameters, log_noise and scale included); got {walkers}"),
+            (self.max_steps >= 1, f"max_steps (--max-steps) must be >= 1; got "
+                                  f"{self.max_steps}"),
+            (self.check_every >= 1, f"check_every (--check-every) must be >= 1; got "
+                                    f"{self.check_every}"),
             (0 <= self.laplace_move <= 1, f"laplace_move must be in [0, 1]; got "
                                           f"{self.laplace_move}"),
             (adapt >= 0 and not (adapt and self.laplace_move <= 0),
              f"adapt must be >= 0, and 0 when laplace_move is 0; got {adapt}"),
             (self.n_starts >= 1, f"n_starts must be >= 1; got {self.n_starts}"),
-            (self.time_limit is None or self.time_limit > 0,
-             f"time_limit must be > 0 seconds; got {self.time_limit}"),
+            (self.time_limit is None or (self.time_limit > 0 and np.isfinite(self.time_limit)),
+             f"time_limit (--time-limit) must be a finite number of seconds > 0; got "
+             f"{self.time_limit}"),
             (self.threads is None or self.threads >= 1,
              f"threads must be >= 1; got {self.threads}"),
         ]
@@ -144,7 +152,8 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         tau_tol: float = 0.05, rhat_max: float = 1.01, burn_fraction: float = 0.2,
         n_starts: int = 4, laplace_move: float = 0.75, adapt: int | None = None,
         threads: int | None = None, out_dir=None, time_limit: float | None = None,
-        progress: bool | Callable = True, config_extra: Mapping | None = None) -> FitResult:
+        progress: bool | Callable = True, config_extra: Mapping | None = None,
+        notify: Callable[[str], None] | None = None) -> FitResult:
     """Fit the free parameters of ``spec`` to ``table``; see :mod:`analysis.fit`.
 
     Parameters
@@ -185,6 +194,10 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         A tqdm bar (True), none (False), or ``progress(steps)`` called about every 0.25 s.
     config_extra : mapping, optional
         Also recorded in (and matched against) the stored configuration.
+    notify : callable, optional
+        ``notify(line)`` is given the estimated time of the fit before it starts when it may
+        take ``ESTIMATE_MIN_S`` or more (:func:`estimate_time`; not on a resume), and a
+        point estimate that ends on bounds.
 
     Returns
     -------
@@ -193,8 +206,10 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     Raises
     ------
     ValueError
-        Too few valid values for the free parameters, bad options, a checkpoint made with
-        another configuration, or a corrupt checkpoint: all before sampling starts.
+        Too few valid values for the free parameters, bad options, more memory than there
+        is (the estimate in the message), a checkpoint made with another configuration, a
+        corrupt checkpoint, or a point estimate whose log-posterior is not finite (nothing is
+        then written): all before sampling starts.
     FitInterrupted
         On Ctrl-C during sampling, after checkpointing the steps done (a KeyboardInterrupt).
     """
@@ -203,32 +218,95 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                       criteria=Criteria(min_ratio, tau_tol, rhat_max, burn_fraction),
                       n_starts=n_starts, laplace_move=laplace_move, adapt=adapt,
                       threads=threads, time_limit=time_limit)
-    return _run(table, spec, model, opts, out_dir, progress, config_extra)
+    return _run(table, spec, model, opts, out_dir, progress, config_extra, notify)
 
 
-def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra) -> FitResult:
+def _check_memory(opts: FitOptions, ndim: int, n_used: int) -> None:
+    """Refuse a fit whose chains or batched evaluations cannot fit in memory."""
+    chains = opts.ensembles * opts.walkers * opts.max_steps * (ndim + 2) * 8
+    check_memory(f"the chains of {opts.ensembles} ensembles x {opts.walkers} walkers x "
+                 f"{opts.max_steps} steps (--ensembles, --walkers, --max-steps)", chains,
+                 "lower --walkers, --ensembles or --max-steps")
+    batch = opts.walkers * n_used * FIT_BYTES_PER_VALUE * opts.threads
+    check_memory(f"evaluating {opts.walkers} walkers (--walkers) at {n_used} values",
+                 batch, "lower --walkers")
+
+
+def estimate_time(logpost, opts: FitOptions, n_used: int,
+                  optimize: bool) -> tuple[float, str]:
+    """One line: the time of a step (a batch of ``walkers / 2`` evaluations timed, twice for
+    each ensemble, shared by the threads), of ``max_steps`` steps, and of the point estimate (a batch of ndim + 1
+    evaluations, the finite-difference gradient, timed: ~100 iterations a start); returns
+    (the seconds at most, the line)."""
+    def timed(k):
+        batch = np.repeat(logpost.spec.start()[None], k, axis=0)
+        t0 = time.perf_counter()
+        logpost(batch)
+        return time.perf_counter() - t0
+
+    # a step moves each ensemble's walkers in two halves; the threads share the ensembles
+    timed(1)                                            # the first call warms caches
+    step = 2 * timed(opts.walkers // 2) * opts.ensembles / min(opts.threads, opts.ensembles)
+    line = (f"fit: {n_used} values, {logpost.spec.ndim} free parameters; about "
+            f"{format_seconds(step) if step >= 1 else f'{step:.2g} s'} a step "
+            f"({opts.ensembles} ensembles x {opts.walkers} walkers), so up to "
+            f"{format_seconds(step * opts.max_steps)} for --max-steps {opts.max_steps} "
+            f"(convergence usually stops it sooner; --time-limit bounds it)")
+    est = 0.0
+    if optimize:
+        est = timed(logpost.spec.ndim + 1) * opts.n_starts * 100
+        line += f"; the point estimate first, about {format_seconds(est)}"
+    return est + step * opts.max_steps, line
+
+
+def _check_start(spec: ParamSpec, best, best_logp: float, notify=None) -> None:
+    """A point estimate the walkers can start from, or a ValueError saying what to change;
+    ``notify`` is told of parameters that ended on a bound."""
+    at_bound = [n for n, u in zip(spec.free, best) if abs(u) >= 0.99 * INTERNAL_LIMIT]
+    if notify is not None and at_bound:
+        notify(f"fit: the point estimate lies on the bound of {', '.join(at_bound)} "
+               f"(log-posterior {best_logp:.4g}); if most are, the fabric may not match the "
+               f"table")
+    if not np.isfinite(best_logp):
+        at = dict(zip(spec.free, np.round(spec.to_natural(best), 6).tolist()))
+        raise ValueError(f"the point estimate has log-posterior {best_logp} (at {at}): the "
+                         f"model cannot describe this table from the start; check that the "
+                         f"fabric matches the table, fit fewer or other parameters (--free), "
+                         f"or try --likelihood relative or student-t")
+
+
+def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
+         notify=None) -> FitResult:
     """:func:`fit` once its options are gathered: checks, start, sampling, result."""
     t0 = time.perf_counter()
     lik = Likelihood(table, kind=opts.likelihood, nu=opts.nu)
     spec = _with_nuisance(spec, lik)
     _check_points(lik, spec.ndim)
     opts = opts.resolve(spec.ndim)
+    _check_memory(opts, spec.ndim, lik.n_used)
     logpost = LogPosterior(spec, lik, model)
     config = opts.config(spec, table, lik, config_extra)
     folder = None if out_dir is None else FitFolder(out_dir)
     start = None if folder is None else folder.read_start(config)
     ckpt = None if start is None else folder.read_checkpoint()
+    if start is not None and ckpt is None and not np.isfinite(start["best_logp"]):
+        start = None                   # a failed start of an older version: estimate again
     rng_opt, *rngs = [np.random.default_rng(s)
                       for s in np.random.SeedSequence(opts.seed).spawn(opts.ensembles + 1)]
     with threadpool_limits(limits=1, user_api="blas"):
+        if notify is not None and ckpt is None:
+            seconds, line = estimate_time(logpost, opts, lik.n_used, start is None)
+            if seconds >= ESTIMATE_MIN_S:
+                notify(line)
         if start is None:
             best, best_logp, cov = optimize_start(logpost, opts.n_starts, rng_opt, opts.threads)
-            if folder is not None:
-                folder.write_start(config, best, best_logp, cov)
+            _check_start(spec, best, best_logp, notify)
         else:
             best, best_logp, cov = start["best"], start["best_logp"], start["cov"]
         t_opt = time.perf_counter() - t0
         sampler = FitSampler(logpost, opts, best, cov, rngs, ckpt)
+        if start is None and folder is not None:    # only a start the walkers could use
+            folder.write_start(config, best, best_logp, cov)
         resumed = sampler.steps if ckpt is not None else 0
         with _progress(progress, opts.max_steps, sampler.steps) as (tick, postfix):
             out = sampler.run(folder, tick, t0, postfix)

@@ -51,22 +51,28 @@ def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int
     h = 1e-6 * spec.width
     big = 1e30
 
-    def fun_grad(x):
+    def fun_grad(x, bad):
         pts, steps = _fd_grad_batch(x, h, lower, upper)
         lp = logpost(pts)
         f0 = -lp[0]
         if not np.isfinite(f0):
-            return big, np.zeros_like(x)
+            return bad, np.zeros_like(x)
         fi = np.where(np.isfinite(lp[1:]), -lp[1:], f0 + 1e6 * np.abs(steps))
         return float(f0), (fi - f0) / steps
 
     def one(s):
-        if not np.isfinite(logpost(s[None])[0]):
+        f_start = -float(logpost(s[None])[0])
+        if not np.isfinite(f_start):
             return s, -np.inf
-        r = scipy.optimize.minimize(fun_grad, s, jac=True, method="L-BFGS-B",
+        # a point that cannot be evaluated must look worse than the start, however poor the
+        # start (a log-posterior of -1e43 made the bounds, where it is -inf, look better)
+        bad = big + 10.0 * abs(f_start)
+        r = scipy.optimize.minimize(fun_grad, s, args=(bad,), jac=True, method="L-BFGS-B",
                                     bounds=list(zip(lower, upper)),
                                     options={"maxiter": maxiter})
-        return r.x, (-float(r.fun) if r.fun < big else -np.inf)
+        if not (np.isfinite(r.fun) and r.fun < bad and r.fun <= f_start):
+            return s, -f_start                  # never a point worse than the start
+        return r.x, -float(r.fun)
 
     starts = np.atleast_2d(starts)
     if threads > 1 and _LBFGSB_THREAD_SAFE:
@@ -151,6 +157,9 @@ def initial_walkers(logpost, best, cov, nwalkers, rng) -> tuple[np.ndarray, np.n
     xs, lps = np.empty((0, best.size)), np.empty(0)
     for shrink in (1.0, 0.3, 0.1, 0.03, 0.01, 1e-3, 1e-4):
         cand = rng.multivariate_normal(best, cov * shrink, size=4 * nwalkers)
+        lo, hi = logpost.spec.lower, logpost.spec.upper    # reflected at the bounds: a
+        cand = np.where(cand > hi, 2 * hi - cand, cand)    # point estimate on a bound
+        cand = np.where(cand < lo, 2 * lo - cand, cand)    # keeps its walkers inside
         lp = logpost(cand)
         ok = np.isfinite(lp)
         xs = np.concatenate([xs, cand[ok]])[:nwalkers]
@@ -158,7 +167,9 @@ def initial_walkers(logpost, best, cov, nwalkers, rng) -> tuple[np.ndarray, np.n
         if len(xs) >= nwalkers:
             return xs, lps
     raise RuntimeError("could not place the walkers around the point estimate: the "
-                       "log-posterior is not finite near it")
+                       "log-posterior is not finite near it; check that the fabric matches "
+                       "the table, widen the bounds of parameters at a bound ([bounds] of "
+                       "--spec) or fit other parameters (--free)")
 
 
 def optimize_start(logpost, n_starts: int, rng,
@@ -183,8 +194,11 @@ def optimize_start(logpost, n_starts: int, rng,
     start = spec.start()
     if not np.isfinite(logpost(start[None])[0]):
         raise ValueError(f"the log-posterior is not finite at the start "
-                         f"{dict(zip(spec.free, spec.to_natural(start).tolist()))}; "
-                         f"check the bounds, ties and the table")
+                         f"{dict(zip(spec.free, spec.to_natural(start).tolist()))}: the "
+                         f"model cannot be evaluated there or gives the table zero "
+                         f"probability; check that the fabric matches the table, set start "
+                         f"values inside the bounds ([start] of --spec), or try --likelihood "
+                         f"relative or student-t")
     starts = [start]
     for _ in range(max(0, n_starts - 1)):
         starts.append(np.clip(start + rng.normal(scale=0.05 * spec.width), spec.lower,

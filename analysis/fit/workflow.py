@@ -9,6 +9,7 @@ from analysis.fit.driver import fit
 from analysis.fit.posterior import FabricModel
 from analysis.fit.quality import fit_quality
 from analysis.fit.results import FitResult, write_results
+from analysis.folderlock import output_lock
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
 
 __all__ = ["fit_fabric", "fit_spec"]
@@ -59,7 +60,10 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
                **fit_kw) -> FitResult:
     """Fit ``fabric``'s free parameters to ``table`` and write the results into ``out_dir``.
 
-    The fit (:func:`analysis.fit.fit`) checkpoints into ``out_dir`` and resumes there. Then the
+    The fit (:func:`analysis.fit.fit`) checkpoints into ``out_dir`` and resumes there; the
+    folder is locked meanwhile (:func:`analysis.folderlock.output_lock`: a second fit into it
+    is refused, ``another fit is running in DIR (pid N)``), and temporaries a killed fit left
+    in it are removed. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
     colours and their CIEDE2000 difference), the plots drawn when ``plots`` is given, and
     ``results.json`` / ``results.csv`` written, once, atomically.
@@ -85,10 +89,12 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         With ``quality`` and ``plots`` filled in.
     """
     out = Path(out_dir)
-    result = fit(table, spec, FabricModel(fabric, table.wi, table.wo), out_dir=out, **fit_kw)
-    result.quality = fit_quality(result, table)
-    if plots is not None:
-        files = plots(result, table, lambda wi, wo: FabricModel(fabric, wi, wo), out)
-        result.plots = {k: Path(v).name for k, v in files.items()}
-    write_results(result, out)
+    with output_lock(out, "fit"):
+        result = fit(table, spec, FabricModel(fabric, table.wi, table.wo), out_dir=out,
+                     **fit_kw)
+        result.quality = fit_quality(result, table)
+        if plots is not None:
+            files = plots(result, table, lambda wi, wo: FabricModel(fabric, wi, wo), out)
+            result.plots = {k: Path(v).name for k, v in files.items()}
+        write_results(result, out)
     return result

@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 import brdf
+from analysis.folderlock import output_lock
 from gonio.atomic import file_mode
 from gonio.progress import progress_bar
 from reports.report.folder import MARKER, check_output_dir, swap_into_place, write_file
@@ -193,7 +194,10 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     Notes
     -----
     Built in a temporary folder beside ``out_dir`` and renamed into place at the end; a
-    failure or interrupt removes the temporary folder and leaves ``out_dir`` as it was.
+    failure or interrupt removes the temporary folder and leaves ``out_dir`` as it was. The
+    build holds the lock ``.NAME.lock`` beside ``out_dir`` (a second report into it is
+    refused: ``another report is running in DIR (pid N)``) and first removes the temporary
+    folders a killed build left.
     """
     if quality not in QUALITIES:
         raise ValueError(f"quality must be one of {', '.join(QUALITIES)}; got {quality!r}")
@@ -202,16 +206,17 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     measured_fits = read_measured(measured) if measured is not None else None
     out = check_output_dir(out_dir)
     fits = {str(k): v for k, v in dict(fit_results or {}).items()}
-    try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
-    except OSError as exc:
-        raise OSError(f"output folder {out.parent} is not writable: {exc.strerror or exc}") \
-            from None
-    try:
-        os.chmod(tmp, file_mode(0o777))
-        _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress)
-        swap_into_place(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+    with output_lock(out, "report", inside=False):    # removes a killed build's .tmp-*
+        try:
+            tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
+        except OSError as exc:
+            raise OSError(f"output folder {out.parent} is not writable: "
+                          f"{exc.strerror or exc}") from None
+        try:
+            os.chmod(tmp, file_mode(0o777))
+            _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress)
+            swap_into_place(tmp, out)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
     return out / "index.html"

@@ -21,7 +21,7 @@ from reports.colour import CHANNEL_COLOURS, luminance
 
 __all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
            "quantity_styles", "QUANTITIES", "check_quantity", "half_diff_to_io", "check_angle",
-           "DPI", "FONT", "PALETTE", "series_style", "preset_style", "legend_outside",
+           "DPI", "FONT", "PALETTE", "series_style", "preset_style", "series_styles", "legend_outside",
            "log_range", "pow10_label", "shade_zero"]
 
 #: What a plot can show of an RGB f_r: its Rec. 709 luminance, each channel, or one channel.
@@ -58,6 +58,22 @@ def preset_style(name: str, n: int = 0) -> dict:
     return series_style(PRESETS.index(name) if name in PRESETS else len(PRESETS) + n)
 
 
+def series_styles(names) -> dict:
+    """Name -> style for the series of one figure: a preset keeps :func:`preset_style`,
+    another name (a fit, a user's model) takes the first style no preset of ``names`` has.
+
+    Examples
+    --------
+    >>> st = series_styles(["linen_plain", "fit"])
+    >>> st["linen_plain"]["color"] != st["fit"]["color"]
+    True
+    """
+    names = list(names)
+    used = {PRESETS.index(n) for n in names if n in PRESETS}
+    free = (k for k in range(len(PRESETS) + len(names) + 1) if k not in used)
+    return {n: preset_style(n) if n in PRESETS else series_style(next(free)) for n in names}
+
+
 def legend_outside(ax, where="right", *, ncol=1, below_pt=34.0, **kw):
     """A legend beside the axes (``where`` "right") or ``below_pt`` points under it
     ("below": clear of the tick labels and axis label), in 8 pt, so it hides no data; a
@@ -72,33 +88,35 @@ def legend_outside(ax, where="right", *, ncol=1, below_pt=34.0, **kw):
                      fontsize=FONT["small"], ncol=ncol, frameon=False, **kw)
 
 
-def log_range(peaks, decades: float = 6.0):
-    """The log axis of curves with the given peak values (1/sr): whole decades from the
-    largest peak down ``decades`` (or to the lowest peak when nearer), and which series peak
-    below the axis (drawn apart or noted, never stretching it).
+def log_range(series, decades: float = 6.0):
+    """The log axis of curves (values in 1/sr, one array a series): whole decades from the
+    largest value down ``decades``, or only down to the smallest positive value drawn when
+    that is nearer, and which series peak below the axis (to be drawn apart or noted, never
+    stretching it).
 
     Returns
     -------
     (lo, hi) : tuple of float
         Powers of ten.
     below : numpy.ndarray of bool
-        True for series whose peak is under ``lo`` (or not positive).
+        True for series whose peak is under ``lo`` (or none of whose values is positive).
 
     Examples
     --------
-    >>> lims, below = log_range([0.3, 0.02, 1e-18], 6)
+    >>> lims, below = log_range([[0.3, 0.01], [0.02, 0.001], [1e-18, 0.0]], 6)
     >>> lims, below.tolist()
-    ((1e-06, 1.0), [False, False, True])
+    ((0.001, 1.0), [False, False, True])
     """
-    p = np.asarray(peaks, dtype=np.float64)
-    pos = p[np.isfinite(p) & (p > 0)]
-    if pos.size == 0:
-        return (1e-3, 1.0), np.ones(p.shape, bool)
-    hi = float(np.ceil(np.log10(pos.max())))
+    arrays = [np.asarray(v, dtype=np.float64).ravel() for v in series]
+    peaks = np.array([np.nanmax(a, initial=0.0) for a in arrays])
+    if not np.any(peaks > 0):
+        return (1e-3, 1.0), np.ones(peaks.shape, bool)
+    hi = float(np.ceil(np.log10(peaks.max())))
     lo = hi - float(np.ceil(decades))
-    below = ~(np.isfinite(p) & (p >= 10.0 ** lo))
-    lo = max(lo, float(np.floor(np.log10(p[~below].min()))) - 2.0)
-    return (10.0 ** lo, 10.0 ** hi), below
+    below = ~(peaks >= 10.0 ** lo)
+    kept = np.concatenate([a[np.isfinite(a) & (a > 0)] for a, b in zip(arrays, below) if not b])
+    lo = max(lo, float(np.floor(np.log10(kept.min()))))
+    return (10.0 ** lo, 10.0 ** max(hi, lo + 1.0)), below
 
 
 def shade_zero(ax, x, zero, *, label="f_r = 0"):

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from reports._plotting import (FONT, check_quantity, eval_brdf, finish, legend_outside,
-                               log_range, new_axes, preset_style, quantity_styles,
+                               log_range, new_axes, quantity_styles, series_styles,
                                reduce_quantity)
 from reports.colour import REC709_WEIGHTS
 from reports.plot_lobes import plane_directions
@@ -142,7 +142,7 @@ def plot_table_models(table, models, theta_i_deg, phi_deg=0.0, *, quantity="lumi
                       tol_deg=2.0, resolution=181, log=True, decades=6.0, legend=True,
                       ax=None, filename=None, title=None):
     """A measured table at one incidence in a plane (black circles with error bars) against
-    models, each curve in its own colour and line style (:func:`preset_style`).
+    models, each curve in its own colour and line style (:func:`series_styles`).
 
     Parameters
     ----------
@@ -184,16 +184,16 @@ def plot_table_models(table, models, theta_i_deg, phi_deg=0.0, *, quantity="lumi
     wi, wo = plane_directions(float(np.mean(ti[sel])), x_model, phi_deg)
     curves = {name: reduce_quantity(eval_brdf(m, wi, wo), quantity)
               for name, m in dict(models).items()}
-    for n, (name, c) in enumerate(curves.items()):
-        st = preset_style(name, n)
+    styles = series_styles(curves)
+    for name, c in curves.items():
+        st = styles[name]
         line, = ax.plot(x_model, c, color=st["color"], ls=st["ls"], lw=1.5, label=name)
         line.set_gid(f"model {name}")
     cont = ax.errorbar(x, y, yerr=err, ls="", marker="o", ms=4, mfc="none", color="k",
                        capsize=1.5, label="measured", zorder=3)
     cont.lines[0].set_gid("data")
     if log:
-        peaks = [float(np.nanmax(y))] + [float(np.nanmax(c)) for c in curves.values()]
-        (lo, hi), _ = log_range(peaks, decades)
+        (lo, hi), _ = log_range([y, *curves.values()], decades)
         ax.set_yscale("log")
         ax.set_ylim(lo, hi)
         if np.any(y <= 0):
@@ -202,7 +202,8 @@ def plot_table_models(table, models, theta_i_deg, phi_deg=0.0, *, quantity="lumi
     _cartesian_labels(ax)
     if legend:
         legend_outside(ax, "right")
-    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {phi_deg:g}°",
+    what = "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
+    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {phi_deg:g}°, {what}",
                  fontsize=FONT["title"])
     return finish(fig, ax, filename)
 

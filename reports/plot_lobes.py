@@ -15,7 +15,7 @@ from matplotlib.ticker import MaxNLocator
 
 from brdf.frames import from_angles
 from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish, legend_outside,
-                               new_axes, pow10_label, preset_style, quantity_styles,
+                               new_axes, pow10_label, quantity_styles, series_styles,
                                reduce_quantity, series_style)
 from reports.colour import luminance
 
@@ -265,7 +265,7 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
                          resolution=181, quantity="luminance", legend=True, ax=None,
                          filename=None, title=None):
     """Luminance lobes of several BRDFs in one polar plot, each in its own colour and line
-    style (:func:`reports._plotting.preset_style`: a preset's style is the same in every
+    style (:func:`reports._plotting.series_styles`: a preset's style is the same in every
     figure).
 
     Parameters
@@ -298,10 +298,11 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
     peak = max((float(np.nanmax(v)) for v in data.values()), default=0.0)
     floor = _log_floor(peak, decades)
     rmax = 0.0
-    for n, (name, y) in enumerate(data.items()):
+    styles = series_styles(data)
+    for name, y in data.items():
         r = log_radius(y, floor) if scale == "log" else y
         rmax = max(rmax, float(np.nanmax(r)))
-        st = preset_style(name, n)
+        st = styles[name]
         line, = ax.plot(np.radians(theta_o), r, color=st["color"], ls=st["ls"], lw=1.5,
                         label=name)
         line.set_gid(f"lobe {name}")

@@ -48,7 +48,7 @@ def _draw(ax, x_deg, values, quantity, colour, log, gid, decades=6.0, label=None
     styles = quantity_styles(quantity, colour)
     ys = [values[..., k] if values.ndim == 2 else values for k, _, _ in styles]
     peaks = [float(np.nanmax(y)) if np.any(np.isfinite(y)) else 0.0 for y in ys]
-    lims, below = log_range(peaks, decades)
+    lims, below = log_range(ys, decades)
     overlay = label is not None and len(styles) == 1
     for (k, col, suffix), y, peak, low in zip(styles, ys, peaks, below):
         name = label if overlay else ("luminance" if k is None else "RGB"[k])
@@ -61,8 +61,8 @@ def _draw(ax, x_deg, values, quantity, colour, log, gid, decades=6.0, label=None
         line.set_gid(f"{gid} {'luminance' if k is None else 'rgb'[k]}")
     if log:
         if overlay:  # the range of every curve on the axes
-            every = [float(np.nanmax(l.get_ydata())) for l in ax.get_lines() if l.get_gid()]
-            lims = log_range(every, decades)[0]
+            lims = log_range([l.get_ydata() for l in ax.get_lines() if l.get_gid()],
+                             decades)[0]
         ax.set_yscale("log")
         ax.set_ylim(*lims)
         if not overlay:

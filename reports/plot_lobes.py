@@ -11,7 +11,7 @@ from __future__ import annotations
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from brdf.frames import from_angles
 from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish, legend_outside,
@@ -92,7 +92,8 @@ def _setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
                             for k in shown])
         label = f"{label}, log scale"
     else:
-        ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.yaxis.set_major_locator(MaxNLocator(3))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
     # r tick labels on the right edge, reading outward; the axis label under the centre
     ax.yaxis.set_tick_params(label1On=False, label2On=True)
     ax.annotate(f"radius: {label}", xy=(0.0, 0.0), xytext=(0.0, -19.0), ha="center",
@@ -364,15 +365,15 @@ def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resoluti
     ax.set_xlim(-ext, ext)
     ax.set_ylim(-ext, ext)
     ax.set_zlim(0, ext)
-    ax.set_xlabel("x, warp (1/sr)", fontsize=FONT["label"])
-    ax.set_ylabel("y, weft (1/sr)", fontsize=FONT["label"])
-    ax.set_zlabel("z, normal (1/sr)", fontsize=FONT["label"])
+    ax.set_xlabel("x: warp", fontsize=FONT["label"], labelpad=12)
+    ax.set_ylabel("y: weft", fontsize=FONT["label"], labelpad=12)
+    ax.set_zlabel("z", fontsize=FONT["label"], labelpad=10)
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
         axis.set_major_locator(MaxNLocator(3))
     ax.tick_params(labelsize=FONT["small"], pad=1)
     what = "luminance f_r cos θo" if cosine else "luminance f_r"
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap="viridis")
     fig.colorbar(sm, ax=ax, shrink=0.7, pad=0.12, label=f"{what} (1/sr)")
-    ax.set_title(title or f"3-D lobe, θi = {float(theta_i_deg):g}°, "
-                 f"φi = {float(phi_i_deg):g}°", fontsize=FONT["title"])
+    ax.set_title(title or f"3-D lobe, θi = {float(theta_i_deg):g}°, φi = {float(phi_i_deg):g}°"
+                 f"\n(x, y, z: r wo, r in 1/sr)", fontsize=FONT["title"])
     return finish(fig, ax, filename)

@@ -100,6 +100,7 @@ def _colour_and_lobe3d(p: Page) -> str:
     peak = float(np.nanmax(luminance(img))) if np.any(np.isfinite(img)) else 0.0
     exposure = float(np.log2(0.7 / peak)) if peak > 0 else 0.0
     fig, axes = new_figure(2, 1, figsize=(10.0, 4.2))
+    fig.get_layout_engine().set(w_pad=0.25)   # room the 3-D axes' layout leaves out
     plot_hemisphere(p.fabric, 45.0, 0.0, quantity="srgb", exposure=exposure,
                     resolution=p.q["hemi"], ax=axes[0],
                     title=f"f_r(wo) colour, sRGB, exposure {exposure:+.1f} stops")

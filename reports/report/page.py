@@ -59,15 +59,13 @@ class Page:
         return f"{self.folder}/{filename}"
 
     def figure(self, fig, filename: str, caption: str) -> str:
-        """Save ``fig`` atomically beside the page, close it, return its <figure> HTML: the
-        image links to itself at full size; a figure more than twice as wide as high spans
-        two columns of the page's grid."""
-        width, height = fig.get_size_inches()
+        """Save ``fig`` atomically beside the page, close it, return its <figure> HTML (a
+        cell of the page's grid; the image links to itself at full size)."""
         try:
             save_figure(fig, self.path(filename), dpi=self.q["dpi"])
         finally:
             _close(fig)
-        return figure_html(self.rel(filename), caption, wide=width > 2.0 * height)
+        return figure_html(self.rel(filename), caption)
 
     def json(self, filename: str, data) -> str:
         """Write ``data`` as strict JSON beside the page, return a link to it."""
@@ -85,7 +83,7 @@ class Page:
         return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
 
 
-def figure_html(src: str, caption: str, wide: bool = False) -> str:
+def figure_html(src: str, caption: str) -> str:
     """A ``<figure>`` of the grid: the image, a link to it at full size, its caption.
 
     Examples
@@ -94,8 +92,7 @@ def figure_html(src: str, caption: str, wide: bool = False) -> str:
     '<figure><a href="a/b.png" title="x (click for full size)">'
     """
     src, text = html.escape(src), html.escape(caption)
-    cls = ' class="wide"' if wide else ""
-    return (f'<figure{cls}><a href="{src}" title="{text} (click for full size)">'
+    return (f'<figure><a href="{src}" title="{text} (click for full size)">'
             f'<img src="{src}" alt="{text}" loading="lazy"></a>'
             f'<figcaption>{text}</figcaption></figure>')
 

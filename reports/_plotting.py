@@ -21,8 +21,8 @@ from reports.colour import CHANNEL_COLOURS, luminance
 
 __all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
            "quantity_styles", "QUANTITIES", "check_quantity", "half_diff_to_io", "check_angle",
-           "DPI", "FONT", "PALETTE", "series_style", "preset_style", "series_styles", "legend_outside",
-           "log_range", "pow10_label", "shade_zero"]
+           "DPI", "FONT", "PALETTE", "series_style", "preset_style", "series_styles",
+           "legend_outside", "log_range", "pow10_label", "shade_zero"]
 
 #: What a plot can show of an RGB f_r: its Rec. 709 luminance, each channel, or one channel.
 QUANTITIES = ("luminance", "rgb", "r", "g", "b")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from analysis import AlbedoCurve, AlbedoResult
-from reports._plotting import FONT, check_quantity, finish, legend_outside, new_axes, quantity_styles
+from reports._plotting import (FONT, check_quantity, finish, legend_outside, new_axes,
+                               quantity_styles)
 from reports.colour import REC709_WEIGHTS, luminance
 
 __all__ = ["plot_albedo"]
@@ -82,7 +83,13 @@ def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, l
                            label=f"{prefix}{suffix}")
         channel = suffix.strip().lower() if suffix.strip() else "grey"
         cont.lines[0].set_gid(f"albedo {prefix} {channel if channel in 'rgb' else channel}")
-    if not any(l.get_gid() == "unit" for l in ax.get_lines()):
+    _decorate(ax, legend, title)
+    return finish(fig, ax, filename)
+
+
+def _decorate(ax, legend, title):
+    """The line albedo = 1 (once), labels with units, 8 pt ticks, the legend, the title."""
+    if not any(line.get_gid() == "unit" for line in ax.get_lines()):
         ref = ax.axhline(1.0, color="0.5", ls=":", lw=1.0)
         ref.set_gid("unit")
     ax.set_xlabel("θ (degrees)", fontsize=FONT["label"])
@@ -93,4 +100,3 @@ def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, l
     if legend:
         legend_outside(ax, "right")
     ax.set_title(title or "directional albedo", fontsize=FONT["title"])
-    return finish(fig, ax, filename)

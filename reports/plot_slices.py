@@ -57,6 +57,8 @@ def _draw(ax, x_deg, values, quantity, colour, log, gid, decades=6.0, label=None
             st.update(style)
         if log and low and not overlay:
             name += f" (peak {peak:.2g} 1/sr, below the axis)"
+        elif log and not overlay and np.any((y > 0) & (y < lims[0])):
+            name += f" (off the axis below {lims[0]:.0e})"
         line, = ax.plot(x_deg, y, color=st["color"], ls=st["ls"], lw=1.5, label=name)
         line.set_gid(f"{gid} {'luminance' if k is None else 'rgb'[k]}")
     if log:

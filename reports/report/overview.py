@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reports._plotting import series_styles
+from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
 from reports.plot_lobes import plot_lobe_comparison
 from reports.plot_masking import plot_masking_terms
@@ -66,7 +66,8 @@ def _albedo(p: Page, reports: list[FabricReport]) -> str:
                         legend=False, title=f"luminance albedo, wo at φ = {phi:g}°")
         ax.set_xlabel("θo (degrees)")
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=8, frameon=False)
+    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=FONT["small"],
+               frameon=False)
     out.append(p.figure(fig, "albedo_comparison.png", "Rec. 709 luminance of the "
                         "directional albedo of every fabric, against θo, wo along the warp "
                         "(left) and the weft (right); each fabric in its own colour, line style "

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import eval_brdf
+from reports._plotting import FONT, eval_brdf
 from reports.colour import luminance
 from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
 from reports.plot_lobes import plane_directions, plot_lobe_3d, plot_lobe_planes
@@ -148,7 +148,7 @@ def section_masking(p: Page) -> Section:
             plot_masking_lobes(p.fabric, ti, phi, resolution=p.q["lobe"], ax=ax, scale=scale,
                                legend=False)
         handles, labels = axes[0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=8,
+        fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=FONT["small"],
                    frameon=False)
         out.append(p.figure(fig, stem, caption))
     out.append('<p>The terms M, P and u themselves are drawn on the <a href="index.html#masking">'

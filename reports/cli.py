@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "reports.cmd_fit",
     "reports.cmd_measured",
     "reports.cmd_batch",
+    "reports.cmd_plot",
     "reports.cmd_export",
 )
 

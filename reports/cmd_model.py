@@ -49,8 +49,9 @@ def register(sub):
                    help="limit to these presets (repeatable; default all)")
     p.add_argument("-o", "--output", default="report", metavar="DIR",
                    help="output folder (default ./report); replaced whole by the next run")
-    p.add_argument("--quality", choices=("default", "fast"), default="default",
-                   help="figure and render resolution (default: default)")
+    p.add_argument("--quality", choices=("default", "high", "fast"), default="default",
+                   help="figure and render resolution: default (renders 640 x 360), high "
+                        "(1280 x 720, finer figures, slower) or fast (previews)")
     p.add_argument("--fit", action="append", metavar="FABRIC=RESULTS",
                    help="show a fit's results.json in FABRIC's page (repeatable)")
     p.add_argument("--measured", default=None, metavar="DIR",

@@ -5,14 +5,15 @@ from __future__ import annotations
 import numpy as np
 
 from analysis import AlbedoCurve, AlbedoResult
-from reports._plotting import check_quantity, finish, new_axes, quantity_styles
+from reports._plotting import (FONT, check_quantity, finish, legend_outside, new_axes,
+                               quantity_styles)
 from reports.colour import REC709_WEIGHTS, luminance
 
 __all__ = ["plot_albedo"]
 
 
 def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, label=None,
-                ax=None, filename=None, title=None):
+                style=None, legend=True, ax=None, filename=None, title=None):
     """Albedo rho(theta) with error bars, and the line rho = 1.
 
     Parameters
@@ -30,6 +31,12 @@ def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, l
         fabric's sRGB colour). Grey (n,) input is drawn as given whatever the quantity.
     label : str, optional
         Prefix of the legend labels (e.g. a fabric name).
+    style : dict, optional
+        Colour, line style and marker of a grey or luminance curve (e.g.
+        :func:`reports._plotting.preset_style` of the fabric, so that every fabric of an
+        overlay differs in all three); overrides ``colour``.
+    legend : bool
+        Draw the legend beside the axes (8 pt).
 
     Returns
     -------
@@ -67,17 +74,29 @@ def plot_albedo(theta_deg, albedo, error=None, *, quantity="rgb", colour=None, l
                   for k, col, suffix in quantity_styles(quantity)]
     prefix = label or "albedo"
     for y, e, col, suffix in series:
-        cont = ax.errorbar(theta, y, yerr=e, color=col, lw=1.3, capsize=2, ms=3,
-                           marker="o" if theta.size <= 30 else None, label=f"{prefix}{suffix}")
+        st = {"color": col, "ls": "-", "marker": "o"}
+        if style is not None and len(series) == 1:
+            st.update(style)
+        cont = ax.errorbar(theta, y, yerr=e, color=st["color"], ls=st["ls"], lw=1.4,
+                           capsize=2, ms=4, mfc="none",
+                           marker=st["marker"] if theta.size <= 30 else None,
+                           label=f"{prefix}{suffix}")
         channel = suffix.strip().lower() if suffix.strip() else "grey"
         cont.lines[0].set_gid(f"albedo {prefix} {channel if channel in 'rgb' else channel}")
-    if not any(l.get_gid() == "unit" for l in ax.get_lines()):
+    _decorate(ax, legend, title)
+    return finish(fig, ax, filename)
+
+
+def _decorate(ax, legend, title):
+    """The line albedo = 1 (once), labels with units, 8 pt ticks, the legend, the title."""
+    if not any(line.get_gid() == "unit" for line in ax.get_lines()):
         ref = ax.axhline(1.0, color="0.5", ls=":", lw=1.0)
         ref.set_gid("unit")
-    ax.set_xlabel("θ (degrees)")
-    ax.set_ylabel("directional albedo (unitless)")
+    ax.set_xlabel("θ (degrees)", fontsize=FONT["label"])
+    ax.set_ylabel("directional albedo (unitless)", fontsize=FONT["label"])
     ax.set_xlim(0, 90)
+    ax.tick_params(labelsize=FONT["small"])
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, frameon=False)
-    ax.set_title(title or "directional albedo", fontsize=9)
-    return finish(fig, ax, filename)
+    if legend:
+        legend_outside(ax, "right")
+    ax.set_title(title or "directional albedo", fontsize=FONT["title"])

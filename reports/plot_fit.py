@@ -1,15 +1,17 @@
-"""Model curves over measured table points in a plane of incidence, with error bars."""
+"""Model curves over measured table points in a plane of incidence, with error bars: one
+model at several incidences, or several models (presets, fits) at one."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import (check_quantity, eval_brdf, finish, new_axes, quantity_styles,
+from reports._plotting import (FONT, check_quantity, eval_brdf, finish, legend_outside,
+                               log_range, new_axes, quantity_styles, series_styles,
                                reduce_quantity)
 from reports.colour import REC709_WEIGHTS
 from reports.plot_lobes import plane_directions
 
-__all__ = ["plane_points", "plot_fit_overlay"]
+__all__ = ["plane_points", "plot_fit_overlay", "plot_table_models", "plane_incidences"]
 
 
 def _signed(theta, phi, phi_plane, tol):
@@ -113,12 +115,96 @@ def plot_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity="rg
                         reduce_quantity(values[sel], quantity), err)
     if log:
         ax.set_yscale("log")
-    ax.set_xlabel("signed θo (degrees; light on the negative side)")
-    ax.set_ylabel("f_r (1/sr)")
+    _cartesian_labels(ax)
+    legend_outside(ax, "right")
+    ax.set_title(title or f"model and measurement, plane φ = {phi_deg:g}°",
+                 fontsize=FONT["title"])
+    return finish(fig, ax, filename)
+
+
+def _cartesian_labels(ax):
+    ax.set_xlabel("signed θo (degrees; light on the negative side)", fontsize=FONT["label"])
+    ax.set_ylabel("f_r (1/sr)", fontsize=FONT["label"])
     ax.set_xlim(-90, 90)
+    ax.set_xticks(np.arange(-90, 91, 30))
+    ax.tick_params(labelsize=FONT["small"])
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=6, frameon=False, ncol=2)
-    ax.set_title(title or f"model and measurement, plane φ = {phi_deg:g}°", fontsize=9)
+
+
+def plane_incidences(table, phi_deg=0.0, tol_deg=2.0) -> np.ndarray:
+    """The distinct incidence angles (degrees, to 0.5 degree) of a table's valid points in
+    the plane ``phi_deg``; raises ``ValueError`` when the plane holds none."""
+    ti = _plane_data(table, phi_deg, tol_deg)[0]
+    return np.unique(np.round(ti * 2.0) / 2.0)
+
+
+def plot_table_models(table, models, theta_i_deg, phi_deg=0.0, *, quantity="luminance",
+                      tol_deg=2.0, resolution=181, log=True, decades=6.0, legend=True,
+                      ax=None, filename=None, title=None):
+    """A measured table at one incidence in a plane (black circles with error bars) against
+    models, each curve in its own colour and line style (:func:`series_styles`).
+
+    Parameters
+    ----------
+    table : gonio.Table
+        Measured f_r (1/sr); invalid values are skipped.
+    models : mapping of str to BRDF
+        Label -> object with ``.eval`` (a preset, a fitted fabric).
+    theta_i_deg : float
+        Incidence in degrees, matched within 0.5 degree to the table's.
+    phi_deg : float
+        Azimuth of the plane of incidence in degrees.
+    quantity : {"luminance", "r", "g", "b"}
+        What of f_r is drawn.
+    log, decades : bool, float
+        Log axis over the decades that hold the data (:func:`log_range`); measured zeros
+        sit on the lower edge as open triangles labelled "f_r = 0".
+
+    Returns
+    -------
+    (fig, ax)
+        The measured points' Line2D has gid "data", each model's "model <label>" (x signed
+        theta_o in degrees, y f_r in 1/sr).
+    """
+    check_quantity(quantity)
+    if quantity == "rgb":
+        raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b' to compare models; "
+                         "got 'rgb'")
+    ti, to, values, sigma = _plane_data(table, phi_deg, tol_deg)
+    sel = np.abs(ti - float(theta_i_deg)) <= 0.5
+    if not sel.any():
+        have = ", ".join(f"{t:g}" for t in np.unique(np.round(ti * 2.0) / 2.0))
+        raise ValueError(f"theta_i must be one of the table's incidences in the plane "
+                         f"phi = {phi_deg:g} degrees ({have}); got {float(theta_i_deg):g}")
+    fig, ax = new_axes(ax, figsize=(6.0, 3.8))
+    order = np.argsort(to[sel])
+    x, y = to[sel][order], reduce_quantity(values[sel], quantity)[order]
+    err = None if sigma is None else _reduce_sigma(sigma[sel], quantity)[order]
+    x_model = np.linspace(-90.0, 90.0, int(resolution))
+    wi, wo = plane_directions(float(np.mean(ti[sel])), x_model, phi_deg)
+    curves = {name: reduce_quantity(eval_brdf(m, wi, wo), quantity)
+              for name, m in dict(models).items()}
+    styles = series_styles(curves)
+    for name, c in curves.items():
+        st = styles[name]
+        line, = ax.plot(x_model, c, color=st["color"], ls=st["ls"], lw=1.5, label=name)
+        line.set_gid(f"model {name}")
+    cont = ax.errorbar(x, y, yerr=err, ls="", marker="o", ms=4, mfc="none", color="k",
+                       capsize=1.5, label="measured", zorder=3)
+    cont.lines[0].set_gid("data")
+    if log:
+        (lo, hi), _ = log_range([y, *curves.values()], decades)
+        ax.set_yscale("log")
+        ax.set_ylim(lo, hi)
+        if np.any(y <= 0):
+            ax.plot(x[y <= 0], np.full(int(np.sum(y <= 0)), lo), ls="", marker="v",
+                    mfc="none", color="k", ms=5, clip_on=False, label="measured f_r = 0")
+    _cartesian_labels(ax)
+    if legend:
+        legend_outside(ax, "right")
+    what = "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
+    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {phi_deg:g}°, {what}",
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 

@@ -13,7 +13,7 @@ import matplotlib.colors as mcolors
 import numpy as np
 
 from brdf.frames import from_angles
-from reports._plotting import check_angle, eval_brdf, finish, new_axes
+from reports._plotting import FONT, check_angle, eval_brdf, finish, legend_outside, new_axes
 from reports.colour import luminance, to_srgb
 
 __all__ = ["equal_area_grid", "equal_area_xy", "hemisphere_image", "plot_hemisphere"]
@@ -92,7 +92,8 @@ def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminanc
     theta_i_deg, phi_i_deg : float
         Direction of the light in degrees.
     quantity : {"luminance", "srgb"}
-        "luminance": Rec. 709 luminance in a colour map with a colour bar in 1/sr;
+        "luminance": Rec. 709 luminance in a colour map with a colour bar in 1/sr (zeros
+        inside the disc grey, values below the log floor black);
         "srgb": the RGB value itself, times ``2**exposure`` and encoded as sRGB through
         colour-science (no colour bar; values above 1 clip).
     log : bool
@@ -118,15 +119,7 @@ def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminanc
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
     extent = (-1, 1, -1, 1)
     if quantity == "luminance":
-        img = np.ma.masked_invalid(luminance(values))
-        peak = float(img.max()) if img.count() and img.max() > 0 else 1.0
-        norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=False) if log
-                else mcolors.Normalize(vmin=0.0, vmax=peak))
-        cmap = matplotlib.colormaps["inferno"].with_extremes(bad="white", under="black")
-        im = ax.imshow(img, origin="lower", extent=extent, norm=norm, cmap=cmap,
-                       interpolation="nearest")
-        label = "luminance f_r cos θo (1/sr)" if cosine else "luminance f_r (1/sr)"
-        fig.colorbar(im, ax=ax, label=label)
+        _luminance_image(fig, ax, luminance(values), log, decades, cosine)
     else:
         rgb = to_srgb(np.nan_to_num(values), exposure=exposure)
         alpha = np.isfinite(values[..., 0]).astype(float)[..., None]
@@ -140,14 +133,38 @@ def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminanc
     wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
     xi, yi = equal_area_xy(wi)
     xm, ym = equal_area_xy(wi * np.array([-1.0, -1.0, 1.0]))
-    ax.plot([xi], [yi], marker="*", color="cyan", ms=9, ls="", label="wi (light)")
-    ax.plot([xm], [ym], marker="+", color="cyan", ms=9, ls="", label="mirror")
+    ax.plot([xi], [yi], marker="*", color="#56B4E9", mec="k", mew=0.5, ms=10, ls="",
+            label="light wi")
+    ax.plot([xm], [ym], marker="P", color="#56B4E9", mec="k", mew=0.5, ms=8, ls="",
+            label="mirror of wi")
     ax.set_xlim(-1.05, 1.05)
     ax.set_ylim(-1.05, 1.05)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (warp)")
-    ax.set_ylabel("y (weft)")
-    ax.legend(fontsize=6, loc="lower right", frameon=False)
-    ax.set_title(title or f"f_r(wo), θi = {theta_i_deg:g}°, φi = {phi_i_deg:g}° "
-                 f"(equal-area)", fontsize=9)
+    ax.set_xlabel("x: warp (equal-area disc, 1 = horizon)", fontsize=FONT["label"])
+    ax.set_ylabel("y: weft", fontsize=FONT["label"])
+    ax.tick_params(labelsize=FONT["small"])
+    legend_outside(ax, "below", ncol=2)
+    ax.set_title(title or f"f_r(wo), θi = {theta_i_deg:g}°, φi = {phi_i_deg:g}°",
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
+
+
+def _luminance_image(fig, ax, lum, log, decades, cosine):
+    """The luminance image (masked outside the disc) and its colour bar; zeros inside the
+    disc grey and named on the colour bar, values below the log floor black."""
+    img = np.ma.masked_invalid(lum)
+    peak = float(img.max()) if img.count() and img.max() > 0 else 1.0
+    norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=False) if log
+            else mcolors.Normalize(vmin=0.0, vmax=peak))
+    cmap = matplotlib.colormaps["inferno"].with_extremes(bad=(1, 1, 1, 0), under="black")
+    ax.imshow(img, origin="lower", extent=(-1, 1, -1, 1), norm=norm, cmap=cmap,
+              interpolation="nearest")
+    zero = np.isfinite(lum) & ~(lum > 0)
+    if zero.any():
+        ax.imshow(np.where(zero[..., None], [0.8, 0.8, 0.8, 1.0], 0.0), origin="lower",
+                  extent=(-1, 1, -1, 1), interpolation="nearest")
+    label = "luminance f_r cos θo (1/sr)" if cosine else "luminance f_r (1/sr)"
+    cb = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                      extend="min" if log else "neither")
+    cb.set_label(label + ("\ngrey: f_r = 0" if zero.any() else ""), fontsize=FONT["label"])
+    cb.ax.tick_params(labelsize=FONT["small"])

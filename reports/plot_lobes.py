@@ -11,15 +11,16 @@ from __future__ import annotations
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from brdf.frames import from_angles
-from reports._plotting import (check_angle, eval_brdf, finish, new_axes,
-                               quantity_styles, reduce_quantity)
-from reports.colour import line_colour, luminance
+from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish, legend_outside,
+                               new_axes, pow10_label, quantity_styles, series_styles,
+                               reduce_quantity, series_style)
+from reports.colour import luminance
 
 __all__ = ["plane_directions", "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison",
-           "plot_lobe_3d", "log_radius"]
+           "plot_lobe_3d", "log_radius", "plane_name"]
 
 
 def plane_directions(theta_i_deg, theta_o_deg, phi_deg=0.0):
@@ -70,25 +71,34 @@ def _log_floor(peak, decades):
     return 10.0 ** np.floor(np.log10(peak) - decades)
 
 
-def _setup_polar(ax, scale, floor, rmax):
+def _setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
+    """Half-disc polar axes (theta_o from -90 to 90 degrees, the normal up) with radial ticks
+    in 8 pt: decades 10^k on a log scale (every other one when more than five), and the
+    radial axis labelled ``label`` under the disc."""
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
     ax.set_thetamin(-90)
     ax.set_thetamax(90)
+    ax.set_xticks(np.radians([-90, -60, -30, 0, 30, 60, 90]))
+    ax.set_xticklabels(["−90°", "−60°", "−30°", "0°", "30°", "60°", "90°"])
+    ax.tick_params(axis="both", labelsize=FONT["small"])
+    ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
     if scale == "log":
-        decades = int(np.ceil(rmax)) if rmax > 0 else 1
-        ticks = np.arange(0, decades + 1)
-        ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
-        ax.set_rticks(ticks[ticks <= rmax * 1.05])
-        shown = ticks[ticks <= rmax * 1.05]
+        shown = np.arange(0, int(np.floor(rmax * 1.05)) + 1)
         base = int(round(np.log10(floor)))
-        every = 1 if len(shown) <= 5 else 2
-        ax.set_yticklabels([f"1e{base + k}" if (len(shown) - 1 - k) % every == 0 else ""
-                            for k in shown], fontsize=6)
+        every = 1 if len(shown) <= 4 else 2
+        ax.set_rticks(shown)
+        ax.set_yticklabels([pow10_label(base + k) if (shown[-1] - k) % every == 0 else ""
+                            for k in shown])
+        label = f"{label}, log scale"
     else:
-        ax.set_rlim(0, max(rmax, 1e-12) * 1.05)
-        ax.yaxis.set_major_locator(MaxNLocator(4))
-        ax.tick_params(axis="y", labelsize=6)
+        ax.yaxis.set_major_locator(MaxNLocator(3))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+    # r tick labels on the right edge, reading outward; the axis label under the centre
+    ax.yaxis.set_tick_params(label1On=False, label2On=True)
+    ax.annotate(f"radius: {label}", xy=(0.0, 0.0), xytext=(0.0, -19.0), ha="center",
+                va="top", textcoords="offset points", fontsize=FONT["small"],
+                annotation_clip=False)
 
 
 def _check_scale(scale):
@@ -98,7 +108,7 @@ def _check_scale(scale):
 
 def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantity="luminance",
                     scale="linear", decades=4.0, resolution=181, cosine=False, colour=None,
-                    ax=None, filename=None, title=None):
+                    normalize=False, legend=True, ax=None, filename=None, title=None):
     """Polar plot of f_r in a plane of incidence, one curve per incidence angle.
 
     Parameters
@@ -114,7 +124,7 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
         channels in red, green and blue, one line style per theta_i.
     scale : {"linear", "log"}
         Radial scale. "log" plots log10(f / floor), clipped at 0, with floor the power of 10
-        at least ``decades`` below the peak; tick labels are f_r values.
+        at least ``decades`` below the peak; tick labels are f_r values 10^k in 1/sr.
     decades : float
         Dynamic range of the log scale.
     resolution : int
@@ -123,7 +133,12 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
         Plot f_r cos(theta_o) (the visible lobe) instead of f_r.
     colour : matplotlib colour, optional
         Colour of all luminance curves (line styles then tell the incidences apart); by
-        default each incidence gets its own colour from the "viridis" colour map.
+        default each incidence gets its own colour and line style (:func:`series_style`).
+    normalize : bool
+        Linear scale only: divide each curve by its own peak (unitless, 1 at the peak; the
+        legend gives each peak in 1/sr), so lobes of very different heights all show.
+    legend : bool
+        Draw the legend under the plot (8 pt); :func:`plot_lobe_planes` draws one for all.
     ax : matplotlib PolarAxes, optional
     filename : str or path, optional
         Save the figure there (atomically) when given.
@@ -133,7 +148,8 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
     -------
     (fig, ax)
         Each curve is a Line2D with x = signed theta_o in radians and y = the plotted value
-        (f_r in 1/sr, or its log radius), and gid "lobe theta_i=<deg> <channel>".
+        (f_r in 1/sr, its log radius, or f_r / its peak), and gid
+        "lobe theta_i=<deg> <channel>".
     """
     _check_scale(scale)
     thetas = np.atleast_1d(check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999))
@@ -142,23 +158,26 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
         raise ValueError(f"resolution must be at least 3; got {resolution}")
     if not decades > 0:
         raise ValueError(f"decades must be positive; got {decades}")
-    fig, ax = new_axes(ax, projection="polar")
+    if normalize and scale == "log":
+        raise ValueError("normalize applies to the linear scale only; got scale='log'")
+    fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
     theta_o = np.linspace(-90.0, 90.0, int(resolution))
     curves = [_plane_curve(brdf, ti, theta_o, phi_deg, quantity, cosine) for ti in thetas]
     peak = max(float(np.nanmax(c)) if np.any(np.isfinite(c)) else 0.0 for c in curves)
     floor = _log_floor(peak, decades)
     rmax = _draw_lobes(ax, thetas, theta_o, curves, quantity_styles(quantity, colour), colour,
-                       floor if scale == "log" else None)
-    _setup_polar(ax, scale, floor, rmax)
+                       floor if scale == "log" else None, normalize)
+    label = "f_r cos θo" if cosine else "f_r"
+    _setup_polar(ax, scale, floor, rmax,
+                 f"{label} / its peak (per curve)" if normalize else f"{label} (1/sr)")
     for ti in thetas:  # incident directions as arrows from the centre
         ax.annotate("", xy=(np.radians(-ti), rmax * 1.0), xytext=(0, 0),
                     arrowprops=dict(arrowstyle="<-", color="0.5", lw=0.8))
-    label = "f_r cos θo" if cosine else "f_r"
-    unit = "1/sr"
     what = "luminance" if quantity == "luminance" else quantity.upper()
-    ax.set_title(title or f"{label} ({unit}, {what}, {scale}) in the plane φ = {float(phi_deg):g}°",
-                 fontsize=9)
-    ax.legend(fontsize=6, loc="lower left", bbox_to_anchor=(-0.1, -0.15), ncol=2, frameon=False)
+    ax.set_title(title or f"{label} ({what}) in the plane φ = {float(phi_deg):g}°",
+                 fontsize=FONT["title"])
+    if legend:
+        legend_outside(ax, "below", ncol=min(3, len(ax.get_lines())))
     return finish(fig, ax, filename)
 
 
@@ -173,21 +192,25 @@ def _plane_curve(brdf, theta_i_deg, theta_o, phi_deg, quantity, cosine) -> np.nd
     return f
 
 
-def _draw_lobes(ax, thetas, theta_o, curves, styles, colour, floor) -> float:
-    """One line per incidence and style (log radius above ``floor`` unless it is None);
-    return the largest radius drawn."""
+def _draw_lobes(ax, thetas, theta_o, curves, styles, colour, floor, normalize=False) -> float:
+    """One line per incidence and style (log radius above ``floor`` unless it is None, or
+    divided by its peak when ``normalize``); return the largest radius drawn."""
     rmax = 0.0
-    dashes = ["-", "--", ":", "-."]
     for n, (ti, f) in enumerate(zip(thetas, curves)):
+        st = series_style(n)
         for k, col, suffix in styles:
             y = f[:, k] if f.ndim == 2 else f
+            label = f"θi = {ti:g}°{suffix}"
+            if normalize:
+                top = float(np.nanmax(y)) if np.any(y > 0) else 1.0
+                y = y / top
+                label += f" (peak {top:.3g} 1/sr)"
             r = log_radius(y, floor) if floor is not None else y
             rmax = max(rmax, float(np.nanmax(r)))
-            ls = dashes[n % len(dashes)] if (len(styles) > 1 or colour is not None) else "-"
+            ls = st["ls"] if (len(styles) > 1 or colour is not None or k is None) else "-"
             if k is None and colour is None:
-                col = matplotlib.colormaps["viridis"](0.85 * n / max(len(thetas) - 1, 1))
-            line, = ax.plot(np.radians(theta_o), r, ls=ls, color=col, lw=1.4,
-                            label=f"θi = {ti:g}°{suffix}")
+                col = st["color"]
+            line, = ax.plot(np.radians(theta_o), r, ls=ls, color=col, lw=1.5, label=label)
             line.set_gid(f"lobe theta_i={ti:g} {'luminance' if k is None else 'rgb'[k]}")
     return rmax
 
@@ -216,23 +239,35 @@ def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0,
     """
     planes = list(np.atleast_1d(planes_deg))
     if fig is None:
-        fig = Figure(figsize=(4.2 * len(planes), 3.6))
+        fig = Figure(figsize=(4.2 * len(planes), 2.9), layout="constrained")
     else:
         fig.clear()
     axes = [fig.add_subplot(1, len(planes), n + 1, projection="polar")
             for n in range(len(planes))]
-    names = {0.0: "warp", 90.0: "weft"}
     for ax, phi in zip(axes, planes):
-        plot_polar_lobe(brdf, theta_i_deg, phi, ax=ax,
-                        title=f"φ = {float(phi):g}° ({names.get(float(phi) % 180, 'diagonal')})",
-                        **kwargs)
+        plot_polar_lobe(brdf, theta_i_deg, phi, ax=ax, legend=False,
+                        title=f"plane φ = {float(phi):g}° ({plane_name(phi)})", **kwargs)
+    if not kwargs.get("normalize"):
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 6),
+                   fontsize=FONT["small"], frameon=False)
+    else:  # each panel's own peaks
+        for ax in axes:
+            legend_outside(ax, "below", ncol=1)
     return finish(fig, axes, filename)
 
 
+def plane_name(phi_deg) -> str:
+    """"warp", "weft" or "diagonal" for a plane's azimuth in degrees."""
+    return {0.0: "warp", 90.0: "weft"}.get(float(phi_deg) % 180, "diagonal")
+
+
 def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", decades=4.0,
-                         resolution=181, ax=None, filename=None, title=None):
-    """Luminance lobes of several BRDFs in one polar plot, each in its own sRGB colour
-    (:func:`reports.colour.line_colour`) and its own line style.
+                         resolution=181, quantity="luminance", legend=True, ax=None,
+                         filename=None, title=None):
+    """Luminance lobes of several BRDFs in one polar plot, each in its own colour and line
+    style (:func:`reports._plotting.series_styles`: a preset's style is the same in every
+    figure).
 
     Parameters
     ----------
@@ -242,6 +277,10 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
         Incidence angle and plane azimuth in degrees.
     scale, decades, resolution
         As in :func:`plot_polar_lobe`; the log floor is common to all curves.
+    quantity : {"luminance", "r", "g", "b"}
+        What of f_r is drawn.
+    legend : bool
+        Draw the legend under the plot (8 pt).
 
     Returns
     -------
@@ -250,25 +289,34 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
     """
     _check_scale(scale)
     check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999)
-    fig, ax = new_axes(ax, projection="polar", figsize=(6.0, 4.5))
+    fig, ax = new_axes(ax, projection="polar", figsize=(5.6, 3.7))
     theta_o = np.linspace(-90.0, 90.0, int(resolution))
     wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
-    data = {name: luminance(eval_brdf(b, wi, wo)) for name, b in dict(brdfs).items()}
+    if check_quantity(quantity) == "rgb":
+        raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b'; got 'rgb'")
+    data = {name: reduce_quantity(eval_brdf(b, wi, wo), quantity)
+            for name, b in dict(brdfs).items()}
     peak = max((float(np.nanmax(v)) for v in data.values()), default=0.0)
     floor = _log_floor(peak, decades)
     rmax = 0.0
-    styles = ["-", "--", "-.", ":"]
-    for n, (name, y) in enumerate(data.items()):
+    styles = series_styles(data)
+    for name, y in data.items():
         r = log_radius(y, floor) if scale == "log" else y
         rmax = max(rmax, float(np.nanmax(r)))
-        line, = ax.plot(np.radians(theta_o), r, color=line_colour(dict(brdfs)[name]),
-                        ls=styles[n % 4], lw=1.5, label=name)
+        st = styles[name]
+        line, = ax.plot(np.radians(theta_o), r, color=st["color"], ls=st["ls"], lw=1.5,
+                        label=name)
         line.set_gid(f"lobe {name}")
-    _setup_polar(ax, scale, floor, rmax)
-    ax.set_title(title or f"luminance f_r (1/sr, {scale}), θi = {float(theta_i_deg):g}°, "
-                 f"φ = {float(phi_deg):g}°", fontsize=9)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    _setup_polar(ax, scale, floor, rmax, f"{_what(quantity)} f_r (1/sr)")
+    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {float(phi_deg):g}° "
+                 f"({plane_name(phi_deg)})", fontsize=FONT["title"])
+    if legend:
+        legend_outside(ax, "below", ncol=2)
     return finish(fig, ax, filename)
+
+
+def _what(quantity) -> str:
+    return "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
 
 
 def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resolution=(30, 60),
@@ -317,11 +365,15 @@ def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resoluti
     ax.set_xlim(-ext, ext)
     ax.set_ylim(-ext, ext)
     ax.set_zlim(0, ext)
-    ax.set_xlabel("x (warp)", fontsize=7)
-    ax.set_ylabel("y (weft)", fontsize=7)
-    ax.set_zlabel("z", fontsize=7)
-    ax.tick_params(labelsize=6)
+    ax.set_xlabel("x: warp", fontsize=FONT["label"], labelpad=12)
+    ax.set_ylabel("y: weft", fontsize=FONT["label"], labelpad=12)
+    ax.set_zlabel("z", fontsize=FONT["label"], labelpad=10)
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(3))
+    ax.tick_params(labelsize=FONT["small"], pad=1)
     what = "luminance f_r cos θo" if cosine else "luminance f_r"
-    ax.set_title(title or f"3-D lobe, {what} (1/sr), θi = {float(theta_i_deg):g}°, "
-                 f"φi = {float(phi_i_deg):g}°", fontsize=9)
+    sm = matplotlib.cm.ScalarMappable(norm=norm, cmap="viridis")
+    fig.colorbar(sm, ax=ax, shrink=0.7, pad=0.12, label=f"{what} (1/sr)")
+    ax.set_title(title or f"3-D lobe, θi = {float(theta_i_deg):g}°, φi = {float(phi_i_deg):g}°"
+                 f"\n(x, y, z: r wo, r in 1/sr)", fontsize=FONT["title"])
     return finish(fig, ax, filename)

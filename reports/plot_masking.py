@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from brdf import terms
-from reports._plotting import eval_brdf, finish, new_axes
-from reports.colour import line_colour, luminance
+from reports._plotting import (FONT, PALETTE, eval_brdf, finish, legend_outside, new_axes,
+                               series_style)
+from reports.colour import luminance
 from reports.plot_lobes import _log_floor, _setup_polar, log_radius, plane_directions
 
 __all__ = ["plot_masking_lobes", "plot_masking_terms", "masking_terms"]
@@ -70,30 +71,35 @@ def plot_masking_terms(pair_with_deg=(0.0, 30.0, 60.0), *, resolution=361, ax=No
     """
     if int(resolution) < 3:
         raise ValueError(f"resolution must be at least 3; got {resolution}")
-    fig, ax = new_axes(ax, figsize=(6.0, 4.0))
+    fig, ax = new_axes(ax, figsize=(8.0, 3.6))
     x = np.linspace(-180.0, 180.0, int(resolution))
     base = masking_terms(x)
     line, = ax.plot(x, base["M"], color="k", lw=1.8, label="M(φ) = P(ψ) = max(cos, 0)")
     line.set_gid("M")
-    line, = ax.plot(x, base["u"], color="tab:purple", lw=1.4, label="u(x), σu = 20°")
+    line, = ax.plot(x, base["u"], color=PALETTE[5], lw=1.4, ls=(0, (1, 1)),
+                    label="u(x), σu = 20°")
     line.set_gid("u")
     for n, other in enumerate(np.atleast_1d(pair_with_deg)):
         t = masking_terms(x, other)
-        line, = ax.plot(x, t["pair"], ls="--", lw=1.2, color=f"C{n}",
-                        label=f"M(wi, wo), φi = {float(other):g}°, against φo")
+        st = series_style(n + 1)
+        line, = ax.plot(x, t["pair"], ls=st["ls"], lw=1.4, color=st["color"],
+                        label=f"M(wi, wo) against φo,\nφi = {float(other):g}°")
         line.set_gid(f"pair phi_i={float(other):g}")
-    ax.set_xlabel("angle about the thread (degrees)")
-    ax.set_ylabel("weight (unitless)")
+    ax.set_xlabel("angle about the thread (degrees)", fontsize=FONT["label"])
+    ax.set_ylabel("weight (unitless)", fontsize=FONT["label"])
     ax.set_xlim(-180, 180)
+    ax.set_xticks(np.arange(-180, 181, 60))
     ax.set_ylim(-0.02, 1.05)
+    ax.tick_params(labelsize=FONT["small"])
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, frameon=False)
-    ax.set_title(title or "shadowing/masking M, reweighting P and the blend u", fontsize=9)
+    legend_outside(ax, "right")
+    ax.set_title(title or "shadowing/masking M, reweighting P and the blend u",
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 
 def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", decades=4.0,
-                       resolution=181, ax=None, filename=None, title=None):
+                       resolution=181, legend=True, ax=None, filename=None, title=None):
     """The same polar lobe (luminance) with masking on (solid) and off (dashed).
 
     Parameters
@@ -103,6 +109,8 @@ def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", d
         ``.options``), the variant ``brdf.replace(masking=False)`` as "masking off".
     theta_i_deg, phi_deg : float
         Incidence angle and plane azimuth in degrees.
+    legend : bool
+        Draw the legend under the plot (8 pt).
 
     Returns
     -------
@@ -121,7 +129,7 @@ def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", d
                          f"got {type(brdf).__name__}")
     on = replace(masking=True)
     off = replace(masking=False)
-    fig, ax = new_axes(ax, projection="polar")
+    fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
     theta_o = np.linspace(-90.0, 90.0, int(resolution))
     wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
     curves = {"masking on": luminance(eval_brdf(on, wi, wo)),
@@ -129,15 +137,16 @@ def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", d
     peak = max(float(np.nanmax(c)) for c in curves.values())
     floor = _log_floor(peak, decades)
     rmax = 0.0
-    col = line_colour(brdf)
-    for name, y in curves.items():
+    for n, (name, y) in enumerate(curves.items()):
         r = log_radius(y, floor) if scale == "log" else y
         rmax = max(rmax, float(np.nanmax(r)))
-        line, = ax.plot(np.radians(theta_o), r, color=col if name == "masking on" else "0.25",
-                        ls="-" if name == "masking on" else "--", lw=1.5, label=name)
+        st = series_style(n)
+        line, = ax.plot(np.radians(theta_o), r, color=st["color"], ls=st["ls"], lw=1.5,
+                        label=name)
         line.set_gid(name)
-    _setup_polar(ax, scale, floor, rmax)
-    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.12), frameon=False)
-    ax.set_title(title or f"luminance f_r (1/sr), θi = {float(theta_i_deg):g}°, "
-                 f"φ = {float(phi_deg):g}°", fontsize=9)
+    _setup_polar(ax, scale, floor, rmax, "luminance f_r (1/sr)")
+    if legend:
+        legend_outside(ax, "below", ncol=2)
+    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {float(phi_deg):g}°",
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)

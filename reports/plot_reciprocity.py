@@ -6,7 +6,7 @@ import numpy as np
 
 from analysis.reciprocity import relative_asymmetry
 from brdf.frames import from_angles
-from reports._plotting import eval_brdf, finish, new_axes
+from reports._plotting import FONT, eval_brdf, finish, new_axes
 from reports.colour import luminance
 
 __all__ = ["reciprocity_map", "plot_reciprocity_map"]
@@ -86,12 +86,16 @@ def plot_reciprocity_map(brdf=None, phi_i_deg=180.0, phi_o_deg=0.0, *, theta_deg
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
     im = ax.imshow(error, origin="lower", extent=(lo, hi, lo, hi), vmin=0.0, vmax=1.0,
                    cmap="viridis", interpolation="nearest")
-    fig.colorbar(im, ax=ax, label="|f(wi,wo) − f(wo,wi)| / max (unitless)")
-    ax.set_xlabel("θo (degrees)")
-    ax.set_ylabel("θi (degrees)")
+    cb = fig.colorbar(im, ax=ax)
+    cb.set_label("|f(wi,wo) − f(wo,wi)| / max\n(unitless; 0 where both are 0)",
+                 fontsize=FONT["label"])
+    cb.ax.tick_params(labelsize=FONT["small"])
+    ax.set_xlabel("θo (degrees)", fontsize=FONT["label"])
+    ax.set_ylabel("θi (degrees)", fontsize=FONT["label"])
+    ax.tick_params(labelsize=FONT["small"])
     finite = error[np.isfinite(error)]
     stats = (f"median {np.median(finite):.3g}, max {np.max(finite):.3g}" if finite.size
              else "no data")
     ax.set_title(title or f"reciprocity error, φi = {phi_i_deg:g}°, φo = {phi_o_deg:g}°\n"
-                 f"({stats})", fontsize=9)
+                 f"({stats})", fontsize=FONT["title"])
     return finish(fig, ax, filename)

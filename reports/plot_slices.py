@@ -16,8 +16,9 @@ import matplotlib.colors as mcolors
 import numpy as np
 
 from brdf.frames import from_angles
-from reports._plotting import (check_angle, eval_brdf, finish, half_diff_to_io,
-                               new_axes, quantity_styles, reduce_quantity, check_quantity)
+from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish,
+                               half_diff_to_io, legend_outside, log_range, new_axes,
+                               quantity_styles, reduce_quantity, shade_zero)
 from reports.colour import line_colour, luminance
 
 __all__ = ["plot_slice_theta_o", "plot_slice_theta_h", "plot_slice_theta_d",
@@ -37,24 +38,46 @@ def _check_res(resolution, least=2):
     return int(resolution)
 
 
-def _draw(ax, x_deg, values, quantity, colour, log, gid):
+def _draw(ax, x_deg, values, quantity, colour, log, gid, decades=6.0, label=None,
+          style=None):
+    """The curves of ``quantity``; on a log axis the y range covers the decades that hold the
+    data (:func:`log_range`): a channel peaking many decades below the others stays drawn
+    but under the axis, its legend entry giving its peak, and zeros are grey bands. ``label``
+    and ``style`` (colour, ls) name and style a one-curve quantity (overlays of fabrics),
+    whose y range then grows with every curve drawn on ``ax``."""
     styles = quantity_styles(quantity, colour)
-    for k, col, suffix in styles:
-        y = values[..., k] if values.ndim == 2 else values
-        line, = ax.plot(x_deg, y, color=col, lw=1.4,
-                        label=("luminance" if k is None else "RGB"[k]))
+    ys = [values[..., k] if values.ndim == 2 else values for k, _, _ in styles]
+    peaks = [float(np.nanmax(y)) if np.any(np.isfinite(y)) else 0.0 for y in ys]
+    lims, below = log_range(ys, decades)
+    overlay = label is not None and len(styles) == 1
+    for (k, col, suffix), y, peak, low in zip(styles, ys, peaks, below):
+        name = label if overlay else ("luminance" if k is None else "RGB"[k])
+        st = {"color": col, "ls": "-"}
+        if overlay and style:
+            st.update(style)
+        if log and low and not overlay:
+            name += f" (peak {peak:.2g} 1/sr, below the axis)"
+        elif log and not overlay and np.any((y > 0) & (y < lims[0])):
+            name += f" (off the axis below {lims[0]:.0e})"
+        line, = ax.plot(x_deg, y, color=st["color"], ls=st["ls"], lw=1.5, label=name)
         line.set_gid(f"{gid} {'luminance' if k is None else 'rgb'[k]}")
     if log:
+        if overlay:  # the range of every curve on the axes
+            lims = log_range([l.get_ydata() for l in ax.get_lines() if l.get_gid()],
+                             decades)[0]
         ax.set_yscale("log")
-    ax.set_ylabel("f_r (1/sr)")
+        ax.set_ylim(*lims)
+        if not overlay:
+            shade_zero(ax, x_deg, np.all([np.asarray(y) <= 0 for y in ys], axis=0))
+    ax.set_ylabel("f_r (1/sr)", fontsize=FONT["label"])
+    ax.tick_params(labelsize=FONT["small"])
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, frameon=False)
+    legend_outside(ax, "right")
 
 
 def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *,
                        quantity="rgb", log=False, resolution=181, theta_max_deg=89.5, ax=None,
-                       filename=None,
-                       title=None):
+                       filename=None, title=None, label=None, style=None):
     """f_r against theta_o at fixed wi and viewing azimuth phi_o.
 
     Parameters
@@ -73,6 +96,10 @@ def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *
         Samples of theta_o over [0, theta_max_deg] degrees.
     theta_max_deg : float
         End of the swept angle in degrees (all three cartesian slices take it).
+    label, style : str, dict, optional
+        For a one-curve ``quantity`` (luminance or one channel): the legend label and the
+        colour and line style (``{"color": ..., "ls": ...}``) of the curve, to overlay several
+        fabrics on one axes (all three cartesian slices take them).
 
     Returns
     -------
@@ -87,17 +114,16 @@ def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *
     wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
     wo = from_angles(np.radians(x), np.radians(phi_o_deg))
     f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_o")
-    ax.set_xlabel("θo (degrees)")
+    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_o", label=label, style=style)
+    ax.set_xlabel("θo (degrees)", fontsize=FONT["label"])
     ax.set_title(title or f"θi = {theta_i_deg:g}°, φi = {phi_i_deg:g}°, φo = {phi_o_deg:g}°",
-                 fontsize=9)
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 
 def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
                        quantity="rgb", log=True, resolution=181, theta_max_deg=89.5, ax=None,
-                       filename=None,
-                       title=None):
+                       filename=None, title=None, label=None, style=None):
     """f_r against theta_h in [0, theta_max_deg] at fixed theta_d, phi_d and phi_h (degrees).
 
     Returns
@@ -113,17 +139,16 @@ def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
     wi, wo = half_diff_to_io(np.radians(x), np.radians(theta_d_deg), np.radians(phi_d_deg),
                              np.radians(phi_h_deg))
     f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_h")
-    ax.set_xlabel("θh (degrees)")
+    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_h", label=label, style=style)
+    ax.set_xlabel("θh (degrees)", fontsize=FONT["label"])
     ax.set_title(title or f"θd = {theta_d_deg:g}°, φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°",
-                 fontsize=9)
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 
 def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
                        quantity="rgb", log=True, resolution=181, theta_max_deg=89.5, ax=None,
-                       filename=None,
-                       title=None):
+                       filename=None, title=None, label=None, style=None):
     """f_r against theta_d in [0, theta_max_deg] at fixed theta_h, phi_d and phi_h (degrees).
 
     Returns
@@ -139,10 +164,10 @@ def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
     wi, wo = half_diff_to_io(np.radians(theta_h_deg), np.radians(x), np.radians(phi_d_deg),
                              np.radians(phi_h_deg))
     f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_d")
-    ax.set_xlabel("θd (degrees)")
+    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_d", label=label, style=style)
+    ax.set_xlabel("θd (degrees)", fontsize=FONT["label"])
     ax.set_title(title or f"θh = {theta_h_deg:g}°, φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°",
-                 fontsize=9)
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 
@@ -181,7 +206,8 @@ def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4
     phi_d_deg, phi_h_deg : float
         Fixed azimuths in degrees.
     log : bool
-        Logarithmic colour scale over ``decades`` below the peak (zeros shown at the floor).
+        Logarithmic colour scale over ``decades`` below the peak; values below it black,
+        zeros grey (and the colour bar's label says so).
     resolution : int
         Cells per axis.
 
@@ -194,16 +220,21 @@ def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4
     theta, img = slice_image(brdf, phi_d_deg, phi_h_deg, resolution)
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
     peak = float(np.nanmax(img)) if np.any(img > 0) else 1.0
-    norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=True) if log
+    norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=False) if log
             else mcolors.Normalize(vmin=0.0, vmax=peak))
-    im = ax.imshow(img, origin="lower", extent=(0, 90, 0, 90), norm=norm, cmap=_CMAP(),
-                   interpolation="nearest", aspect="equal")
-    fig.colorbar(im, ax=ax, label="luminance f_r (1/sr)")
-    ax.set_xlabel("θh (degrees)")
-    ax.set_ylabel("θd (degrees)")
-    ax.set_title(title or f"φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°", fontsize=9)
+    im = ax.imshow(np.ma.masked_where(~(img > 0), img), origin="lower", extent=(0, 90, 0, 90),
+                   norm=norm, cmap=_CMAP(), interpolation="nearest", aspect="equal")
+    zero = " (grey: f_r = 0)" if np.any(~(img > 0)) else ""
+    cb = fig.colorbar(im, ax=ax, extend="min" if log else "neither")
+    cb.set_label(f"luminance f_r (1/sr){zero}", fontsize=FONT["label"])
+    cb.ax.tick_params(labelsize=FONT["small"])
+    ax.set_xlabel("θh (degrees)", fontsize=FONT["label"])
+    ax.set_ylabel("θd (degrees)", fontsize=FONT["label"])
+    ax.tick_params(labelsize=FONT["small"])
+    ax.set_title(title or f"φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°", fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 
 def _CMAP():
-    return matplotlib.colormaps["magma"].with_extremes(bad="black", under="black")
+    # zeros (masked) grey, values below the log floor black
+    return matplotlib.colormaps["magma"].with_extremes(bad="0.8", under="black")

@@ -15,6 +15,7 @@ from analysis import EnergyReport  # noqa: E402
 from analysis.sanity import edge_pairs  # noqa: E402
 from reports import report as rep  # noqa: E402
 from reports.report import sec_energy, sec_renders  # noqa: E402
+from reports.report.page import Page  # noqa: E402
 from reports_standin import Lambert, Phongish  # noqa: E402
 
 FABRICS = ["velvet", "silk_crepe_de_chine"]
@@ -203,3 +204,36 @@ def test_unwritable_output_folder(tmp_path):
         rep.build_report(["velvet"], blocker / "sub" / "rep", progress=False)
     with pytest.raises(OSError, match="is a file"):
         rep.build_report(["velvet"], blocker, progress=False)
+
+
+@pytest.mark.parametrize("quality, size", [("default", (640, 360)), ("high", (1280, 720))])
+def test_renders_size_per_quality(tmp_path, monkeypatch, quality, size):
+    """Renders are 640 x 360 by default and 1280 x 720 at --quality high; each links to
+    itself at full size."""
+    sizes = []
+
+    def render(scene, fab, width, height, spp, progress):
+        sizes.append((width, height))
+        return np.full((height, width, 3), 0.25)
+
+    monkeypatch.setattr(sec_renders, "render", render)
+    page = Page(tmp_path, "standin", Lambert(), rep.QUALITIES[quality])
+    sec = sec_renders.section_renders(page)
+    assert sizes and set(sizes) == {size}
+    for stem in ("curtain", "cylinder"):
+        src = f"standin/render_{stem}.png"
+        assert f'<a href="{src}"' in sec.html and f'<img src="{src}"' in sec.html
+    assert (tmp_path / "standin" / "render_curtain.png").stat().st_size > 0
+
+
+def test_page_is_a_grid_of_clickable_figures(built):
+    """Every figure's image sits in a link to the same file; the sections lay figures out in
+    a responsive grid (CSS grid, columns of at least 560 px or the page width)."""
+    out, index, calls = built
+    page = (out / f"{FABRICS[0]}.html").read_text(encoding="utf-8")
+    figures = page.split("<figure")[1:]
+    assert len(figures) > 5
+    for fig in figures:
+        src = fig.split('<img src="', 1)[1].split('"', 1)[0]
+        assert f'<a href="{src}"' in fig.split("<img", 1)[0]
+    assert "display:grid" in page and "minmax(min(100%,560px),1fr)" in page

@@ -168,7 +168,7 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
         Per-fabric sections, a subset of :data:`SECTIONS` (default all), in any order.
     progress : bool
         Show a tqdm bar over fabrics and sections.
-    quality : {"default", "fast"}
+    quality : {"default", "high", "fast"}
         Resolutions of plots and renders (:data:`QUALITIES`).
     fit_results : mapping of str to path, optional
         Fabric name -> ``results.json`` of a fit, shown in the "fit" section.

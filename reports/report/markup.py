@@ -15,8 +15,11 @@ __all__ = ["plain_json", "table", "fmt", "swatch", "nav", "page", "now", "not_av
 _CSS = """
 body{font-family:system-ui,sans-serif;max-width:1400px;margin:1em auto;padding:0 1em;color:#222}
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
-figure{display:inline-block;margin:.5em;vertical-align:top;max-width:100%}
-figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.85em;color:#555;max-width:900px}
+section{display:grid;grid-template-columns:repeat(auto-fill,minmax(min(100%,560px),1fr));
+gap:.4em 1.2em;align-items:start}section>:not(figure){grid-column:1/-1}
+figure{margin:0;min-width:0}
+figure a{display:block;cursor:zoom-in}figure img{width:100%;height:auto;border:1px solid #eee}
+figcaption{font-size:.85em;color:#555}
 table{border-collapse:collapse;font-size:.9em;margin:.5em 0}td,th{border:1px solid #ccc;padding:.2em .5em}
 th{background:#f4f4f4}.na{color:#a33}nav a{margin-right:1em}.swatch{display:inline-block;width:1em;
 height:1em;border:1px solid #999;vertical-align:middle;margin-right:.3em}

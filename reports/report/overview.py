@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
 from reports.plot_lobes import plot_lobe_comparison
 from reports.plot_masking import plot_masking_terms
@@ -45,7 +46,7 @@ def _lobes(p: Page, reports: list[FabricReport]) -> str:
         fig, ax = plot_lobe_comparison(fabrics, ti, phi, resolution=p.q["lobe"])
         out.append(p.figure(fig, f"lobes_ti{ti:g}_phi{phi:g}.png",
                             f"Luminance f_r (1/sr, log) of every fabric, θi = {ti:g}°, plane "
-                            f"φ = {phi:g}°; each curve in the fabric's own sRGB colour."))
+                            f"φ = {phi:g}°; each fabric in its own colour and line style."))
     return "".join(out) + "</section>"
 
 
@@ -56,15 +57,21 @@ def _albedo(p: Page, reports: list[FabricReport]) -> str:
         out.append('<p class="na">Not available: no fabric has energy results (the energy '
                    'section was not requested).</p></section>')
         return "".join(out)
-    fig, axes = new_figure(2, 1, figsize=(11.0, 4.0))
+    fig, axes = new_figure(2, 1, figsize=(11.0, 4.2))
+    styles = series_styles(have)
     for j, (ax, phi) in enumerate(zip(axes, (0.0, 90.0))):
         for name, e in have.items():
             plot_albedo(e.theta_deg, np.asarray(e.value)[:, j], np.asarray(e.error)[:, j],
-                        quantity="luminance", colour=e.colour, label=name, ax=ax,
-                        title=f"luminance albedo, wo at φ = {phi:g}°")
+                        quantity="luminance", style=styles[name], label=name, ax=ax,
+                        legend=False, title=f"luminance albedo, wo at φ = {phi:g}°")
+        ax.set_xlabel("θo (degrees)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=FONT["small"],
+               frameon=False)
     out.append(p.figure(fig, "albedo_comparison.png", "Rec. 709 luminance of the "
                         "directional albedo of every fabric, against θo, wo along the warp "
-                        "(left) and the weft (right), each in the fabric's own colour."))
+                        "(left) and the weft (right); each fabric in its own colour, line style "
+                        "and marker."))
     rows = [[n, f"{e.max:.4f}", f"{e.max_error:.1e}", f"{e.max_where[0]:g}",
              f"{e.max_where[1]:g}", e.max_where[2], "yes" if e.exceeds_one else "no"]
             for n, e in have.items()]

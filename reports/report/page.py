@@ -18,7 +18,7 @@ from reports._plotting import save_figure
 from reports.report.folder import write_file
 from reports.report.markup import plain_json
 
-__all__ = ["Page", "new_figure", "replace_3d"]
+__all__ = ["Page", "new_figure", "replace_3d", "figure_html"]
 
 
 @dataclasses.dataclass
@@ -59,14 +59,13 @@ class Page:
         return f"{self.folder}/{filename}"
 
     def figure(self, fig, filename: str, caption: str) -> str:
-        """Save ``fig`` atomically beside the page, close it, return its <figure> HTML."""
+        """Save ``fig`` atomically beside the page, close it, return its <figure> HTML (a
+        cell of the page's grid; the image links to itself at full size)."""
         try:
             save_figure(fig, self.path(filename), dpi=self.q["dpi"])
         finally:
             _close(fig)
-        return (f'<figure><img src="{html.escape(self.rel(filename))}" '
-                f'alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}'
-                f'</figcaption></figure>')
+        return figure_html(self.rel(filename), caption)
 
     def json(self, filename: str, data) -> str:
         """Write ``data`` as strict JSON beside the page, return a link to it."""
@@ -82,6 +81,20 @@ class Page:
             w.writerow([f"{v:.9g}" if isinstance(v, (float, np.floating)) else v for v in row])
         write_file(self.path(filename), buf.getvalue())
         return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
+
+
+def figure_html(src: str, caption: str) -> str:
+    """A ``<figure>`` of the grid: the image, a link to it at full size, its caption.
+
+    Examples
+    --------
+    >>> figure_html("a/b.png", "x").split("<img")[0]
+    '<figure><a href="a/b.png" title="x (click for full size)">'
+    """
+    src, text = html.escape(src), html.escape(caption)
+    return (f'<figure><a href="{src}" title="{text} (click for full size)">'
+            f'<img src="{src}" alt="{text}" loading="lazy"></a>'
+            f'<figcaption>{text}</figcaption></figure>')
 
 
 def _close(fig):

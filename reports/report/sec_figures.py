@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import eval_brdf
+from reports._plotting import FONT, eval_brdf
 from reports.colour import luminance
 from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
 from reports.plot_lobes import plane_directions, plot_lobe_3d, plot_lobe_planes
@@ -57,13 +57,17 @@ def _lobes_csv(p: Page) -> str:
 
 def section_lobes(p: Page) -> Section:
     """Polar lobes in the warp, diagonal and weft planes, linear, log and per channel."""
-    out = []
-    for scale in ("linear", "log"):
-        fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale=scale,
-                                  resolution=p.q["lobe"])
-        out.append(p.figure(fig, f"lobes_{scale}.png",
-                            f"Luminance f_r (1/sr, {scale}) in the planes φ = 0° (warp), 45° and "
-                            f"90° (weft), for θi = 0°, 30°, 60°."))
+    fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale="linear", normalize=True,
+                              resolution=p.q["lobe"])
+    out = [p.figure(fig, "lobes_linear.png",
+                    "Luminance f_r, linear, each curve divided by its own peak (the peaks, in "
+                    "1/sr, are in the legends) so that every incidence shows, in the planes "
+                    "φ = 0° (warp), 45° and 90° (weft), for θi = 0°, 30°, 60°.")]
+    fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale="log",
+                              resolution=p.q["lobe"])
+    out.append(p.figure(fig, "lobes_log.png",
+                        "Luminance f_r (1/sr, log, four decades below the peak) in the same "
+                        "planes and incidences."))
     fig, _ = plot_lobe_planes(p.fabric, (30.0, 60.0), PLANES, quantity="rgb", scale="linear",
                               resolution=p.q["lobe"])
     out.append(p.figure(fig, "lobes_rgb.png", "f_r per channel (red, green, blue curves), "
@@ -74,7 +78,7 @@ def section_lobes(p: Page) -> Section:
 
 def section_slices(p: Page) -> Section:
     """Cartesian slices against θo, θh and θd, and θh × θd images (BRDF Explorer)."""
-    fig, axes = new_figure(3, 1, figsize=(14.0, 3.8))
+    fig, axes = new_figure(3, 1, figsize=(15.0, 3.6))
     plot_slice_theta_o(p.fabric, 30.0, 180.0, 0.0, resolution=p.q["lobe"], ax=axes[0], log=True)
     plot_slice_theta_h(p.fabric, 10.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[1])
     plot_slice_theta_d(p.fabric, 0.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[2])
@@ -96,6 +100,7 @@ def _colour_and_lobe3d(p: Page) -> str:
     peak = float(np.nanmax(luminance(img))) if np.any(np.isfinite(img)) else 0.0
     exposure = float(np.log2(0.7 / peak)) if peak > 0 else 0.0
     fig, axes = new_figure(2, 1, figsize=(10.0, 4.2))
+    fig.get_layout_engine().set(w_pad=0.25)   # room the 3-D axes' layout leaves out
     plot_hemisphere(p.fabric, 45.0, 0.0, quantity="srgb", exposure=exposure,
                     resolution=p.q["hemi"], ax=axes[0],
                     title=f"f_r(wo) colour, sRGB, exposure {exposure:+.1f} stops")
@@ -114,7 +119,9 @@ def section_hemisphere(p: Page) -> Section:
     plot_hemisphere(p.fabric, 60.0, 45.0, resolution=p.q["hemi"], ax=axes[2])
     out = [p.figure(fig, "hemisphere.png", "Luminance f_r(wo) (1/sr, log colour scale) over "
                     "the viewing hemisphere, equal-area projection (+x warp, +y weft), for the "
-                    "light at θi = 45° along the warp, 45° along the weft, and 60° at φ = 45°.")]
+                    "light at θi = 45° along the warp, 45° along the weft, and 60° at φ = 45°; "
+                    "black: more than four decades below the peak; grey: f_r = 0 (where the "
+                    "colour bar says so).")]
     out.append(_colour_and_lobe3d(p))
     return Section("".join(out))
 
@@ -129,17 +136,21 @@ def section_masking(p: Page) -> Section:
     """
     if not can_unmask(p.fabric):
         raise Unavailable("this BRDF has no replace(masking=...)")
-    fig, axes = new_figure(3, 1, figsize=(13.0, 3.8), polar=True)
-    for ax, phi in zip(axes, PLANES):
-        plot_masking_lobes(p.fabric, 60.0, phi, resolution=p.q["lobe"], ax=ax)
-    out = [p.figure(fig, "masking_lobes.png", "Luminance f_r (1/sr) at θi = 60° with shadowing "
-                    "and masking on (solid, the fabric's colour) and off (dashed, grey), in the "
-                    "planes φ = 0° (warp), 45° and 90° (weft).")]
-    fig, axes = new_figure(3, 1, figsize=(13.0, 3.8), polar=True)
-    for ax, phi in zip(axes, PLANES):
-        plot_masking_lobes(p.fabric, 80.0, phi, resolution=p.q["lobe"], ax=ax, scale="log")
-    out.append(p.figure(fig, "masking_lobes_grazing.png", "The same at grazing incidence "
-                        "θi = 80°, log scale."))
+    out = []
+    for ti, scale, stem, caption in (
+            (60.0, "log", "masking_lobes.png", "Luminance f_r (1/sr, log) at θi = 60° with "
+             "shadowing and masking on (solid, blue) and off (dashed, vermilion), in the planes "
+             "φ = 0° (warp), 45° and 90° (weft)."),
+            (80.0, "log", "masking_lobes_grazing.png", "The same at grazing incidence "
+             "θi = 80°.")):
+        fig, axes = new_figure(3, 1, figsize=(12.6, 3.1), polar=True)
+        for ax, phi in zip(axes, PLANES):
+            plot_masking_lobes(p.fabric, ti, phi, resolution=p.q["lobe"], ax=ax, scale=scale,
+                               legend=False)
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=FONT["small"],
+                   frameon=False)
+        out.append(p.figure(fig, stem, caption))
     out.append('<p>The terms M, P and u themselves are drawn on the <a href="index.html#masking">'
                'overview page</a>.</p>')
     return Section("".join(out))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 import io
 from typing import Any
 
@@ -13,7 +12,7 @@ import numpy as np
 from reports.colour import luminance, to_srgb
 from reports.render import render
 from reports.report.folder import write_file
-from reports.report.page import Page
+from reports.report.page import Page, figure_html
 from reports.report.sec_figures import can_unmask
 from reports.report.settings import Section
 
@@ -74,10 +73,9 @@ def section_renders(p: Page) -> Section:
             ref = _exposure_reference(img)
         exposure = float(np.log2(0.8 / ref))
         write_file(p.path(f"render_{stem}.png"), _png(img, exposure))
-        out.append(f'<figure><img src="{html.escape(p.rel(f"render_{stem}.png"))}" '
-                   f'alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}, '
-                   f'{width} × {height}, {spp} spp, exposure {exposure:+.1f} stops (sRGB via '
-                   f'colour-science)</figcaption></figure>')
+        out.append(figure_html(p.rel(f"render_{stem}.png"),
+                               f"{caption}, {width} × {height}, {spp} spp, exposure "
+                               f"{exposure:+.1f} stops (sRGB via colour-science)"))
         stats[stem] = {"scene": scene, "masking": masking, "width": width, "height": height,
                        "spp": spp, "exposure": exposure,
                        "mean_luminance": float(luminance(img).mean())}

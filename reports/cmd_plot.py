@@ -1,0 +1,228 @@
+"""The ``plot`` verb: one figure of one view of presets, or of a measured table against models.
+
+``microcyl plot VIEW SOURCE... -o FILE``: the views are those of the report (lobes, slices,
+hemisphere, masking, albedo, reciprocity) and ``table`` (a measured table against presets and
+a fit). Several presets overlay (or sit in one row each where a view is an image). The figure
+is drawn by the plot functions of :mod:`reports.plots`; the format comes from the suffix of
+FILE (PNG at ``--dpi``, PDF and SVG as vector graphics).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+import brdf
+import gonio
+from analysis.paramnames import MODEL_PARAM_NAMES, defaults_from_fabric
+from brdf import schema
+from reports import cliutil
+
+__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "parse_planes"]
+
+#: The views of ``microcyl plot``.
+VIEWS = ("lobes", "slices", "hemisphere", "masking", "albedo", "reciprocity", "table")
+#: Default incidences per view, degrees (``table``: the table's first three in the plane).
+_THETA_I = {"lobes": (0.0, 30.0, 60.0), "slices": (30.0,), "hemisphere": (45.0,),
+            "masking": (60.0,), "albedo": (), "reciprocity": (), "table": ()}
+_FORMATS = (".png", ".pdf", ".svg")
+_PLANES = {"warp": 0.0, "weft": 90.0, "diagonal": 45.0}
+
+
+def register(sub):
+    """Add ``plot`` to the ``microcyl`` sub-parsers."""
+    p = sub.add_parser(
+        "plot", help="draw one view of presets or a measured table (PNG, PDF, SVG)",
+        description="Draw one figure: VIEW of the presets SOURCE... (several overlay), or for "
+                    "'table' a measured table (SOURCE) against presets (further SOURCEs, "
+                    "--preset) and a fit (--fit DIR). The format comes from the suffix of FILE.")
+    p.add_argument("view", choices=VIEWS, metavar="VIEW", help=", ".join(VIEWS))
+    p.add_argument("sources", nargs="+", metavar="FABRIC|TABLE",
+                   help="preset names; for 'table' a table file first")
+    p.add_argument("-o", "--output", required=True, metavar="FILE",
+                   help="output file: .png, .pdf or .svg")
+    p.add_argument("--dpi", type=int, default=200, help="PNG resolution (default 200)")
+    p.add_argument("--size", type=_size, default=None, metavar="W,H",
+                   help="figure size in inches (default: from the panels)")
+    p.add_argument("--channel", choices=("luminance", "r", "g", "b", "rgb"), default=None,
+                   help="what of f_r is drawn (default luminance; rgb for one fabric's slices)")
+    p.add_argument("--theta-i", type=_angles, default=None, metavar="DEG[,DEG...]",
+                   help="incidence angles in degrees, e.g. 30,60")
+    p.add_argument("--plane", type=parse_planes, default=None, metavar="warp|weft|45|DEG",
+                   help="planes of incidence: warp, weft, diagonal or azimuths in degrees, "
+                        "comma-separated (default warp,45,weft for lobes, else warp)")
+    p.add_argument("--scale", choices=("log", "linear", "normalized"), default="log",
+                   help="lobes' radial scale; normalized: linear, each curve / its peak")
+    p.add_argument("--resolution", type=int, default=None, metavar="N",
+                   help="samples per curve or image side (default: the view's)")
+    p.add_argument("--fit", default=None, metavar="DIR",
+                   help="table: a fit's folder (or its results.json) drawn as a model")
+    p.add_argument("--preset", action="append", default=None, metavar="NAME",
+                   help="table: a preset drawn as a model (repeatable); also the fitted preset "
+                        "when the fit does not say")
+    cliutil.add_fabric_options(p)
+    p.set_defaults(func=run_plot)
+
+
+def _size(text: str) -> tuple[float, float]:
+    try:
+        w, h = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected W,H in inches, got {text!r}") from None
+    if not (0.5 <= w <= 50 and 0.5 <= h <= 50):
+        raise argparse.ArgumentTypeError(f"W and H must be in [0.5, 50] inches, got {text!r}")
+    return w, h
+
+
+def _angles(text: str) -> tuple[float, ...]:
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected degrees such as 30,60, got {text!r}") \
+            from None
+    if not all(math.isfinite(v) and 0.0 <= v < 90.0 for v in vals):
+        raise argparse.ArgumentTypeError(f"angles must be in [0, 90) degrees, got {text!r}")
+    return vals
+
+
+def parse_planes(text: str) -> tuple[float, ...]:
+    """Planes of incidence: ``warp``, ``weft``, ``diagonal`` or azimuths in degrees.
+
+    Examples
+    --------
+    >>> parse_planes("warp,45,weft")
+    (0.0, 45.0, 90.0)
+    """
+    out = []
+    for item in text.split(","):
+        item = item.strip().lower()
+        try:
+            out.append(_PLANES[item] if item in _PLANES else float(item))
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"expected warp, weft, diagonal or degrees, got {item!r}") from None
+        if not (math.isfinite(out[-1]) and -360.0 <= out[-1] <= 360.0):
+            raise argparse.ArgumentTypeError(f"plane must be in [-360, 360] degrees, "
+                                             f"got {item!r}")
+    return tuple(out)
+
+
+def _check(args) -> None:
+    """Every option checked before any work."""
+    suffix = Path(args.output).suffix.lower()
+    if suffix not in _FORMATS:
+        raise ValueError(f"-o must end in .png, .pdf or .svg; got {args.output!r}")
+    if not 10 <= args.dpi <= 1200:
+        raise ValueError(f"--dpi must be in [10, 1200]; got {args.dpi}")
+    if args.resolution is not None and not 3 <= args.resolution <= 2000:
+        raise ValueError(f"--resolution must be in [3, 2000]; got {args.resolution}")
+    names = args.sources[1:] if args.view == "table" else args.sources
+    for name in list(names) + list(args.preset or ()):
+        if name not in brdf.PRESETS:
+            raise ValueError(f"unknown fabric {name!r}; valid presets are "
+                             f"{', '.join(brdf.PRESETS)}")
+    if len(set(names)) != len(names):
+        raise ValueError(f"a fabric is given twice: {', '.join(names)}")
+    if args.view == "table" and not Path(args.sources[0]).is_file():
+        raise ValueError(f"table: no such file {args.sources[0]!r}")
+    if args.view != "table" and (args.fit or args.preset):
+        raise ValueError("--fit and --preset apply to the 'table' view only")
+    if args.view == "table" and not (args.sources[1:] or args.preset or args.fit):
+        raise ValueError("table: give a preset (SOURCE or --preset) or --fit DIR to compare "
+                         "the table with")
+    if args.view == "table" and args.channel == "rgb":
+        raise ValueError("--channel for 'table' must be luminance, r, g or b; got 'rgb'")
+    out = Path(args.output).resolve().parent
+    if not out.is_dir():
+        raise ValueError(f"-o: no such folder {str(out)!r}")
+
+
+def _check_incidences(table, args) -> None:
+    from reports.plot_fit import plane_incidences   # matplotlib: loaded by run_plot already
+
+    phi = (args.plane or (0.0,))[0]
+    have = plane_incidences(table, phi)
+    for t in args.theta_i or ():
+        if not np.any(np.abs(have - t) <= 0.5):
+            raise ValueError(f"--theta-i must be among the table's incidences in the plane "
+                             f"{phi:g} degrees ({', '.join(f'{h:g}' for h in have)}); "
+                             f"got {t:g}")
+
+
+def fitted_fabric(fit, preset=None) -> tuple[brdf.Fabric, str]:
+    """The fabric of a fit's posterior medians, and its preset.
+
+    Parameters
+    ----------
+    fit : path
+        A fit's folder (``results.json``, ``fit_config.json``) or its ``results.json``.
+    preset : str, optional
+        The preset that was fitted; by default the one ``fit_config.json`` names.
+
+    Returns
+    -------
+    (brdf.Fabric, str)
+        The preset with every fitted parameter at its median (ties applied: ``equal`` or
+        ``complement``), and the preset's name.
+
+    Raises
+    ------
+    ValueError
+        When the results cannot be read or the preset is not known, naming the file.
+    """
+    from analysis.fit.results import read_results   # reads JSON only
+
+    path = Path(fit)
+    results = path / "results.json" if path.is_dir() else path
+    doc = read_results(results)
+    if preset is None:
+        try:
+            cfg = json.loads((results.parent / "fit_config.json").read_text("utf-8"))
+            preset = cfg["config"]["extra"]["preset"]
+        except (OSError, ValueError, KeyError, TypeError):
+            raise ValueError(f"--fit {str(fit)!r}: cannot tell which preset was fitted "
+                             f"(no fit_config.json naming it); give --preset NAME") from None
+    base = brdf.fabric(preset)
+    values = defaults_from_fabric(base)
+    values.update({k: float(v["median"]) for k, v in doc["parameters"].items()
+                   if k in values})
+    for target, (source, kind) in doc.get("fit", {}).get("ties", {}).items():
+        if target in MODEL_PARAM_NAMES and source in values:
+            values[target] = values[source] if kind == "equal" else 1.0 - values[source]
+    threads = tuple(
+        th.replace(**{q: values[f"{q}{j}"] for q in schema.SCALAR_PARAMS},
+                   albedo=tuple(values[f"albedo{j}_{c}"] for c in schema.RGB_CHANNELS))
+        for j, th in enumerate(base.threads, start=1))
+    return base.replace(threads=threads), preset
+
+
+def run_plot(args):
+    _check(args)
+    # lazy: matplotlib and colour-science (~2 s), which `microcyl --help` and the other
+    # verbs skip
+    from reports import plot_views
+    from reports._plotting import save_figure
+
+    opts = dict(channel=args.channel, theta_i=args.theta_i, planes=args.plane,
+                scale=args.scale, resolution=args.resolution)
+    if args.view == "table":
+        models = {n: cliutil.fabric_from_args(n, args)
+                  for n in dict.fromkeys(list(args.sources[1:]) + list(args.preset or ()))}
+        if args.fit:
+            fab, name = fitted_fabric(args.fit, (args.preset or [None])[0])
+            models[f"fit ({name})"] = fab
+        table = gonio.read(args.sources[0])
+        _check_incidences(table, args)
+        fig = plot_views.table_view(table, models, **opts)
+    else:
+        fabrics = {n: cliutil.fabric_from_args(n, args) for n in args.sources}
+        fig = plot_views.VIEW_FUNCTIONS[args.view](fabrics, **opts)
+    if args.size is not None:
+        fig.set_size_inches(*args.size)
+    path = save_figure(fig, args.output, dpi=args.dpi)
+    print(f"wrote {path} ({args.view}, {len(fig.axes)} axes)")
+    return 0

@@ -1,0 +1,256 @@
+"""Tests of ``microcyl plot`` (reports.cmd_plot) and its figures (reports.plot_views).
+
+End to end: one subprocess per view, as a user runs it, the format chosen by the suffix.
+Layout: every view's figure, drawn, has no two texts overlapping and none outside the figure
+(window extents of the drawn text artists, computed here from matplotlib's own artists).
+"""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from PIL import Image  # noqa: E402
+
+import brdf  # noqa: E402
+from gonio import Table  # noqa: E402
+from reports import plot_views, plots  # noqa: E402
+from reports.cli import main  # noqa: E402
+from reports.cmd_plot import fitted_fabric  # noqa: E402
+from reports.report import overview, sec_figures  # noqa: E402
+from reports.report.page import Page  # noqa: E402
+from reports.report.sec_energy import EnergyData  # noqa: E402
+from reports.report.sections import FabricReport, SectionRun  # noqa: E402
+from reports.report.settings import QUALITIES, Section  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+MAGIC = {".png": b"\x89PNG\r\n\x1a\n", ".pdf": b"%PDF", ".svg": b"<?xml"}
+
+
+def microcyl(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "reports", *map(str, args)], cwd=cwd or REPO,
+                          env=dict(os.environ, PYTHONPATH=str(REPO)), capture_output=True,
+                          text=True, timeout=300)
+
+
+def fake_fit(folder: Path, preset="linen_plain") -> Path:
+    """A fit's folder as ``microcyl fit`` leaves it: kd1 and gamma_s1 fitted, kd2 tied."""
+    folder.mkdir()
+    doc = {"schema": "microcyl-fit", "schema_version": 2, "converged": True, "reason": "",
+           "parameters": {"kd1": {"median": 0.05}, "gamma_s1": {"median": 20.0}},
+           "fit": {"ties": {"kd2": ["kd1", "equal"], "area2": ["area1", "complement"]}},
+           "quality": {}, "plots": {}}
+    (folder / "results.json").write_text(json.dumps(doc))
+    (folder / "fit_config.json").write_text(json.dumps({"config": {"extra": {"preset": preset}}}))
+    return folder
+
+
+def test_fitted_fabric_takes_medians_and_ties(tmp_path):
+    fab, name = fitted_fabric(fake_fit(tmp_path / "fit"))
+    base = brdf.fabric("linen_plain")
+    t1, t2 = fab.threads
+    assert name == "linen_plain"
+    assert t1.kd == 0.05 and t2.kd == 0.05 and t1.gamma_s == 20.0
+    assert t2.gamma_s == base.threads[1].gamma_s          # not fitted, not tied
+    assert t2.area == pytest.approx(1.0 - base.threads[0].area)
+    assert not np.allclose(fab.eval(np.array([0, 0, 1.0]), np.array([0.5, 0, 0.866])),
+                           base.eval(np.array([0, 0, 1.0]), np.array([0.5, 0, 0.866])))
+
+
+# One case a view: arguments after the view, output suffix, what the figure must hold.
+CASES = {
+    "lobes": (["velvet", "--theta-i", "30,60", "--plane", "warp,45", "--dpi", "120"], ".png"),
+    "slices": (["velvet", "linen_plain", "--channel", "g", "--plane", "weft"], ".svg"),
+    "hemisphere": (["silk_shot", "--theta-i", "60", "--plane", "45", "--size", "5,4"], ".pdf"),
+    "masking": (["velvet", "--theta-i", "70", "--plane", "warp,weft", "--scale", "linear"],
+                ".png"),
+    "albedo": (["polyester_satin_charmeuse", "polyester_satin_charmeuse_back", "--channel",
+                "b", "--plane", "30"], ".png"),
+    "reciprocity": (["velvet", "--plane", "warp"], ".pdf"),
+}
+
+
+@pytest.mark.parametrize("view", sorted(CASES))
+def test_plot_view_end_to_end(tmp_path, view):
+    args, suffix = CASES[view]
+    out = tmp_path / f"figure{suffix}"
+    p = microcyl("plot", view, *args, "--resolution", 9 if view != "albedo" else 4, "-o", out)
+    assert p.returncode == 0, p.stderr
+    assert out.read_bytes()[:len(MAGIC[suffix])] == MAGIC[suffix]
+    assert f"wrote {out}" in p.stdout and view in p.stdout
+    assert [f.name for f in tmp_path.iterdir()] == [out.name]     # no temporary file left
+    if suffix == ".png":
+        dpi = Image.open(out).info["dpi"]
+        assert dpi[0] == pytest.approx(120 if "--dpi" in args else 200, abs=1)
+    if suffix == ".pdf":
+        assert b"/Type /Page" in out.read_bytes()
+    if suffix == ".svg":                     # curves as vector paths
+        assert out.read_text().count("<path") > 10
+
+
+def test_plot_table_against_preset_and_fit(tmp_path, shared_data):
+    out = tmp_path / "table.png"
+    bsdf = shared_data / "rgl" / "acrylic_felt_purple_rgb.bsdf"
+    fit = fake_fit(tmp_path / "fit")
+    p = microcyl("plot", "table", bsdf, "velvet", "--fit", fit, "--theta-i", "0,40",
+                 "--channel", "r", "--resolution", 19, "-o", out)
+    assert p.returncode == 0, p.stderr
+    assert out.read_bytes()[:8] == MAGIC[".png"] and Image.open(out).info["dpi"][0] == \
+        pytest.approx(200, abs=1)
+    assert "wrote" in p.stdout and "table, 2 axes" in p.stdout
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["lobes", "velvet", "-o", "x.jpg"], "-o must end in .png, .pdf or .svg"),
+    (["lobes", "denim", "-o", "x.png"], "unknown fabric 'denim'"),
+    (["lobes", "velvet", "--plane", "up", "-o", "x.png"], "--plane: expected warp, weft"),
+    (["lobes", "velvet", "--theta-i", "95", "-o", "x.png"], "--theta-i: angles must be in"),
+    (["table", "velvet", "-o", "x.png"], "table: no such file 'velvet'"),
+    (["lobes", "velvet", "--fit", "fit", "-o", "x.png"], "--fit and --preset apply to"),
+    (["lobes", "velvet", "--dpi", "0", "-o", "x.png"], "--dpi must be in"),
+])
+def test_plot_errors_are_one_line(tmp_path, monkeypatch, capsys, argv, message):
+    monkeypatch.chdir(tmp_path)
+    try:
+        status = main(["plot", *argv])
+    except SystemExit as exc:                 # usage errors: argparse's exit status 2
+        status = exc.code
+    err = capsys.readouterr().err
+    assert status != 0 and message in err
+    assert len(err.strip().splitlines()) == 1 and list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------------------------
+# Layout: no text overlaps another or leaves the figure.
+
+def _drawn_texts(fig):
+    """The text artists a draw of ``fig`` shows: figure texts and legends, and per axes its
+    titles, axis labels, annotations, legend and the tick labels of the ticks in view."""
+    texts = list(fig.texts) + [t for leg in fig.legends for t in leg.get_texts()]
+    for ax in fig.axes:
+        texts += [getattr(ax, n) for n in ("title", "_left_title", "_right_title")]
+        axes = [ax.xaxis, ax.yaxis] + ([ax.zaxis] if hasattr(ax, "zaxis") else [])
+        for axis in axes:
+            texts.append(axis.label)
+            for tick in axis._update_ticks():
+                texts += [tick.label1, tick.label2]
+        texts += list(ax.texts)
+        if ax.get_legend() is not None:
+            texts += ax.get_legend().get_texts()
+    unique = {id(t): t for t in texts}                     # an artist listed twice is one
+    return [t for t in unique.values() if t.get_visible() and t.get_text().strip()]
+
+
+def assert_no_overlap(fig):
+    FigureCanvasAgg(fig)
+    fig.canvas.draw()               # the layout settles, and with it the ticks in view
+    texts = _drawn_texts(fig)
+    fig.canvas.draw()               # every label where a draw puts it (3-D tick labels)
+    renderer = fig.canvas.get_renderer()
+    boxes = [(t.get_text(), t.get_window_extent(renderer).expanded(1.0, 1.0)) for t in texts]
+    frame = fig.bbox
+    for text, b in boxes:
+        assert frame.x0 - 1 <= b.x0 and b.x1 <= frame.x1 + 1 and frame.y0 - 1 <= b.y0 \
+            and b.y1 <= frame.y1 + 1, f"{text!r} extends outside the figure: {b} vs {frame}"
+    for i, (ta, a) in enumerate(boxes):
+        for tb, b in boxes[i + 1:]:
+            ox = min(a.x1, b.x1) - max(a.x0, b.x0)
+            oy = min(a.y1, b.y1) - max(a.y0, b.y0)
+            assert ox <= 1.0 or oy <= 1.0, f"{ta!r} overlaps {tb!r}: {a} and {b}"
+    assert len(boxes) > 5                                # the check saw the figure's text
+
+
+SMALL = dict(resolution=13)
+THREE = {n: brdf.fabric(n) for n in ("polyester_satin_charmeuse",
+                                     "polyester_satin_charmeuse_back", "velvet")}
+TWO = {n: THREE[n] for n in ("polyester_satin_charmeuse", "polyester_satin_charmeuse_back")}
+VELVET = {"velvet": THREE["velvet"]}
+
+
+@pytest.mark.parametrize("view, fabrics, opts", [
+    ("lobes", VELVET, dict(scale="log")),
+    ("lobes", VELVET, dict(scale="normalized")),
+    ("lobes", THREE, dict(theta_i=(30.0, 60.0), planes=(0.0, 90.0))),
+    ("slices", VELVET, {}),
+    ("slices", THREE, dict(channel="luminance")),
+    ("hemisphere", TWO, dict(theta_i=(45.0, 75.0))),
+    ("masking", TWO, dict(planes=(0.0, 45.0, 90.0))),
+    ("albedo", TWO, dict(planes=(0.0, 90.0), resolution=3)),
+    ("reciprocity", VELVET, dict(planes=(0.0, 90.0))),
+], ids=lambda v: v if isinstance(v, str) else "")
+def test_view_text_does_not_overlap(view, fabrics, opts):
+    kw = {**SMALL, **opts}
+    assert_no_overlap(plot_views.VIEW_FUNCTIONS[view](fabrics, **kw))
+
+
+def test_table_view_text_does_not_overlap():
+    rng = np.random.default_rng(1)
+    ti, to = np.meshgrid([0.0, 40.0], np.linspace(-80, 80, 17), indexing="ij")
+    ti, to = ti.ravel(), to.ravel()
+    def sph(t, p):
+        return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
+
+    wi = sph(np.radians(ti), np.full(ti.shape, np.pi))
+    wo = sph(np.radians(np.abs(to)), np.where(to >= 0, 0.0, np.pi))
+    values = 0.1 + 0.01 * rng.random((ti.size, 3))
+    values[:3] = 0.0                                         # measured zeros, on a log axis
+    table = Table(wi, wo, values, meta={"source": "synthetic"})
+    fig = plot_views.table_view(table, {"linen_plain": brdf.fabric("linen_plain"),
+                                        "fit (linen_plain)": brdf.fabric("silk_shot")},
+                                resolution=13)
+    assert_no_overlap(fig)
+    with pytest.raises(ValueError, match=r"theta_i must be one of the table's incidences.*"
+                                         r"\(0, 40\); got 31"):
+        plot_views.table_view(table, {"linen_plain": brdf.fabric("linen_plain")},
+                              theta_i=(31.0,))
+
+
+class CapturePage(Page):
+    """A report page that keeps its figures instead of saving them."""
+
+    def figure(self, fig, filename, caption):
+        self.figures[filename] = fig
+        return ""
+
+    def csv(self, filename, header, rows):
+        return ""
+
+
+@pytest.mark.parametrize("builder", [sec_figures.section_lobes, sec_figures.section_slices,
+                                     sec_figures.section_hemisphere,
+                                     sec_figures.section_masking],
+                         ids=lambda b: b.__name__)
+def test_report_figures_text_does_not_overlap(tmp_path, builder):
+    """Every figure of the report's figure sections, as the report draws it."""
+    page = CapturePage(tmp_path, "velvet", THREE["velvet"], QUALITIES["fast"], "velvet")
+    page.figures = {}
+    builder(page)
+    assert page.figures
+    for name, fig in page.figures.items():
+        assert_no_overlap(fig)
+
+
+def test_overview_figures_text_does_not_overlap(tmp_path):
+    page = CapturePage(tmp_path, "overview", None, QUALITIES["fast"])
+    page.figures = {}
+    overview._masking(page)
+    theta = np.array([0.0, 45.0, 85.0])
+    value = np.full((3, 2, 3), 0.3)
+    reports = []
+    for name in THREE:
+        rep = FabricReport(name, THREE[name])
+        data = EnergyData(theta, np.array([0.0, 90.0]), value, value * 0.01, 0.0, (0.5, 0.5, 0.5))
+        rep.runs.append(SectionRun("energy", "ok", 0.0, Section("", data)))
+        reports.append(rep)
+    overview._albedo(page, reports)
+    overview._lobes(page, reports)
+    for fig in page.figures.values():
+        assert_no_overlap(fig)

@@ -10,7 +10,6 @@ FILE (PNG at ``--dpi``, PDF and SVG as vector graphics).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from pathlib import Path
 
@@ -18,8 +17,7 @@ import numpy as np
 
 import brdf
 import gonio
-from analysis.paramnames import MODEL_PARAM_NAMES, defaults_from_fabric
-from brdf import schema
+from analysis.fit.medians import median_fabric
 from reports import cliutil
 
 __all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "parse_planes"]
@@ -154,50 +152,15 @@ def _check_incidences(table, args) -> None:
 
 
 def fitted_fabric(fit, preset=None) -> tuple[brdf.Fabric, str]:
-    """The fabric of a fit's posterior medians, and its preset.
-
-    Parameters
-    ----------
-    fit : path
-        A fit's folder (``results.json``, ``fit_config.json``) or its ``results.json``.
-    preset : str, optional
-        The preset that was fitted; by default the one ``fit_config.json`` names.
-
-    Returns
-    -------
-    (brdf.Fabric, str)
-        The preset with every fitted parameter at its median (ties applied: ``equal`` or
-        ``complement``), and the preset's name.
-
-    Raises
-    ------
-    ValueError
-        When the results cannot be read or the preset is not known, naming the file.
-    """
-    from analysis.fit.results import read_results   # reads JSON only
-
+    """The fabric of a fit's posterior medians and its preset
+    (:func:`analysis.fit.median_fabric`); ``fit`` is a fit's folder or its ``results.json``,
+    ``preset`` names the preset where ``fit_config.json`` does not."""
     path = Path(fit)
-    results = path / "results.json" if path.is_dir() else path
-    doc = read_results(results)
-    if preset is None:
-        try:
-            cfg = json.loads((results.parent / "fit_config.json").read_text("utf-8"))
-            preset = cfg["config"]["extra"]["preset"]
-        except (OSError, ValueError, KeyError, TypeError):
-            raise ValueError(f"--fit {str(fit)!r}: cannot tell which preset was fitted "
-                             f"(no fit_config.json naming it); give --preset NAME") from None
-    base = brdf.fabric(preset)
-    values = defaults_from_fabric(base)
-    values.update({k: float(v["median"]) for k, v in doc["parameters"].items()
-                   if k in values})
-    for target, (source, kind) in doc.get("fit", {}).get("ties", {}).items():
-        if target in MODEL_PARAM_NAMES and source in values:
-            values[target] = values[source] if kind == "equal" else 1.0 - values[source]
-    threads = tuple(
-        th.replace(**{q: values[f"{q}{j}"] for q in schema.SCALAR_PARAMS},
-                   albedo=tuple(values[f"albedo{j}_{c}"] for c in schema.RGB_CHANNELS))
-        for j, th in enumerate(base.threads, start=1))
-    return base.replace(threads=threads), preset
+    try:
+        m = median_fabric(path if path.is_dir() else path.parent, preset=preset)
+    except ValueError as exc:
+        raise ValueError(f"--fit {str(fit)!r}: {exc}") from None
+    return m.fabric, m.preset
 
 
 def run_plot(args):

@@ -42,14 +42,21 @@ def microcyl(*args, cwd=None):
 
 
 def fake_fit(folder: Path, preset="linen_plain") -> Path:
-    """A fit's folder as ``microcyl fit`` leaves it: kd1 and gamma_s1 fitted, kd2 tied."""
+    """A fit's folder as ``microcyl fit`` leaves it: kd1, gamma_s1, area1 fitted, kd2 and
+    area2 tied (its
+    configuration holds the spec's description, as the fit writes it)."""
+    from analysis.params import ParamSpec, defaults_from_fabric
     folder.mkdir()
+    spec = ParamSpec(["kd1", "gamma_s1", "area1"], defaults=defaults_from_fabric(brdf.fabric(preset)),
+                     ties=["kd2=kd1", "area2=1-area1"])
     doc = {"schema": "microcyl-fit", "schema_version": 2, "converged": True, "reason": "",
-           "parameters": {"kd1": {"median": 0.05}, "gamma_s1": {"median": 20.0}},
+           "parameters": {"kd1": {"median": 0.05}, "gamma_s1": {"median": 20.0},
+                          "area1": {"median": 0.4}},
            "fit": {"ties": {"kd2": ["kd1", "equal"], "area2": ["area1", "complement"]}},
            "quality": {}, "plots": {}}
     (folder / "results.json").write_text(json.dumps(doc))
-    (folder / "fit_config.json").write_text(json.dumps({"config": {"extra": {"preset": preset}}}))
+    (folder / "fit_config.json").write_text(json.dumps(
+        {"config": {"spec": spec.describe(), "extra": {"fabric": preset, "options": {}}}}))
     return folder
 
 
@@ -60,7 +67,7 @@ def test_fitted_fabric_takes_medians_and_ties(tmp_path):
     assert name == "linen_plain"
     assert t1.kd == 0.05 and t2.kd == 0.05 and t1.gamma_s == 20.0
     assert t2.gamma_s == base.threads[1].gamma_s          # not fitted, not tied
-    assert t2.area == pytest.approx(1.0 - base.threads[0].area)
+    assert t1.area == 0.4 and t2.area == pytest.approx(0.6)       # area2 = 1 - area1
     assert not np.allclose(fab.eval(np.array([0, 0, 1.0]), np.array([0.5, 0, 0.866])),
                            base.eval(np.array([0, 0, 1.0]), np.array([0.5, 0, 0.866])))
 

@@ -54,8 +54,9 @@ def _config(folder: Path) -> dict:
         doc = json.loads(path.read_text(encoding="utf-8"))
         cfg = doc["config"]
         spec = cfg["spec"]
-        extra = cfg["extra"]
-        return {"preset": extra["fabric"], "options": dict(extra.get("options") or {}),
+        extra = cfg["extra"]       # `microcyl fit` and fit-batch: fabric; fit-measured: preset
+        return {"preset": extra.get("fabric", extra.get("preset")),
+                "options": dict(extra.get("options") or {}),
                 "params": spec["params"], "ties": spec.get("ties", {}),
                 "free": tuple(spec["free"])}
     except OSError as exc:
@@ -66,13 +67,15 @@ def _config(folder: Path) -> dict:
                          f"{exc})") from None
 
 
-def median_fabric(fit_dir) -> MedianFabric:
+def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
     """The fabric at the posterior medians of the fit in ``fit_dir``.
 
     Parameters
     ----------
     fit_dir : path
         A ``microcyl fit`` output folder (``results.json`` and ``fit_config.json``).
+    preset : str, optional
+        The preset that was fitted, when ``fit_config.json`` does not name it.
 
     Returns
     -------
@@ -87,6 +90,11 @@ def median_fabric(fit_dir) -> MedianFabric:
     folder = Path(fit_dir)
     results = read_results(folder / "results.json")
     cfg = _config(folder)
+    if preset is not None:
+        cfg["preset"] = preset
+    if cfg["preset"] not in brdf.PRESETS:
+        raise ValueError(f"{folder / CONFIG_FILE}: cannot tell which preset was fitted "
+                         f"({cfg['preset']!r}); name it")
     medians = results.get("parameters", {})
     values = {name: float(p["default"]) for name, p in cfg["params"].items()}
     missing = [n for n in cfg["free"] if n not in medians]

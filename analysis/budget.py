@@ -15,6 +15,8 @@ import math
 import os
 import re
 
+from gonio import geomspec
+
 __all__ = ["available_memory", "memory_limit", "check_memory", "format_bytes",
            "format_seconds", "spec_pairs", "MEASURE_BYTES_PER_PAIR", "RGL_BYTES_PER_PAIR",
            "FIT_BYTES_PER_VALUE"]
@@ -116,45 +118,22 @@ def check_memory(what: str, nbytes: float, change: str) -> None:
                          f"limit is {format_bytes(limit)} ({how}); {change}")
 
 
-def _n(step: float, stop: float) -> float:
-    return float(math.ceil(stop / step - 1e-9))
-
-
-def _count(x: float) -> int | float:
-    """An exact int while it is one, else the float (inf past the float range)."""
-    return int(x) if x < 1e18 else x
-
-
 def spec_pairs(spec: str) -> int | float | None:
     """Number of direction pairs a geometry spec (``full:10``, ``rus:5``, ``merl:2``) makes,
-    counted without building it; None when the spec is another kind or malformed (then
-    :func:`gonio.from_spec` gives the error), or small by construction (``plane``, ``pairs``).
+    counted without building it (:func:`gonio.geomspec.spec_pairs`, the same parser as
+    :func:`gonio.from_spec`); a float (inf past the float range) from 10^18 on; None when the
+    spec is malformed (then :func:`gonio.from_spec` gives the error) or small by construction
+    (``plane``, ``pairs``).
 
     Examples
     --------
     >>> spec_pairs("full:45:90"), spec_pairs("full:0.5"), spec_pairs("plane:warp:5")
     (25, 16610312161, None)
     """
-    kind, _, rest = str(spec).strip().partition(":")
     try:
-        v = [float(a) for a in rest.split(":")] if rest else []
+        n = geomspec.spec_pairs(spec)
     except ValueError:
         return None
-    if not all(math.isfinite(x) and x > 0 for x in v):
-        return None
-    kind = kind.lower()
-    if kind == "full" and len(v) in (1, 2, 4):
-        ti, pi = v[0], v[1] if len(v) > 1 else v[0]
-        to, po = (v[2], v[3]) if len(v) == 4 else (ti, pi)
-        if max(ti, to) > 90 or max(pi, po) > 360:
-            return None
-        side_i = 1 + (_n(ti, 90.0) - 1) * _n(pi, 360.0)
-        side_o = 1 + (_n(to, 90.0) - 1) * _n(po, 360.0)
-        return _count(side_i * side_o)
-    if kind in ("rusinkiewicz", "rus") and len(v) in (1, 4):
-        th, ph, td, pd = v * 4 if len(v) == 1 else v
-        return _count(_n(th, 90.0) * _n(ph, 360.0) * _n(td, 90.0) * _n(pd, 360.0))
-    if kind == "merl" and len(v) <= 1:
-        s = v[0] if v else 1.0
-        return _count(_n(s, 90.0) ** 2 * _n(s, 180.0))
-    return None
+    if n is None or n < 10**18:
+        return n
+    return float(n) if n < 10**300 else math.inf

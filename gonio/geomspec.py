@@ -9,10 +9,11 @@ from pathlib import Path
 from gonio.csvtable import ANGLES, parse_columns, read_rows
 from gonio.errors import FormatError
 from gonio.geometry import SPEC_HELP, Geometry
-from gonio.layouts import PLANE_AZIMUTHS, full_grid, merl, pairs_from_angles, plane, rusinkiewicz
+from gonio.layouts import (PLANE_AZIMUTHS, full_grid, full_grid_pairs, merl, merl_pairs,
+                           pairs_from_angles, plane, rusinkiewicz, rusinkiewicz_pairs)
 from gonio.numtext import NUMBER_FORM, parse_number
 
-__all__ = ["from_spec", "read_pairs_csv", "SPEC_HELP"]
+__all__ = ["from_spec", "spec_pairs", "read_pairs_csv", "SPEC_HELP"]
 
 _AZIMUTH = re.compile(r"[-+]?[0-9]+(\.[0-9]*)?")
 
@@ -47,20 +48,12 @@ def read_pairs_csv(path) -> Geometry:
     return pairs_from_angles(*a.T, degrees=True, params={"file": str(path)})
 
 
-def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
-    """Build a geometry from a compact string; see :meth:`Geometry.from_spec`.
-
-    Examples
-    --------
-    >>> from_spec("full:30").spec
-    'full:30:30:30:30'
-    >>> from_spec("plane:45:45:0").spec
-    'plane:45:45:0'
-    """
+def _parse(spec: str):
+    """``(kind, args, kwargs)`` of a spec string, checked: what :func:`from_spec` builds
+    and :func:`spec_pairs` counts. ValueError naming the spec when it is malformed."""
     if not isinstance(spec, str) or not spec.strip():
         raise ValueError(f"geometry spec must be a non-empty string; got {spec!r}; use {SPEC_HELP}")
-    s = spec.strip()
-    kind, _, rest = s.partition(":")
+    kind, _, rest = spec.strip().partition(":")
     kind = kind.lower()
     args = rest.split(":") if rest else []
 
@@ -73,47 +66,86 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
         except ValueError:
             raise bad(f"{what} {x!r} is not a number ({NUMBER_FORM})") from None
 
+    if kind == "full":
+        if len(args) not in (1, 2, 4):
+            raise bad("full takes 1, 2 or 4 steps")
+        v = [num(a, "step") for a in args]
+        kw = {"theta_o_step": v[2], "phi_o_step": v[3]} if len(v) == 4 else {}
+        return "full", tuple(v[:2]), kw
+    if kind == "plane":
+        if len(args) not in (2, 3):
+            raise bad("plane takes WHICH:STEP[:THETA_I,...]")
+        which = args[0].lower()
+        if which not in PLANE_AZIMUTHS and not _AZIMUTH.fullmatch(which):
+            raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
+        ti = ([[num(t, "theta_i") for t in args[2].split(",") if t.strip()]]
+              if len(args) == 3 else [])
+        return "plane", (which, num(args[1], "step"), *ti), {}
+    if kind in ("rusinkiewicz", "rus"):
+        if len(args) not in (1, 4):
+            raise bad("rusinkiewicz takes 1 or 4 steps")
+        return "rusinkiewicz", tuple(num(a, "step") for a in args), {}
+    if kind == "merl":
+        if len(args) > 1:
+            raise bad("merl takes at most a stride")
+        if args and not re.fullmatch(r"[0-9]+", args[0]):
+            raise bad(f"stride {args[0]!r} is not a positive integer")
+        return "merl", tuple(int(a) for a in args), {}
+    if kind == "pairs":
+        if not rest:
+            raise bad("pairs needs a file name")
+        return "pairs", (rest,), {}
+    raise bad(f"unknown kind {kind!r}")
+
+
+def _checked(spec, make):
+    """``make()``, its ValueErrors naming the spec (once)."""
     try:
-        if kind == "full":
-            if len(args) not in (1, 2, 4):
-                raise bad("full takes 1, 2 or 4 steps")
-            v = [num(a, "step") for a in args]
-            if len(v) == 1:
-                return full_grid(v[0], rotation=rotation)
-            if len(v) == 2:
-                return full_grid(v[0], v[1], rotation=rotation)
-            return full_grid(v[0], v[1], theta_o_step=v[2], phi_o_step=v[3], rotation=rotation)
-        if kind == "plane":
-            if len(args) not in (2, 3):
-                raise bad("plane takes WHICH:STEP[:THETA_I,...]")
-            which = args[0].lower()
-            if which not in PLANE_AZIMUTHS and not _AZIMUTH.fullmatch(which):
-                raise bad(f"plane {args[0]!r} is not warp, weft, 45 or an azimuth in degrees")
-            step = num(args[1], "step")
-            if len(args) == 3:
-                ti = [num(t, "theta_i") for t in args[2].split(",") if t.strip()]
-                return plane(which, step, ti, rotation=rotation)
-            return plane(which, step, rotation=rotation)
-        if kind in ("rusinkiewicz", "rus"):
-            if len(args) not in (1, 4):
-                raise bad("rusinkiewicz takes 1 or 4 steps")
-            v = [num(a, "step") for a in args]
-            return rusinkiewicz(*v, rotation=rotation) if len(v) == 4 else \
-                rusinkiewicz(v[0], rotation=rotation)
-        if kind == "merl":
-            if len(args) > 1:
-                raise bad("merl takes at most a stride")
-            if args:
-                if not re.fullmatch(r"[0-9]+", args[0]):
-                    raise bad(f"stride {args[0]!r} is not a positive integer")
-                return merl(int(args[0]), rotation=rotation)
-            return merl(rotation=rotation)
-        if kind == "pairs":
-            if not rest:
-                raise bad("pairs needs a file name")
-            return read_pairs_csv(rest)
+        return make()
     except ValueError as exc:
         if str(exc).startswith("geometry spec"):
             raise
         raise ValueError(f"geometry spec {spec!r}: {exc}; use {SPEC_HELP}") from None
-    raise bad(f"unknown kind {kind!r}")
+
+
+def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
+    """Build a geometry from a compact string; see :meth:`Geometry.from_spec`.
+
+    Examples
+    --------
+    >>> from_spec("full:30").spec
+    'full:30:30:30:30'
+    >>> from_spec("plane:45:45:0").spec
+    'plane:45:45:0'
+    """
+    def make():
+        kind, args, kw = _parse(spec)
+        if kind == "pairs":
+            return read_pairs_csv(*args)
+        build = {"full": full_grid, "plane": plane, "rusinkiewicz": rusinkiewicz,
+                 "merl": merl}[kind]
+        return build(*args, rotation=rotation, **kw)
+    return _checked(spec, make)
+
+
+def spec_pairs(spec: str) -> int | None:
+    """Number of direction pairs the grid ``spec`` places, counted without building it (an
+    exact int, however large; ``rus`` and ``merl`` before their below-horizon nodes are
+    dropped); None for ``plane`` and ``pairs``, small by construction.
+
+    Raises
+    ------
+    ValueError
+        A malformed spec, as :func:`from_spec` says it.
+
+    Examples
+    --------
+    >>> spec_pairs("full:45:90"), spec_pairs("full:0.5"), spec_pairs("plane:warp:5")
+    (25, 16610312161, None)
+    """
+    def count():
+        kind, args, kw = _parse(spec)
+        counter = {"full": full_grid_pairs, "rusinkiewicz": rusinkiewicz_pairs,
+                   "merl": merl_pairs}.get(kind)
+        return None if counter is None else counter(*args, **kw)
+    return _checked(spec, count)

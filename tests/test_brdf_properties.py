@@ -16,6 +16,8 @@ from hypothesis import strategies as st
 
 import brdf
 from brdf import Fabric, TangentCurve, Thread, frames, terms
+from tests._properties import call as _call
+from tests._properties import raises_naming as _raises_naming
 
 ALLOWED = (ValueError, TypeError)
 FAST = settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -41,20 +43,11 @@ presets = st.sampled_from(sorted(brdf.PRESETS))
 
 
 def raises_naming(exc, *names):
-    """The exception is allowed and its message names one of ``names``."""
-    assert isinstance(exc, ALLOWED), f"{type(exc).__name__} escaped: {exc}"
-    msg = str(exc)
-    assert "\n" not in msg.strip(), f"not one line: {msg!r}"
-    assert any(n in msg for n in names), f"message {msg!r} names none of {names}"
+    _raises_naming(exc, *names, allowed=ALLOWED)
 
 
 def call(fn, *names):
-    """fn() or None when it raised an allowed exception naming one of ``names``."""
-    try:
-        return fn()
-    except Exception as exc:  # noqa: BLE001 - the property is about what escapes
-        raises_naming(exc, *names)
-        return None
+    return _call(fn, *names, allowed=ALLOWED)
 
 
 # -- Thread and TangentCurve --------------------------------------------------------------------

@@ -19,6 +19,8 @@ import brdf
 import gonio
 from brdf.frames import from_angles
 from tests._gonio_helpers import Lambert
+from tests._properties import call as _call
+from tests._properties import raises_naming as _raises_naming
 
 ALLOWED = (ValueError, TypeError, OSError)
 
@@ -29,18 +31,11 @@ def fast(n):
 
 
 def raises_naming(exc, *names):
-    assert isinstance(exc, ALLOWED), f"{type(exc).__name__} escaped: {exc}"
-    msg = str(exc)
-    assert "\n" not in msg.strip(), f"not one line: {msg!r}"
-    assert any(n in msg for n in names), f"message {msg!r} names none of {names}"
+    _raises_naming(exc, *names, allowed=ALLOWED)
 
 
 def call(fn, *names):
-    try:
-        return fn()
-    except Exception as exc:  # noqa: BLE001 - the property is about what escapes
-        raises_naming(exc, *names)
-        return None
+    return _call(fn, *names, allowed=ALLOWED)
 
 
 any_float = st.floats(allow_nan=True, allow_infinity=True)

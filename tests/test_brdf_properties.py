@@ -20,7 +20,8 @@ from tests._properties import call as _call
 from tests._properties import raises_naming as _raises_naming
 
 ALLOWED = (ValueError, TypeError)
-FAST = settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+FAST = settings(max_examples=400, deadline=None, derandomize=True,
+                suppress_health_check=[HealthCheck.too_slow])
 
 
 def fast(n):

@@ -26,7 +26,7 @@ ALLOWED = (ValueError, TypeError, OSError)
 
 
 def fast(n):
-    return settings(max_examples=n, deadline=None,
+    return settings(max_examples=n, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 
 

@@ -32,6 +32,8 @@ import math
 import numpy as np
 from scipy.special import gammaln
 
+from brdf.scratch import Scratch
+
 __all__ = ["Likelihood", "KINDS", "is_relative", "is_grey"]
 
 KINDS = ("gaussian", "relative", "student-t")
@@ -141,6 +143,9 @@ class Likelihood:
         self.has_sigma = sigma is not None
         self.relative_data = is_relative(getattr(table, "meta", {}))
         self.pt, self.ch = np.nonzero(mask)
+        self._scratch = Scratch()
+        # the used entries as indices into the flattened (n * 3) values; None when all are
+        self._flat = None if mask.all() else self.pt * 3 + self.ch
         f = values[self.pt, self.ch]
         c = cos_i[self.pt]
         self.cos_i = c
@@ -162,8 +167,14 @@ class Likelihood:
         """Model values (B..., n, 3) at the used entries (B..., n_used); grey: channel mean."""
         m = np.asarray(model_values, dtype=np.float64)
         if self.grey:
-            return m[..., self.pt, :].mean(axis=-1)
-        return m[..., self.pt, self.ch]
+            return np.take(m, self.pt, axis=-2).mean(axis=-1)
+        flat = m.reshape(m.shape[:-2] + (-1,))
+        # np.take, not m[..., pt, ch]: fancy indexing over two trailing axes gives an array
+        # laid out point-major, whose every later operation is strided (6x slower)
+        if self._flat is None:
+            return flat
+        return np.take(flat, self._flat, axis=-1,
+                       out=self._scratch.array("at", flat.shape[:-1] + self._flat.shape))
 
     @property
     def n_used(self) -> int:
@@ -199,24 +210,32 @@ class Likelihood:
         ValueError
             When the table has no sigma and no ``log_noise`` is given.
         """
-        m = self._at(model_values)
-        if scale is not None:
-            m = m * np.asarray(scale, dtype=np.float64)[..., None]
-        if self.kind == "relative":
-            mu = np.log(np.maximum(m, 1e-300))
-        else:
-            mu = np.log1p(np.maximum(m, 0.0) * self.cos_i)
-        r = np.subtract(self.y, mu, out=mu)
         if log_noise is None and self.sigma_y2 is None:
             raise ValueError("the table has no sigma: a log_noise parameter is needed")
+        m = self._at(model_values)
+        # one buffer for mu and the residuals, the rest in place: fresh large temporaries
+        # cost page faults, which threads take in turn
+        lo = 1e-300 if self.kind == "relative" else 0.0
+        mu = self._scratch.array("mu", m.shape)
+        if scale is None:
+            np.maximum(m, lo, out=mu)
+        else:
+            np.multiply(m, np.asarray(scale, dtype=np.float64)[..., None], out=mu)
+            np.maximum(mu, lo, out=mu)
+        if self.kind == "relative":
+            np.log(mu, out=mu)
+        else:
+            mu *= self.cos_i
+            np.log1p(mu, out=mu)
+        r = np.subtract(self.y, mu, out=mu)
         if self.kind == "student-t":
             out = self._student_t(r, log_noise)
         elif log_noise is None:           # fixed sigma: sum r^2 / s^2 as one product
-            out = -0.5 * ((r * r) @ self._inv_s2) + self._gauss_const
+            out = -0.5 * (np.multiply(r, r, out=r) @ self._inv_s2) + self._gauss_const
         elif self.sigma_y2 is None:       # s^2 = exp(2 log_noise), one value per row
             ln = np.asarray(log_noise, dtype=np.float64)
             n = r.shape[-1]
-            out = (-0.5 * np.exp(-2.0 * ln) * np.einsum("...i,...i->...", r, r)
+            out = (-0.5 * np.exp(-2.0 * ln) * np.multiply(r, r, out=r).sum(axis=-1)
                    - n * ln - 0.5 * n * _LOG_2PI)
         else:
             s2 = self.sigma_y2 + np.exp(2.0 * np.asarray(log_noise, dtype=np.float64))[..., None]

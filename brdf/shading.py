@@ -35,7 +35,8 @@ DENOM_MIN = 2.0 ** -1000
 def _fresnel_from_cos(eta2, c, c2):
     """Unpolarized dielectric Fresnel reflectance from c = cos and c2 = cos^2 (broadcasting)."""
     shape = np.broadcast_shapes(np.shape(eta2), np.shape(c), np.shape(c2))
-    rs = fresnel2_into(eta2, c, c2, *(np.empty(shape) for _ in range(4)))
+    dtype = np.result_type(eta2, c, c2)
+    rs = fresnel2_into(eta2, c, c2, *(np.empty(shape, dtype) for _ in range(4)))
     rs *= 0.5
     return rs
 
@@ -84,17 +85,29 @@ class _ShadeParams(NamedTuple):
 #: the limits (F_r -> 1, a flat or a needle lobe) beyond.
 PARAM_CLAMP = (2.0 ** -500, 2.0 ** 500)
 
+#: The same bounds for float32 shading (2^-60..2^60): eta^2 and 1/(8 gamma^2) stay below
+#: float32's largest number (about 2^128).
+PARAM_CLAMP_32 = (2.0 ** -60, 2.0 ** 60)
 
-def _shade_params(eta, kd, gamma_s, gamma_v) -> _ShadeParams:
+#: The precisions :func:`thread_shade` shades in (that of its geometry's arrays).
+SHADE_DTYPES = (np.dtype(np.float64), np.dtype(np.float32))
+
+
+def _shade_params(eta, kd, gamma_s, gamma_v, dtype=np.float64) -> _ShadeParams:
     """Row constants from 1-D arrays (nb,) of eta, k_d and the gammas (radians), each
-    within :data:`PARAM_CLAMP`."""
+    within :data:`PARAM_CLAMP` (:data:`PARAM_CLAMP_32` for float32), computed in float64
+    and given in ``dtype``."""
     c3 = (slice(None), None, None)
-    eta, gamma_s, gamma_v = (np.clip(x, *PARAM_CLAMP) for x in (eta, gamma_s, gamma_v))
+    clamp = PARAM_CLAMP if np.dtype(dtype) == np.float64 else PARAM_CLAMP_32
+    eta, gamma_s, gamma_v = (np.clip(x, *clamp) for x in (eta, gamma_s, gamma_v))
     s_scale = GAUSS_NORM / gamma_s
     s_scale *= 0.5
-    return _ShadeParams((eta * eta)[c3], (-0.125 / (gamma_s * gamma_s))[c3],
-                        (-0.125 / (gamma_v * gamma_v))[c3], gamma_v == 2.0 * gamma_s,
-                        s_scale[:, None], ((1.0 - kd) * GAUSS_NORM / gamma_v)[c3], kd[c3])
+    par = _ShadeParams((eta * eta)[c3], (-0.125 / (gamma_s * gamma_s))[c3],
+                       (-0.125 / (gamma_v * gamma_v))[c3], gamma_v == 2.0 * gamma_s,
+                       s_scale[:, None], ((1.0 - kd) * GAUSS_NORM / gamma_v)[c3], kd[c3])
+    if np.dtype(dtype) == np.float64:
+        return par
+    return _ShadeParams(*(a if a.dtype == bool else a.astype(dtype) for a in par))
 
 
 def _blocks(nb, nc, ns, block):
@@ -182,7 +195,7 @@ def volume_term(geom, weight, par, f2, ev, transmission, out):
 def _shade_block(geom, weight, par, transmission, surf, vol, work):
     """One block of :func:`thread_shade`: geometry (c, S), constants of b rows, outputs (b, c).
 
-    ``work`` is a float64 buffer of at least 4 b c S elements, overwritten.
+    ``work`` is a buffer of the geometry's dtype of at least 4 b c S elements, overwritten.
     """
     shape = (par.eta2.shape[0],) + geom.th2.shape
     n = shape[0] * shape[1] * shape[2]
@@ -196,13 +209,14 @@ def _shade_block(geom, weight, par, transmission, surf, vol, work):
 
 
 def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
-                 transmission="half_angle", *, out=None, block=None):
+                 transmission="half_angle", *, out=None, block=None, scratch=None):
     r"""Weighted sums of one thread's surface and volume terms.
 
     Parameters
     ----------
     geom : ThreadGeometry
-        From :func:`thread_geometry`, arrays (C, S).
+        From :func:`thread_geometry`, arrays (C, S). Their dtype, float64 or float32 (see
+        :meth:`brdf.Prepared.eval`), is the precision of the shading and of the sums.
     weight : ndarray, shape (S,)
         Weights of the distinct tangent samples.
     eta, kd : float or ndarray of shape (B...)
@@ -211,12 +225,15 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
         Lobe widths, radians.
     transmission : {"half_angle", "longitudinal"}
     out : tuple of two ndarray, shape (B..., C), optional
-        C-contiguous float64 arrays to write ``surf`` and ``vol`` into (returned).
+        C-contiguous arrays of the geometry's dtype to write ``surf`` and ``vol`` into
+        (returned).
     block : int, optional
         Target number of (parameter set, pair, sample) elements per block (default
         :data:`SHADE_BLOCK`): the batch and the pairs are shaded in blocks of about this
         size, so that the temporaries stay in cache. Only the speed and the rounding of
         the weighted sums depend on it.
+    scratch : brdf.scratch.Scratch, optional
+        Where the block temporaries are kept between calls (else allocated per call).
 
     Returns
     -------
@@ -232,16 +249,21 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
     and :math:`\theta_h^2 = \mathrm{th2}/4`. Where :math:`\gamma_v = 2\gamma_s` (Table II) the
     surface lobe is the volume lobe to the fourth power, one ``exp`` for both.
     """
+    dtype = geom.th2.dtype
+    if dtype not in SHADE_DTYPES:
+        raise ValueError(f"geom must hold float64 or float32 arrays; got {dtype}")
     params = [np.asarray(x, dtype=np.float64) for x in (eta, kd, gamma_s, gamma_v)]
     batch = np.broadcast_shapes(*(x.shape for x in params))
     nb = math.prod(batch)
-    par = _shade_params(*(np.broadcast_to(x, batch).reshape(nb) for x in params))
+    par = _shade_params(*(np.broadcast_to(x, batch).reshape(nb) for x in params), dtype=dtype)
+    weight = np.asarray(weight, dtype=dtype)
     nc, ns = geom.th2.shape
     if out is None:
-        out = (np.empty(batch + (nc,)), np.empty(batch + (nc,)))
+        out = (np.empty(batch + (nc,), dtype), np.empty(batch + (nc,), dtype))
     surf, vol = (o.reshape(nb, nc) for o in out)
     block = SHADE_BLOCK if block is None else max(1, int(block))
-    work = np.empty(4 * min(nb * nc * ns, max(block, ns)))
+    size = 4 * min(nb * nc * ns, max(block, ns))
+    work = np.empty(size, dtype) if scratch is None else scratch.array("shade", (size,), dtype)
     for rows, pairs in _blocks(nb, nc, ns, block):
         g = ThreadGeometry(*(None if x is None else x[pairs] for x in geom))
         _shade_block(g, weight, par.rows(rows), transmission, surf[rows, pairs],

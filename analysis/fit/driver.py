@@ -34,6 +34,9 @@ ESTIMATE_MIN_S = 10.0
 #: Version of the sampler's configuration; a folder fitted by another version is refused.
 CONFIG_VERSION = 7
 
+#: The precisions the model may shade in while sampling (``fit(shading=...)``).
+SHADINGS = ("float32", "float64")
+
 
 @dataclasses.dataclass(frozen=True)
 class FitOptions:
@@ -52,6 +55,7 @@ class FitOptions:
     adapt: int | None = None
     threads: int | None = None
     time_limit: float | None = None
+    shading: str = "float32"
 
     def resolve(self, ndim: int) -> "FitOptions":
         """Defaults filled in for ``ndim`` free parameters; a ValueError naming the first bad
@@ -83,6 +87,8 @@ class FitOptions:
              f"{self.time_limit}"),
             (self.threads is None or self.threads >= 1,
              f"threads must be >= 1; got {self.threads}"),
+            (self.shading in SHADINGS,
+             f"shading must be one of {', '.join(SHADINGS)}; got {self.shading!r}"),
         ]
         for ok, message in checks:
             if not ok:
@@ -153,7 +159,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         n_starts: int = 4, laplace_move: float = 0.75, adapt: int | None = None,
         threads: int | None = None, out_dir=None, time_limit: float | None = None,
         progress: bool | Callable = True, config_extra: Mapping | None = None,
-        notify: Callable[[str], None] | None = None) -> FitResult:
+        notify: Callable[[str], None] | None = None, shading: str = "float32") -> FitResult:
     """Fit the free parameters of ``spec`` to ``table``; see :mod:`analysis.fit`.
 
     Parameters
@@ -198,6 +204,13 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         ``notify(line)`` is given the estimated time of the fit before it starts when it may
         take ``ESTIMATE_MIN_S`` or more (:func:`estimate_time`; not on a resume), and a
         point estimate that ends on bounds.
+    shading : {"float32", "float64"}
+        Precision of the model's shading while sampling, when ``model`` offers
+        ``with_dtype`` (as :class:`~analysis.fit.posterior.FabricModel` does). float32 (the
+        default) shades about twice as fast, at a relative error of a few 1e-6 in f_r: a
+        change of the log-likelihood far below its sampling noise. The point estimate, the
+        Laplace step and every prediction of the result use float64. Not part of the
+        stored configuration: a checkpoint resumes under either.
 
     Returns
     -------
@@ -217,7 +230,7 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
                       seed=seed, max_steps=max_steps, check_every=check_every,
                       criteria=Criteria(min_ratio, tau_tol, rhat_max, burn_fraction),
                       n_starts=n_starts, laplace_move=laplace_move, adapt=adapt,
-                      threads=threads, time_limit=time_limit)
+                      threads=threads, time_limit=time_limit, shading=shading)
     return _run(table, spec, model, opts, out_dir, progress, config_extra, notify)
 
 
@@ -285,6 +298,9 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
     opts = opts.resolve(spec.ndim)
     _check_memory(opts, spec.ndim, lik.n_used)
     logpost = LogPosterior(spec, lik, model)
+    sampling = logpost
+    if opts.shading == "float32" and hasattr(model, "with_dtype"):
+        sampling = logpost.with_model(model.with_dtype(np.float32))
     config = opts.config(spec, table, lik, config_extra)
     folder = None if out_dir is None else FitFolder(out_dir)
     start = None if folder is None else folder.read_start(config)
@@ -295,7 +311,7 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
                       for s in np.random.SeedSequence(opts.seed).spawn(opts.ensembles + 1)]
     with threadpool_limits(limits=1, user_api="blas"):
         if notify is not None and ckpt is None:
-            seconds, line = estimate_time(logpost, opts, lik.n_used, start is None)
+            seconds, line = estimate_time(sampling, opts, lik.n_used, start is None)
             if seconds >= ESTIMATE_MIN_S:
                 notify(line)
         if start is None:
@@ -304,7 +320,7 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
         else:
             best, best_logp, cov = start["best"], start["best_logp"], start["cov"]
         t_opt = time.perf_counter() - t0
-        sampler = FitSampler(logpost, opts, best, cov, rngs, ckpt)
+        sampler = FitSampler(sampling, opts, best, cov, rngs, ckpt)
         if start is None and folder is not None:    # only a start the walkers could use
             folder.write_start(config, best, best_logp, cov)
         resumed = sampler.steps if ckpt is not None else 0

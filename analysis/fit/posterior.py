@@ -22,23 +22,39 @@ class FabricModel:
 
     Wraps ``fab.prepare(wi, wo)``; the call takes the keyword arguments of ``prep.eval``
     (each (B..., 2), albedo (B..., 2, 3)) and optionally ``tangent_scale`` (B..., 2), a factor
-    on each thread's tangent offsets. Scaled curves cannot be prepared once: that slow path
-    rebuilds the fabric and its preparation for every batch row whose factors differ from 1.
+    on each thread's tangent offsets, and returns f_r (B..., n, 3) in 1/sr, float64. Scaled
+    curves cannot be prepared once: that slow path rebuilds the fabric and its preparation
+    for every batch row whose factors differ from 1.
+
+    ``dtype`` is the precision of the shading (:meth:`brdf.Prepared.eval`): float64 by
+    default; :meth:`with_dtype` gives the same model shading in float32, which the sampling
+    of :func:`~analysis.fit.fit` uses.
     """
 
-    def __init__(self, fab, wi, wo):
+    def __init__(self, fab, wi, wo, dtype=np.float64):
         self.fab = fab
         self.wi = np.asarray(wi, dtype=np.float64)
         self.wo = np.asarray(wo, dtype=np.float64)
         self.prep = fab.prepare(self.wi, self.wo)
+        self.dtype = np.dtype(dtype)
+        self.prep.eval(dtype=self.dtype)          # a bad dtype is refused here, once
+
+    def with_dtype(self, dtype) -> "FabricModel":
+        """The same model (sharing its preparation) shading in ``dtype``."""
+        other = object.__new__(FabricModel)
+        other.__dict__.update(self.__dict__)
+        other.dtype = np.dtype(dtype)
+        other.prep.eval(dtype=other.dtype)
+        return other
 
     def __call__(self, tangent_scale=None, **kw) -> np.ndarray:
+        kw["dtype"] = self.dtype
         if tangent_scale is None or np.all(np.asarray(tangent_scale) == 1.0):
             return self.prep.eval(**kw)
         ts = np.asarray(tangent_scale, dtype=np.float64)
         batch = ts.shape[:-1]
         flat_kw = {k: np.asarray(v).reshape((-1,) + np.shape(v)[len(batch):])
-                   for k, v in kw.items()}
+                   for k, v in kw.items() if k != "dtype"}
         out = np.empty((int(np.prod(batch)), self.wi.shape[0], 3))
         ts = ts.reshape(-1, 2)
         for b in range(ts.shape[0]):
@@ -46,8 +62,21 @@ class FabricModel:
                 th.replace(offsets=tuple(np.clip(np.asarray(th.offsets) * ts[b, j], -90, 90)))
                 for j, th in enumerate(self.fab.threads))
             prep = self.fab.replace(threads=threads).prepare(self.wi, self.wo)
-            out[b] = prep.eval(**{k: v[b] for k, v in flat_kw.items()})
+            out[b] = prep.eval(dtype=self.dtype, **{k: v[b] for k, v in flat_kw.items()})
         return out.reshape(batch + out.shape[1:])
+
+
+class _Count:
+    """A count shared by threads (and by a posterior and its :meth:`~LogPosterior.with_model`
+    copies)."""
+
+    def __init__(self):
+        self.n = 0
+        self._lock = threading.Lock()
+
+    def add(self, k: int):
+        with self._lock:
+            self.n += k
 
 
 class LogPosterior:
@@ -64,26 +93,39 @@ class LogPosterior:
 
     def __init__(self, spec: ParamSpec, likelihood: Likelihood, model: Callable):
         self.spec, self.lik, self.model = spec, likelihood, model
-        self.n_evals = 0
-        self._lock = threading.Lock()
+        self._count = _Count()
         names = set(spec.free) | set(spec.ties)
         self.use_scale = "scale" in names or spec.params["scale"].default != 1.0
         self.use_noise = "log_noise" in names
         self.use_tangent = bool({"tangent_scale1", "tangent_scale2"} & names) or any(
             spec.params[f"tangent_scale{j}"].default != 1.0 for j in (1, 2))
 
+    @property
+    def n_evals(self) -> int:
+        """Parameter sets evaluated so far (those inside the prior's support)."""
+        return self._count.n
+
+    def with_model(self, model: Callable) -> "LogPosterior":
+        """This posterior with another forward model (e.g. ``model.with_dtype(np.float32)``);
+        its evaluations count in this one's :attr:`n_evals`."""
+        other = object.__new__(LogPosterior)
+        other.__dict__.update(self.__dict__)
+        other.model = model
+        return other
+
     def predict(self, theta) -> np.ndarray:
         """Model f_r (B, n, 3) for internal theta (B, ndim), scale included."""
         theta = np.atleast_2d(np.asarray(theta, dtype=np.float64))
         return self._predict(self.spec.values(theta))
 
-    def _predict(self, v) -> np.ndarray:
-        """Model f_r (B, n, 3) from the natural values ``v`` of :meth:`ParamSpec.values`."""
+    def _predict(self, v, scaled: bool = True) -> np.ndarray:
+        """Model f_r (B, n, 3) from the natural values ``v`` of :meth:`ParamSpec.values`
+        (times ``scale`` unless ``scaled`` is False)."""
         kw = self.spec.model_kwargs(v)
         if self.use_tangent:
             kw["tangent_scale"] = np.stack([v["tangent_scale1"], v["tangent_scale2"]], -1)
         out = np.asarray(self.model(**kw), dtype=np.float64)
-        if self.use_scale:
+        if self.use_scale and scaled:
             out = out * v["scale"][:, None, None]
         return out
 
@@ -96,11 +138,11 @@ class LogPosterior:
             th = theta[ok]
             v = self.spec.values(th)
             with np.errstate(all="ignore"):
-                pred = self._predict(v)
-                ll = self.lik(pred, log_noise=v["log_noise"] if self.use_noise else None)
+                pred = self._predict(v, scaled=False)      # the likelihood applies scale
+                ll = self.lik(pred, scale=v["scale"] if self.use_scale else None,
+                              log_noise=v["log_noise"] if self.use_noise else None)
             out[ok] = lp[ok] + ll
-            with self._lock:
-                self.n_evals += int(ok.sum())
+            self._count.add(int(ok.sum()))
         return out
 
 

@@ -130,3 +130,24 @@ def test_a_fit_folder_and_a_report_folder_lose_their_stale_temporaries(tmp_path)
         assert not report_tmp.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fit"]
     assert list(fit_dir.iterdir()) == []
+
+
+def test_a_second_report_into_the_same_folder_is_refused(tmp_path):
+    """`microcyl report` twice into one -o folder at once: the second is refused, naming
+    the first's pid; the first writes its report whole."""
+    out = tmp_path / "rep"
+    args = ("report", "--fabric", "velvet", "--quality", "fast", "-o", out)
+    lock = tmp_path / ".rep.lock"
+    first = _cli(*args)
+    try:
+        assert _wait_for(lambda: lock.exists() and lock.read_text().strip(), timeout=120)
+        second = _cli(*args)
+        _, err = second.communicate(timeout=120)
+        assert second.returncode == 1
+        assert err.strip().splitlines()[-1] == (
+            f"microcyl report: error: another report is running in {out} (pid {first.pid}); "
+            f"wait for it to end or use another output")
+    finally:
+        _, err = first.communicate(timeout=600)
+    assert first.returncode == 0, err
+    assert (out / "index.html").is_file() and not lock.exists()

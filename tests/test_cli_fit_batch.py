@@ -113,3 +113,30 @@ def test_ctrl_c_stops_the_batch_and_the_same_command_resumes(tables, tmp_path):
     rows = {x["name"]: x for x in json.loads((out / "summary.json").read_text())["tables"]}
     assert {x["status"] for x in rows.values()} == {"converged"}
     assert rows["silk0"]["resumed_from"] > 0 or "silk0" in stdout  # resumed, or had ended
+
+
+def test_a_second_batch_into_the_same_folder_is_refused_at_once(tables, tmp_path):
+    """Two `fit-batch` runs into one -o folder: the second is refused before any work,
+    naming the first's pid; the first goes on and resumes like any other."""
+    out = tmp_path / "out"
+    args = ["fit-batch", str(tables), *FIT, "--max-steps", "100000", "--workers", "1",
+            "--no-plots", "-o", str(out)]
+    lock = out / ".microcyl.lock"
+    first = subprocess.Popen([sys.executable, "-m", "reports", *args], env=ENV,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        end = time.monotonic() + 120
+        while not (lock.exists() and lock.read_text().strip()) and time.monotonic() < end:
+            time.sleep(0.05)
+        t0 = time.monotonic()
+        second = microcyl(*args)
+        assert time.monotonic() - t0 < 30              # refused at once, not after a fit
+        assert second.returncode == 1
+        assert second.stderr.strip().splitlines()[-1] == (
+            f"microcyl fit-batch: error: another batch is running in {out} (pid "
+            f"{first.pid}); wait for it to end or use another output")
+        assert first.poll() is None                    # the first one is untouched
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=120)
+    assert not lock.exists()

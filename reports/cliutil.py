@@ -14,6 +14,7 @@ import brdf
 import gonio
 import gonio.rgl
 from analysis.budget import RGL_BYTES_PER_PAIR, check_memory
+from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
@@ -222,7 +223,9 @@ def data_dir(arg=None) -> Path:
 
 
 def check_writable_dir(path: Path) -> Path:
-    """Create ``path`` if needed and check that files can be written in it.
+    """Check that ``path`` can be created (when missing) and written in, leaving nothing
+    behind: a folder created for the check is removed again, so a run refused later leaves
+    no new folder (its writer creates it when it starts).
 
     Raises
     ------
@@ -230,6 +233,7 @@ def check_writable_dir(path: Path) -> Path:
         If the folder cannot be created or written, naming it.
     """
     path = Path(path)
+    created = missing_folders(path)
     try:
         path.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path, prefix=".write-test-"):
@@ -237,4 +241,6 @@ def check_writable_dir(path: Path) -> Path:
     except OSError as exc:
         raise OSError(f"output folder {str(path)!r} is not writable: {exc.strerror or exc}") \
             from None
+    finally:
+        remove_empty_folders(created)
     return path

@@ -100,15 +100,11 @@ def _make_fabric(name: str, options: dict):
 
 
 #: The instrument's parameters and their options, longest name first (messages name them).
-_INSTRUMENT_OPTIONS = (("snr_reference", "--snr-reference"), ("cone_detector", "--cone-detector"),
+_INSTRUMENT_OPTIONS = (("rings x azimuths", "--cone-rings x --cone-azimuths"),
+                       ("snr_reference", "--snr-reference"), ("cone_detector", "--cone-detector"),
                        ("cone_source", "--cone-source"), ("azimuths", "--cone-azimuths"),
                        ("rings", "--cone-rings"), ("floor", "--floor"), ("noise", "--noise"),
                        ("snr", "--snr"))
-
-
-#: Largest --cone-rings and --cone-azimuths (each cone point is one more BRDF evaluation of
-#: every pair; the quadrature is built whole).
-MAX_CONE_POINTS = 256
 
 
 def _instrument(args) -> Instrument:
@@ -117,10 +113,6 @@ def _instrument(args) -> Instrument:
         bad = "--cone-source" if not 0 <= args.cone_source < 90 else "--cone-detector"
         value = args.cone_source if bad == "--cone-source" else args.cone_detector
         raise ValueError(f"{bad} must be a half-angle in [0, 90) degrees; got {value}")
-    for option, value in (("--cone-rings", args.cone_rings),
-                          ("--cone-azimuths", args.cone_azimuths)):
-        if not 1 <= value <= MAX_CONE_POINTS:
-            raise ValueError(f"{option} must be an integer in 1..{MAX_CONE_POINTS}; got {value}")
     try:
         return Instrument(cone_source=args.cone_source, cone_detector=args.cone_detector,
                           snr=args.snr, floor=args.floor, noise=args.noise,
@@ -147,7 +139,7 @@ def _check_size(args, instrument, fabric) -> None:
     what = f"--geometry {args.geometry} ({n:.3g} pairs)"
     nbytes = n * MEASURE_BYTES_PER_PAIR
     check_memory(what, nbytes, "use a coarser step")
-    points = len(instrument.source_rule[1]) * len(instrument.detector_rule[1])
+    points = instrument.n_source * instrument.n_detector      # no quadrature built
     seconds = n * points * SECONDS_PER_EVALUATION * fabric.options["tangent_samples"] / 32
     if seconds > 5:
         print(f"measure: {what} x {points} cone points: about {format_bytes(nbytes)} of "

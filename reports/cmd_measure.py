@@ -65,6 +65,8 @@ def register(sub):
     i.add_argument("--cone-azimuths", type=int, default=6, metavar="N",
                    help="cone quadrature azimuths per ring (default 6)")
     i.add_argument("--seed", type=int, default=None, help="seed of the noise")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (shown on stderr otherwise, terminal or not)")
     f = p.add_argument_group("fabric variant (defaults: the model's)")
     f.add_argument("--masking", choices=_ON_OFF, default=None)
     f.add_argument("--reweighting", choices=_ON_OFF, default=None)
@@ -159,7 +161,8 @@ def run(args) -> int:
     fabric = _make_fabric(args.fabric, _fabric_options(args))
     _check_size(args, instrument, fabric)
     geometry = from_spec(args.geometry, rotation=math.radians(args.rotation))
-    table = measure(fabric, geometry, instrument, seed=args.seed)
+    table = measure(fabric, geometry, instrument, seed=args.seed,
+                    progress=not args.no_progress)
     if "name" not in table.meta["source"]:
         table.meta["source"]["name"] = args.fabric
     with output_lock(out, "measure", inside=False):   # removes a killed run's .OUT.*.tmp

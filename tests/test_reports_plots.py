@@ -201,6 +201,32 @@ def test_slice_image_equals_eval(velvet):
     assert img[r, c] == pytest.approx(float(ev(velvet, wi, wo) @ W))
 
 
+
+def _bar_gap(fig, ax):
+    """(gap between the image's right edge and its colour bar's left edge, image width),
+    in pixels of the drawn figure; the bar is the axes holding a colour bar of the image."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    im = ax.images[0]
+    bar = im.colorbar.ax
+    img_box = ax.get_window_extent()
+    return bar.get_window_extent().x0 - img_box.x1, img_box.width
+
+
+def test_the_colour_bar_sits_beside_its_image(velvet):
+    """No wide gap between an image and its colour bar: at most a tenth of the image's
+    width, alone and in the slices view's grid (whose image keeps its aspect)."""
+    from reports.plot_views import slices_view
+    fig, ax = plots.plot_slice_image(velvet, 90.0, resolution=8)
+    gap, width = _bar_gap(fig, ax)
+    assert 0 <= gap <= 0.1 * width, (gap, width)
+    fig = slices_view({"velvet": velvet}, resolution=9)
+    ax = next(a for a in fig.axes if a.images)
+    gap, width = _bar_gap(fig, ax)
+    assert 0 <= gap <= 0.1 * width, (gap, width)
+
+
 def test_hemisphere_is_equal_area_and_equals_eval(silk):
     n = 40
     fig, ax = plots.plot_hemisphere(silk, 45.0, 30.0, resolution=n)

@@ -18,7 +18,8 @@ import os
 import shutil
 from pathlib import Path
 
-__all__ = ["output_lock", "FolderBusy", "remove_stale_temporaries", "LOCK_NAME"]
+__all__ = ["output_lock", "FolderBusy", "remove_stale_temporaries", "LOCK_NAME",
+           "missing_folders", "remove_empty_folders"]
 
 #: The lock file inside a locked folder.
 LOCK_NAME = ".microcyl.lock"
@@ -78,6 +79,20 @@ def remove_stale_temporaries(folder, name: str | None = None) -> list[Path]:
     return removed
 
 
+def missing_folders(path) -> list[Path]:
+    """``path`` and those of its parents that do not exist, deepest first (what
+    ``mkdir(parents=True)`` would create)."""
+    path = Path(path).absolute()
+    return [p for p in (path, *path.parents) if not p.exists()]
+
+
+def remove_empty_folders(folders) -> None:
+    """Remove each of ``folders`` (deepest first) that is empty; leave any other alone."""
+    for p in folders:
+        with contextlib.suppress(OSError):
+            os.rmdir(p)
+
+
 @contextlib.contextmanager
 def output_lock(path, what: str, *, inside: bool = True):
     """Hold the lock of an output while the block runs; remove its stale temporaries first.
@@ -110,17 +125,24 @@ def output_lock(path, what: str, *, inside: bool = True):
     True
     """
     path = Path(path)
+    created = []
     if inside:
+        created = missing_folders(path)
         path.mkdir(parents=True, exist_ok=True)
         lock, folder, name = path / LOCK_NAME, path, None
     else:
         folder = path.parent if str(path.parent) else Path(".")
         lock, name = folder / f".{path.name}.lock", path.name
-    fd = _acquire(lock, what, path)
+    fd, done = None, False
     try:
+        fd = _acquire(lock, what, path)
         remove_stale_temporaries(folder, name)
         yield lock
+        done = True
     finally:
-        with contextlib.suppress(OSError):
-            os.unlink(lock)
-        os.close(fd)
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(lock)
+            os.close(fd)
+        if not done:
+            remove_empty_folders(created)

@@ -38,7 +38,8 @@ import math
 
 import numpy as np
 
-__all__ = ["Instrument", "cap_quadrature", "cone_directions", "NOISE_MODELS"]
+__all__ = ["Instrument", "cap_quadrature", "cone_directions", "NOISE_MODELS",
+           "MAX_CONE_POINTS", "MAX_EVALUATIONS_PER_PAIR"]
 
 #: Names of the noise models.
 NOISE_MODELS = ("multiplicative", "shot")
@@ -46,6 +47,17 @@ NOISE_MODELS = ("multiplicative", "shot")
 #: snr^2 v / snr_reference stay finite for any f_r (beyond, the noise is no measurement).
 SNR_RANGE = (1e-3, 1e12)
 REFERENCE_RANGE = (1e-12, 1e12)
+
+#: Largest ``rings`` and ``azimuths`` (the Gauss-Legendre rule of a cone is built whole).
+MAX_CONE_POINTS = 256
+#: Largest number of BRDF evaluations of one pair (source points x detector points): a pair's
+#: evaluations are made at once (a chunk of ``gonio.measure`` holds one pair at least), so
+#: this bounds its memory: about 2 GiB.
+MAX_EVALUATIONS_PER_PAIR = 1 << 22
+#: Peak bytes of one BRDF evaluation inside a chunk, for the estimate in the size refusal:
+#: a fabric's eval with 32 tangent samples about 340 (measured with tracemalloc, 2^15
+#: pairs), the chunk's directions, weights and values the rest.
+BYTES_PER_EVALUATION = 500
 
 #: Above this Poisson mean the normal approximation is drawn (numpy's Poisson has a ceiling).
 _POISSON_MAX = 1e7
@@ -162,8 +174,10 @@ class Instrument:
     snr_reference : float
         For ``noise="shot"``: the f_r (1/sr) at which the SNR equals ``snr``.
     rings, azimuths : int
-        The cone quadrature: Gauss-Legendre rings x equally spaced azimuths per cone (so a
-        pair costs (rings * azimuths)^2 evaluations with both cones open).
+        The cone quadrature: Gauss-Legendre rings x equally spaced azimuths per cone, each in
+        1..:data:`MAX_CONE_POINTS` (so a pair costs (rings * azimuths)^2 evaluations with
+        both cones open, at most :data:`MAX_EVALUATIONS_PER_PAIR`). Checked on construction,
+        before any quadrature is built.
 
     Examples
     --------
@@ -224,7 +238,26 @@ class Instrument:
                              f"[{REFERENCE_RANGE[0]:g}, {REFERENCE_RANGE[1]:g}]; "
                              f"got {self.snr_reference!r}")
         object.__setattr__(self, "snr_reference", ref)
-        cap_quadrature(0.0, self.rings, self.azimuths)  # validates rings and azimuths
+        self._check_size()
+
+    def _check_size(self) -> None:
+        """Refuse quadratures too large to build or to evaluate a pair with, before any is
+        built: rings and azimuths in 1..MAX_CONE_POINTS, and at most
+        MAX_EVALUATIONS_PER_PAIR evaluations a pair (its memory estimated in the message)."""
+        for name in ("rings", "azimuths"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not (
+                    1 <= v <= MAX_CONE_POINTS):
+                raise ValueError(f"{name} must be an integer in 1..{MAX_CONE_POINTS}; got "
+                                 f"{v!r}")
+        per_pair = self.n_source * self.n_detector
+        if per_pair > MAX_EVALUATIONS_PER_PAIR:
+            gib = per_pair * BYTES_PER_EVALUATION / 2 ** 30
+            raise ValueError(
+                f"rings x azimuths = {self.rings} x {self.azimuths} points a cone, with both "
+                f"cones open, is {per_pair:,} evaluations for each pair (about {gib:.3g} GiB "
+                f"at once); at most {MAX_EVALUATIONS_PER_PAIR:,}: lower rings or azimuths, "
+                f"or use a point source or detector (cone 0)")
 
     # ------------------------------------------------------------------------- quadrature
 

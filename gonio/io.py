@@ -14,10 +14,16 @@ from gonio.merl import read_merl, write_merl
 from gonio.rgl import load_rgl, read_tensor_file
 from gonio.table import Table
 
-__all__ = ["read", "write", "READ_SUFFIXES", "WRITE_SUFFIXES"]
+__all__ = ["read", "write", "check_read_options", "READ_SUFFIXES", "WRITE_SUFFIXES",
+           "READ_OPTIONS"]
 
 READ_SUFFIXES = (".exr", ".csv", ".binary", ".alta", ".bsdf", "abrdf.dat")
 WRITE_SUFFIXES = (".exr", ".csv", ".binary", ".alta")
+#: Each format read: its name in messages, and the options its reader takes.
+READ_OPTIONS = {"exr": ("a native .exr", ()), "csv": ("a .csv", ()),
+                "alta": ("an ALTA .alta", ()),
+                "merl": ("a MERL .binary", ("stride", "keep_missing")),
+                "curet": ("a CUReT abrdf.dat", ("sample",)), "rgl": ("an RGL .bsdf", ("step",))}
 
 
 def _kind(path: Path, known) -> str:
@@ -30,6 +36,53 @@ def _kind(path: Path, known) -> str:
         raise ValueError(f"{path}: unknown table format {suffix or '(no suffix)'!r}; known: "
                          + ", ".join(known))
     return kinds[suffix]
+
+
+def check_read_options(path, options, *, as_flags: bool = False) -> None:
+    """Refuse, by name, an option that the reader of ``path``'s format does not take.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table file (only its name is used: the format comes from the suffix).
+    options : iterable of str
+        The option names given.
+    as_flags : bool
+        Name them as command-line flags (``--stride``) in the message.
+
+    Raises
+    ------
+    ValueError
+        ``stride applies to a MERL .binary only, not to t.csv; drop it`` for an option of
+        another format (whatever the suffix of ``path``), ``unknown option 'x' for t.csv; its
+        reader takes none`` for one of no format (for a file of unknown suffix, the unknown
+        format instead).
+
+    Examples
+    --------
+    >>> check_read_options("t.binary", ["stride"])
+    >>> check_read_options("t.csv", ["stride"])
+    Traceback (most recent call last):
+    ...
+    ValueError: stride applies to a MERL .binary only, not to t.csv; drop it
+    """
+    path = Path(path)
+    try:
+        takes = READ_OPTIONS[_kind(path, READ_SUFFIXES)][1]
+    except ValueError:                  # an unknown suffix: an option of a format says so
+        takes = None
+    for key in options:
+        if takes is not None and key in takes:
+            continue
+        name = f"--{key.replace('_', '-')}" if as_flags else key
+        owners = [what for what, opts in READ_OPTIONS.values() if key in opts]
+        if owners:
+            raise ValueError(f"{name} applies to {' or '.join(owners)} only, not to "
+                             f"{path.name}; drop it")
+        if takes is None:
+            _kind(path, READ_SUFFIXES)
+        raise ValueError(f"unknown option {name!r} for {path.name}; its reader takes "
+                         f"{', '.join(takes) or 'none'}")
 
 
 def read(path, **options) -> Table:
@@ -45,7 +98,9 @@ def read(path, **options) -> Table:
         ``step`` degrees, default 5), or a CUReT ``abrdf.dat`` (needs ``sample=N``; its
         ``table.txt`` must be beside it).
     **options
-        Passed to the reader (``stride`` for MERL, ``step`` for RGL, ``sample`` for CUReT).
+        Passed to the reader (``stride`` and ``keep_missing`` for MERL, ``step`` for RGL,
+        ``sample`` for CUReT; :data:`READ_OPTIONS`); another is refused by name
+        (:func:`check_read_options`) before the file is opened.
 
     Returns
     -------
@@ -54,12 +109,14 @@ def read(path, **options) -> Table:
     Raises
     ------
     ValueError
-        Unknown suffix (the message lists the known ones), or a missing option.
+        Unknown suffix (the message lists the known ones), an option the format does not
+        take, or a missing option.
     FormatError
         The file is not what its name says, truncated or corrupt.
     """
     path = Path(path)
     kind = _kind(path, READ_SUFFIXES)
+    check_read_options(path, options)
     if not path.exists():
         raise FileNotFoundError(2, "No such file", str(path))
     if kind == "exr":

@@ -214,7 +214,7 @@ def _cone_averages(brdf, geometry: Geometry, instrument: Instrument, chunk: int,
                    progress: bool | None) -> np.ndarray:
     """Noiseless cone averages of f_r, (n, 3), chunk by chunk with an optional progress bar."""
     n = len(geometry)
-    per_pair = len(instrument.source_rule[1]) * len(instrument.detector_rule[1])
+    per_pair = instrument.n_source * instrument.n_detector
     step = max(1, chunk // per_pair)
     if progress is None:
         progress = n * per_pair >= PROGRESS_MIN_EVALUATIONS and sys.stderr.isatty()

@@ -12,8 +12,10 @@ import numpy as np
 
 import brdf
 import gonio
+import gonio.io
 import gonio.rgl
 from analysis.budget import RGL_BYTES_PER_PAIR, check_memory
+from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
@@ -27,10 +29,6 @@ __all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_
 MAX_TANGENT_SAMPLES = 4096
 #: Largest --ensembles: R-hat needs a few; each is a group of the one checkpoint.
 MAX_ENSEMBLES = 64
-#: Reader options and the formats (by suffix, or the CUReT file name) they apply to.
-READER_OPTIONS = {"sample": (("abrdf.dat",), "a CUReT abrdf.dat"),
-                  "step": ((".bsdf",), "an RGL .bsdf"),
-                  "stride": ((".binary",), "a MERL .binary")}
 
 
 def _on_off(value: str) -> bool:
@@ -139,15 +137,12 @@ def split_ties(ties):
 def reader_options(path, **options) -> dict:
     """The reader options given (not None) for ``path``, each checked against its format:
     ``--sample`` for a CUReT abrdf.dat, ``--step`` for an RGL .bsdf, ``--stride`` for a MERL
-    .binary; another is refused by name. An RGL ``--step`` too fine for the memory is refused
-    with its estimate."""
+    .binary; another is refused by name (:func:`gonio.io.check_read_options`). An RGL
+    ``--step`` too fine for the memory is refused with its estimate."""
     path = Path(path)
     given = {k: v for k, v in options.items() if v is not None}
-    name, suffix = path.name.lower(), path.suffix.lower()
-    for key, value in given.items():
-        formats, what = READER_OPTIONS[key]
-        if name not in formats and suffix not in formats:
-            raise ValueError(f"--{key} applies to {what} only, not to {path.name}; drop it")
+    if given:
+        gonio.io.check_read_options(path, given, as_flags=True)
     if "stride" in given and given["stride"] < 1:
         raise ValueError(f"--stride must be a positive integer; got {given['stride']}")
     if "sample" in given and not 1 <= given["sample"] <= 61:
@@ -222,7 +217,9 @@ def data_dir(arg=None) -> Path:
 
 
 def check_writable_dir(path: Path) -> Path:
-    """Create ``path`` if needed and check that files can be written in it.
+    """Check that ``path`` can be created (when missing) and written in, leaving nothing
+    behind: a folder created for the check is removed again, so a run refused later leaves
+    no new folder (its writer creates it when it starts).
 
     Raises
     ------
@@ -230,6 +227,7 @@ def check_writable_dir(path: Path) -> Path:
         If the folder cannot be created or written, naming it.
     """
     path = Path(path)
+    created = missing_folders(path)
     try:
         path.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path, prefix=".write-test-"):
@@ -237,4 +235,6 @@ def check_writable_dir(path: Path) -> Path:
     except OSError as exc:
         raise OSError(f"output folder {str(path)!r} is not writable: {exc.strerror or exc}") \
             from None
+    finally:
+        remove_empty_folders(created)
     return path

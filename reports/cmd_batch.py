@@ -70,7 +70,7 @@ def run(args) -> int:
         plots=plots)
     log.info(f"fit-batch: {len(jobs)} tables into {out}")
     summary = run_batch(jobs, out, workers=args.workers, scheduler=args.scheduler,
-                        progress=not args.no_progress)
+                        progress=not args.no_progress, notify=log.info)
     page = write_batch_page(out)
     c = summary.counts()
     print(f"{c.get('converged', 0)} converged, {c.get('not_converged', 0)} not converged, "

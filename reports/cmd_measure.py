@@ -65,6 +65,8 @@ def register(sub):
     i.add_argument("--cone-azimuths", type=int, default=6, metavar="N",
                    help="cone quadrature azimuths per ring (default 6)")
     i.add_argument("--seed", type=int, default=None, help="seed of the noise")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (shown on stderr otherwise, terminal or not)")
     f = p.add_argument_group("fabric variant (defaults: the model's)")
     f.add_argument("--masking", choices=_ON_OFF, default=None)
     f.add_argument("--reweighting", choices=_ON_OFF, default=None)
@@ -100,15 +102,11 @@ def _make_fabric(name: str, options: dict):
 
 
 #: The instrument's parameters and their options, longest name first (messages name them).
-_INSTRUMENT_OPTIONS = (("snr_reference", "--snr-reference"), ("cone_detector", "--cone-detector"),
+_INSTRUMENT_OPTIONS = (("rings x azimuths", "--cone-rings x --cone-azimuths"),
+                       ("snr_reference", "--snr-reference"), ("cone_detector", "--cone-detector"),
                        ("cone_source", "--cone-source"), ("azimuths", "--cone-azimuths"),
                        ("rings", "--cone-rings"), ("floor", "--floor"), ("noise", "--noise"),
                        ("snr", "--snr"))
-
-
-#: Largest --cone-rings and --cone-azimuths (each cone point is one more BRDF evaluation of
-#: every pair; the quadrature is built whole).
-MAX_CONE_POINTS = 256
 
 
 def _instrument(args) -> Instrument:
@@ -117,10 +115,6 @@ def _instrument(args) -> Instrument:
         bad = "--cone-source" if not 0 <= args.cone_source < 90 else "--cone-detector"
         value = args.cone_source if bad == "--cone-source" else args.cone_detector
         raise ValueError(f"{bad} must be a half-angle in [0, 90) degrees; got {value}")
-    for option, value in (("--cone-rings", args.cone_rings),
-                          ("--cone-azimuths", args.cone_azimuths)):
-        if not 1 <= value <= MAX_CONE_POINTS:
-            raise ValueError(f"{option} must be an integer in 1..{MAX_CONE_POINTS}; got {value}")
     try:
         return Instrument(cone_source=args.cone_source, cone_detector=args.cone_detector,
                           snr=args.snr, floor=args.floor, noise=args.noise,
@@ -147,7 +141,7 @@ def _check_size(args, instrument, fabric) -> None:
     what = f"--geometry {args.geometry} ({n:.3g} pairs)"
     nbytes = n * MEASURE_BYTES_PER_PAIR
     check_memory(what, nbytes, "use a coarser step")
-    points = len(instrument.source_rule[1]) * len(instrument.detector_rule[1])
+    points = instrument.n_source * instrument.n_detector      # no quadrature built
     seconds = n * points * SECONDS_PER_EVALUATION * fabric.options["tangent_samples"] / 32
     if seconds > 5:
         print(f"measure: {what} x {points} cone points: about {format_bytes(nbytes)} of "
@@ -167,7 +161,8 @@ def run(args) -> int:
     fabric = _make_fabric(args.fabric, _fabric_options(args))
     _check_size(args, instrument, fabric)
     geometry = from_spec(args.geometry, rotation=math.radians(args.rotation))
-    table = measure(fabric, geometry, instrument, seed=args.seed)
+    table = measure(fabric, geometry, instrument, seed=args.seed,
+                    progress=not args.no_progress)
     if "name" not in table.meta["source"]:
         table.meta["source"]["name"] = args.fabric
     with output_lock(out, "measure", inside=False):   # removes a killed run's .OUT.*.tmp

@@ -20,7 +20,7 @@ import gonio
 from analysis.fit.medians import median_fabric
 from reports import cliutil
 
-__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "parse_planes"]
+__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes"]
 
 #: The views of ``microcyl plot``.
 VIEWS = ("lobes", "slices", "hemisphere", "masking", "albedo", "reciprocity", "table")
@@ -163,6 +163,20 @@ def fitted_fabric(fit, preset=None) -> tuple[brdf.Fabric, str]:
     return m.fabric, m.preset
 
 
+def fitted_model(fit, preset=None):
+    """The model of a fit at its posterior medians, to draw against its table, and its label:
+    the median fabric (tangent offsets scaled by the fit's ``tangent_scale``) times the fit's
+    overall ``scale`` (:attr:`analysis.fit.MedianFabric.model`); the label names the preset
+    and a scale other than 1."""
+    path = Path(fit)
+    try:
+        m = median_fabric(path if path.is_dir() else path.parent, preset=preset)
+    except ValueError as exc:
+        raise ValueError(f"--fit {str(fit)!r}: {exc}") from None
+    scale = "" if m.scale == 1.0 else f", × {m.scale:.3g}"
+    return m.model, f"fit ({m.preset}{scale})"
+
+
 def run_plot(args):
     _check(args)
     # lazy: matplotlib and colour-science (~2 s), which `microcyl --help` and the other
@@ -176,8 +190,8 @@ def run_plot(args):
         models = {n: cliutil.fabric_from_args(n, args)
                   for n in dict.fromkeys(list(args.sources[1:]) + list(args.preset or ()))}
         if args.fit:
-            fab, name = fitted_fabric(args.fit, (args.preset or [None])[0])
-            models[f"fit ({name})"] = fab
+            model, label = fitted_model(args.fit, (args.preset or [None])[0])
+            models[label] = model
         table = gonio.read(args.sources[0])
         _check_incidences(table, args)
         fig = plot_views.table_view(table, models, **opts)

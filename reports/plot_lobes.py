@@ -1,4 +1,5 @@
-"""Lobe plots: polar lobes in a plane of incidence, a comparison of fabrics, and the 3-D lobe.
+"""Lobe plots: polar lobes in a plane of incidence and a comparison of fabrics (the 3-D lobe
+is in :mod:`reports.plot_lobe3d`).
 
 A *plane of incidence* is the vertical plane at azimuth ``phi`` (0 = along the warp, 90 = along
 the weft, 45 = the diagonal). The light sits on the negative side, wi at signed angle
@@ -8,7 +9,6 @@ the weft, 45 = the diagonal). The light sits on the negative side, wi at signed 
 
 from __future__ import annotations
 
-import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, MaxNLocator
@@ -17,10 +17,9 @@ from brdf.frames import from_angles
 from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish, legend_outside,
                                new_axes, pow10_label, quantity_styles, series_styles,
                                reduce_quantity, series_style)
-from reports.colour import luminance
 
 __all__ = ["plane_directions", "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison",
-           "plot_lobe_3d", "log_radius", "plane_name"]
+           "log_radius", "plane_name", "lobe_peak"]
 
 
 def plane_directions(theta_i_deg, theta_o_deg, phi_deg=0.0):
@@ -71,6 +70,47 @@ def _log_floor(peak, decades):
     return 10.0 ** np.floor(np.log10(peak) - decades)
 
 
+def _finite_max(values) -> float:
+    """The largest finite value (0 when there is none)."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    return float(v.max()) if v.size else 0.0
+
+
+def _radius(value, scale, floor) -> float:
+    """The radius of ``value`` (1/sr) on ``scale``."""
+    return float(log_radius(value, floor)) if scale == "log" else float(value)
+
+
+def lobe_peak(brdfs, theta_i_deg, planes_deg, *, quantity="luminance", resolution=181,
+              cosine=False) -> float:
+    """The largest f_r (1/sr) that lobe panels of these BRDFs, incidences and planes draw:
+    the ``peak`` that gives all panels of a figure one set of log decades.
+
+    Parameters
+    ----------
+    brdfs : BRDF or mapping of str to BRDF
+        Objects with ``.eval``.
+    theta_i_deg, planes_deg : float or sequence of float
+        Incidence angles and plane azimuths in degrees.
+    quantity, resolution, cosine
+        As in :func:`plot_polar_lobe`.
+
+    Returns
+    -------
+    float
+        f_r in 1/sr (times cos theta_o when ``cosine``); 0 when nothing is positive.
+    """
+    thetas = np.atleast_1d(check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999))
+    planes = np.atleast_1d(check_angle("planes_deg", planes_deg, -360.0, 360.0))
+    if int(resolution) < 3:
+        raise ValueError(f"resolution must be at least 3; got {resolution}")
+    many = brdfs.values() if isinstance(brdfs, dict) else [brdfs]
+    theta_o = np.linspace(-90.0, 90.0, int(resolution))
+    return max(_finite_max(_plane_curve(b, ti, theta_o, phi, quantity, cosine))
+               for b in many for ti in thetas for phi in planes)
+
+
 def _setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
     """Half-disc polar axes (theta_o from -90 to 90 degrees, the normal up) with radial ticks
     in 8 pt: decades 10^k on a log scale (every other one when more than five), and the
@@ -108,7 +148,8 @@ def _check_scale(scale):
 
 def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantity="luminance",
                     scale="linear", decades=4.0, resolution=181, cosine=False, colour=None,
-                    normalize=False, legend=True, ax=None, filename=None, title=None):
+                    normalize=False, legend=True, peak=None, ax=None, filename=None,
+                    title=None):
     """Polar plot of f_r in a plane of incidence, one curve per incidence angle.
 
     Parameters
@@ -139,6 +180,10 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
         legend gives each peak in 1/sr), so lobes of very different heights all show.
     legend : bool
         Draw the legend under the plot (8 pt); :func:`plot_lobe_planes` draws one for all.
+    peak : float, optional
+        The f_r (1/sr) that sets the log floor and the radial limit, instead of this plot's
+        own largest value: panels of one figure given the figure's peak
+        (:func:`lobe_peak`) share their decades, limits and ticks.
     ax : matplotlib PolarAxes, optional
     filename : str or path, optional
         Save the figure there (atomically) when given.
@@ -163,10 +208,12 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
     fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
     theta_o = np.linspace(-90.0, 90.0, int(resolution))
     curves = [_plane_curve(brdf, ti, theta_o, phi_deg, quantity, cosine) for ti in thetas]
-    peak = max(float(np.nanmax(c)) if np.any(np.isfinite(c)) else 0.0 for c in curves)
-    floor = _log_floor(peak, decades)
+    own = max(_finite_max(c) for c in curves)
+    floor = _log_floor(own if peak is None else peak, decades)
     rmax = _draw_lobes(ax, thetas, theta_o, curves, quantity_styles(quantity, colour), colour,
                        floor if scale == "log" else None, normalize)
+    if peak is not None and not normalize:
+        rmax = max(rmax, _radius(peak, scale, floor))
     label = "f_r cos θo" if cosine else "f_r"
     _setup_polar(ax, scale, floor, rmax,
                  f"{label} / its peak (per curve)" if normalize else f"{label} (1/sr)")
@@ -230,7 +277,9 @@ def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0,
         Figure to draw into (its content is replaced); a new one when None.
     filename : str or path, optional
     **kwargs
-        Passed to :func:`plot_polar_lobe` (quantity, scale, decades, resolution, cosine).
+        Passed to :func:`plot_polar_lobe` (quantity, scale, decades, resolution, cosine);
+        ``peak`` defaults to the largest value of all panels (:func:`lobe_peak`), so that
+        they share their radial limit and, on a log scale, their decades.
 
     Returns
     -------
@@ -244,6 +293,11 @@ def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0,
         fig.clear()
     axes = [fig.add_subplot(1, len(planes), n + 1, projection="polar")
             for n in range(len(planes))]
+    if not kwargs.get("normalize") and "peak" not in kwargs:      # one set of decades
+        kwargs["peak"] = lobe_peak(brdf, theta_i_deg, planes,
+                                   quantity=kwargs.get("quantity", "luminance"),
+                                   resolution=kwargs.get("resolution", 181),
+                                   cosine=kwargs.get("cosine", False))
     for ax, phi in zip(axes, planes):
         plot_polar_lobe(brdf, theta_i_deg, phi, ax=ax, legend=False,
                         title=f"plane φ = {float(phi):g}° ({plane_name(phi)})", **kwargs)
@@ -263,8 +317,8 @@ def plane_name(phi_deg) -> str:
 
 
 def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", decades=4.0,
-                         resolution=181, quantity="luminance", legend=True, ax=None,
-                         filename=None, title=None):
+                         resolution=181, quantity="luminance", legend=True, peak=None,
+                         ax=None, filename=None, title=None):
     """Luminance lobes of several BRDFs in one polar plot, each in its own colour and line
     style (:func:`reports._plotting.series_styles`: a preset's style is the same in every
     figure).
@@ -281,6 +335,8 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
         What of f_r is drawn.
     legend : bool
         Draw the legend under the plot (8 pt).
+    peak : float, optional
+        As in :func:`plot_polar_lobe`: the figure's peak f_r (1/sr), for shared decades.
 
     Returns
     -------
@@ -296,9 +352,9 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
         raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b'; got 'rgb'")
     data = {name: reduce_quantity(eval_brdf(b, wi, wo), quantity)
             for name, b in dict(brdfs).items()}
-    peak = max((float(np.nanmax(v)) for v in data.values()), default=0.0)
-    floor = _log_floor(peak, decades)
-    rmax = 0.0
+    own = max((_finite_max(v) for v in data.values()), default=0.0)
+    floor = _log_floor(own if peak is None else peak, decades)
+    rmax = 0.0 if peak is None else _radius(peak, scale, floor)
     styles = series_styles(data)
     for name, y in data.items():
         r = log_radius(y, floor) if scale == "log" else y
@@ -317,63 +373,3 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
 
 def _what(quantity) -> str:
     return "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
-
-
-def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resolution=(30, 60),
-                 ax=None, filename=None, title=None):
-    """3-D lobe: the surface r(wo) wo over the upper hemisphere for a fixed wi.
-
-    Parameters
-    ----------
-    brdf : object with ``.eval``
-    theta_i_deg, phi_i_deg : float
-        Direction of the light in degrees.
-    cosine : bool
-        r = luminance(f_r) cos(theta_o) when True (the visible lobe), luminance(f_r) when False;
-        in 1/sr.
-    resolution : (int, int)
-        Samples in theta_o over [0, 90] and in phi_o over [0, 360] degrees.
-    ax : Axes3D, optional
-    filename : str or path, optional
-
-    Returns
-    -------
-    (fig, ax)
-        The surface is ``ax.collections[0]``; its z extent is the largest r cos(theta_o).
-    """
-    check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999)
-    nt, npf = (int(v) for v in resolution)
-    if nt < 2 or npf < 3:
-        raise ValueError(f"resolution must be at least (2, 3); got {resolution}")
-    fig, ax = new_axes(ax, projection="3d", figsize=(5.0, 4.5))
-    t = np.radians(np.linspace(0.0, 90.0, nt))
-    p = np.radians(np.linspace(0.0, 360.0, npf))
-    T, P = np.meshgrid(t, p, indexing="ij")
-    wo = from_angles(T, P)
-    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
-    r = luminance(eval_brdf(brdf, wi, wo))
-    if cosine:
-        r = r * np.cos(T)
-    X, Y, Z = (r * wo[..., k] for k in range(3))
-    norm = matplotlib.colors.Normalize(0.0, max(float(np.nanmax(r)), 1e-12))
-    facecolors = matplotlib.colormaps["viridis"](norm(r))
-    ax.plot_surface(X, Y, Z, facecolors=facecolors, rstride=1, cstride=1, linewidth=0,
-                    antialiased=False, shade=False)
-    ext = max(float(np.nanmax(np.abs([X, Y, Z]))), 1e-12)
-    ax.plot([0, wi[0] * ext], [0, wi[1] * ext], [0, wi[2] * ext], color="orange", lw=1.5,
-            label="wi")
-    ax.set_xlim(-ext, ext)
-    ax.set_ylim(-ext, ext)
-    ax.set_zlim(0, ext)
-    ax.set_xlabel("x: warp", fontsize=FONT["label"], labelpad=12)
-    ax.set_ylabel("y: weft", fontsize=FONT["label"], labelpad=12)
-    ax.set_zlabel("z", fontsize=FONT["label"], labelpad=10)
-    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
-        axis.set_major_locator(MaxNLocator(3))
-    ax.tick_params(labelsize=FONT["small"], pad=1)
-    what = "luminance f_r cos θo" if cosine else "luminance f_r"
-    sm = matplotlib.cm.ScalarMappable(norm=norm, cmap="viridis")
-    fig.colorbar(sm, ax=ax, shrink=0.7, pad=0.12, label=f"{what} (1/sr)")
-    ax.set_title(title or f"3-D lobe, θi = {float(theta_i_deg):g}°, φi = {float(phi_i_deg):g}°"
-                 f"\n(x, y, z: r wo, r in 1/sr)", fontsize=FONT["title"])
-    return finish(fig, ax, filename)

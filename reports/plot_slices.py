@@ -225,7 +225,11 @@ def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4
     im = ax.imshow(np.ma.masked_where(~(img > 0), img), origin="lower", extent=(0, 90, 0, 90),
                    norm=norm, cmap=_CMAP(), interpolation="nearest", aspect="equal")
     zero = " (grey: f_r = 0)" if np.any(~(img > 0)) else ""
-    cb = fig.colorbar(im, ax=ax, extend="min" if log else "neither")
+    # the bar in an inset just right of the image (axes coordinates: it follows the image
+    # box, which aspect="equal" shrinks; a bar stealing space from the axes would sit where
+    # the axes were, leaving a gap)
+    cax = ax.inset_axes([1.04, 0.0, 0.05, 1.0])
+    cb = fig.colorbar(im, cax=cax, extend="min" if log else "neither")
     cb.set_label(f"luminance f_r (1/sr){zero}", fontsize=FONT["label"])
     cb.ax.tick_params(labelsize=FONT["small"])
     ax.set_xlabel("θh (degrees)", fontsize=FONT["label"])

@@ -20,7 +20,7 @@ from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
 from reports.plot_fit import plane_incidences, plot_table_models
 from reports.plot_hemisphere import plot_hemisphere
-from reports.plot_lobes import plane_name, plot_lobe_comparison, plot_lobe_planes
+from reports.plot_lobes import lobe_peak, plane_name, plot_lobe_comparison, plot_lobe_planes
 from reports.plot_masking import plot_masking_lobes
 from reports.plot_reciprocity import plot_reciprocity_map
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
@@ -67,10 +67,11 @@ def lobes_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",
     if scale == "normalized":
         raise ValueError("--scale normalized draws one fabric only; give log or linear")
     fig, axes = _grid(len(theta_i), len(planes), (4.2, 2.7), polar=True)
+    peak = lobe_peak(fabrics, theta_i, planes, quantity=quantity, resolution=res)
     for row, ti in zip(axes, theta_i):
-        for ax, phi in zip(row, planes):
+        for ax, phi in zip(row, planes):     # one peak: the same decades in every panel
             plot_lobe_comparison(fabrics, ti, phi, scale=scale, resolution=res,
-                                 quantity=quantity, legend=False, ax=ax)
+                                 quantity=quantity, legend=False, peak=peak, ax=ax)
     _figure_legend(fig, axes[0][0], ncol=3)
     return fig
 

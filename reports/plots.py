@@ -26,7 +26,8 @@ from reports.plot_albedo import plot_albedo
 from reports.plot_fit import plane_points, plot_fit_overlay
 from reports.plot_hemisphere import (equal_area_grid, equal_area_xy, hemisphere_image,
                                      plot_hemisphere)
-from reports.plot_lobes import (plane_directions, plot_lobe_3d, plot_lobe_comparison,
+from reports.plot_lobe3d import plot_lobe_3d
+from reports.plot_lobes import (lobe_peak, plane_directions, plot_lobe_comparison,
                                 plot_lobe_planes, plot_polar_lobe)
 from reports.plot_masking import masking_terms, plot_masking_lobes, plot_masking_terms
 from reports.plot_reciprocity import plot_reciprocity_map, reciprocity_map
@@ -35,7 +36,7 @@ from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slic
 from reports._plotting import half_diff_to_io, save_figure
 
 __all__ = [
-    "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison", "plot_lobe_3d",
+    "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison", "plot_lobe_3d", "lobe_peak",
     "plot_slice_theta_o", "plot_slice_theta_h", "plot_slice_theta_d", "plot_slice_image",
     "plot_hemisphere", "plot_albedo", "plot_masking_lobes", "plot_masking_terms",
     "plot_reciprocity_map", "plot_fit_overlay",

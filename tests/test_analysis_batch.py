@@ -163,3 +163,44 @@ def test_job_key_follows_its_inputs(tmp_path, inputs):
                                  free=FREE).key()
     assert job.key() != BatchJob("t0", str(inputs / "t0.csv"), preset=PRESET,
                                  free=("kd1",)).key()
+
+
+def test_the_batch_estimate_is_tables_times_one_fit_over_the_workers(monkeypatch, inputs):
+    """100 s a table (a stand-in for the timing), 5 tables: ceil(5 / 2) x 100 s = 5 min on
+    two workers, 500 s = 8 min shared by a scheduler's workers; a table that cannot be read
+    is skipped for the estimate; --time-limit caps a table's time."""
+    import analysis.batch.engine as engine
+    timed = []
+
+    def fake(job):
+        timed.append(job.name)
+        if job.name == "unreadable":
+            raise ValueError("unreadable.csv: not a table")
+        return 100.0, "fit: ..."
+    monkeypatch.setattr(engine, "estimate_job", fake)
+    jobs = [BatchJob(name, f"{name}.csv", preset=PRESET)
+            for name in ("unreadable", "a", "b", "c", "d")]
+    line = engine.estimate_batch(jobs, workers=2)
+    assert timed == ["unreadable", "a"]                  # one fit timed, the first readable
+    assert line.startswith("fit-batch: 5 tables to fit, up to 100 s each (estimated on a)")
+    assert "so up to 5 min on 2 workers" in line
+    assert "up to 8 min of fitting in all, shared by the workers of tcp://h:1" in \
+        engine.estimate_batch(jobs, scheduler="tcp://h:1")
+    assert "up to 100 s on 5 workers" in engine.estimate_batch(jobs, workers=8)
+    capped = [BatchJob("a", "a.csv", preset=PRESET, fit={"time_limit": 30.0})] * 3
+    assert "up to 30 s each (estimated on a, --time-limit), so up to 60 s on 2 workers" in \
+        engine.estimate_batch(capped, workers=2)
+    assert engine.estimate_batch([BatchJob("unreadable", "u.csv")]) is None
+
+
+def test_estimate_job_times_the_fit_a_worker_runs(inputs):
+    from analysis.batch.worker import estimate_job
+    job = BatchJob("t1", str(inputs / "t1.csv"), preset=PRESET, free=FREE, ties=(),
+                   fit={"max_steps": 1000})
+    seconds, line = estimate_job(job)
+    assert 0 < seconds < 600 and "for --max-steps 1000" in line
+    one = gonio.read(str(inputs / "t1.csv"))
+    tiny = gonio.Table(one.wi[:1], one.wo[:1], one.values[:1], sigma=one.sigma[:1])
+    with pytest.raises(ValueError, match="table has 3 valid values for"):
+        estimate_job(BatchJob("t1", "t1.csv", preset=PRESET, free=("kd1", "gamma_s1", "eta1"),
+                              ties=(), loader=lambda: tiny))

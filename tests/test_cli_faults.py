@@ -98,6 +98,31 @@ def test_a_lock_of_a_killed_process_is_taken_over(tmp_path):
                 pass
 
 
+def test_a_lock_that_created_its_folder_removes_it_when_the_run_fails(tmp_path):
+    """A run refused inside the lock (a fit whose start cannot be evaluated, a batch's bad
+    job) leaves no new folder; one that wrote something, or an existing folder, stays."""
+    new = tmp_path / "a" / "b"
+    with pytest.raises(ValueError, match="refused"):
+        with output_lock(new, "fit"):
+            assert new.is_dir()
+            raise ValueError("refused")
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(KeyboardInterrupt):
+        with output_lock(new, "fit"):
+            (new / "checkpoint.h5").write_text("steps done")
+            raise KeyboardInterrupt
+    assert sorted(p.name for p in new.iterdir()) == ["checkpoint.h5"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(ValueError):
+        with output_lock(empty, "fit"):
+            raise ValueError("refused")
+    assert empty.is_dir() and list(empty.iterdir()) == []
+    with output_lock(tmp_path / "ok", "fit"):      # a run that ends well keeps its folder
+        pass
+    assert (tmp_path / "ok").is_dir()
+
+
 def _killed_mid_write(path):
     """A process that dies (SIGKILL) inside gonio.atomic_write of ``path``."""
     code = ("import os, signal, sys; from gonio import atomic_write\n"

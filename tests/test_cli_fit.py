@@ -76,3 +76,30 @@ def test_bad_input_is_one_line(table_file, tmp_path, capsys):
     spec.write_text('free = ["gamma_s1"]\n[bounds]\ngamma_s1 = [6.0, 30.0]\n')
     assert main(base + ["--spec", str(spec)]) == 1
     assert "start value of gamma_s1" in capsys.readouterr().err
+
+
+def test_a_refused_fit_leaves_no_new_folder(tmp_path, capsys):
+    """Refusals that need the table (too few values, chains larger than memory): no new
+    folder left (nor its new parent), an existing folder left as it was."""
+    table, _ = fabric_table("silk_crepe_de_chine", n=1, seed=3)     # 3 values
+    few = tmp_path / "few.csv"
+    _write_csv(table, few)
+    silk = tmp_path / "silk.csv"
+    _write_csv(fabric_table("silk_crepe_de_chine", n=40, seed=4)[0], silk)
+    cases = [
+        (few, ["--free", "gamma_s1,kd1,eta1", "--tie", "none"], "3 valid values"),
+        (silk, ["--free", "kd1", "--walkers", "2000000", "--max-steps", "20000"], "memory"),
+    ]
+    existing = tmp_path / "existing"
+    existing.mkdir()
+    (existing / "notes.txt").write_text("mine")
+    for table_path, extra, message in cases:
+        new = tmp_path / "new" / "deeper"
+        for out in (new, existing):
+            args = ["fit", str(table_path), "--fabric", "silk_crepe_de_chine",
+                    "--no-progress", "--no-plots", "-o", str(out)] + extra
+            assert main(args) == 1
+            err = capsys.readouterr().err
+            assert message in err and len(err.strip().splitlines()) == 1, err
+            assert not (tmp_path / "new").exists(), (extra, sorted(tmp_path.iterdir()))
+            assert sorted(p.name for p in existing.iterdir()) == ["notes.txt"]

@@ -46,6 +46,10 @@ def test_fit_batch_with_progress_a_corrupt_table_and_the_page(tables, tmp_path):
     r = microcyl("fit-batch", src, *FIT, "--workers", "2", "-o", out)
     assert r.returncode == 1, r.stderr                 # one table failed
     assert "fits:" in r.stderr and "table" in r.stderr     # tqdm's bar over tables
+    # the estimate, once, before the batch: 3 tables, the corrupt one skipped for timing
+    est = [x for x in r.stderr.splitlines() if x.startswith("fit-batch: 3 tables to fit")]
+    assert len(est) == 1 and "(estimated on silk0)" in est[0] and "on 2 workers" in est[0]
+    assert r.stderr.index(est[0]) < r.stderr.index("fits:")
     assert "broken: error" in r.stdout and "broken.exr" in r.stdout
     assert "2 converged, 0 not converged, 1 errors" in r.stdout
     rows = {x["name"]: x for x in json.loads((out / "summary.json").read_text())["tables"]}
@@ -56,6 +60,7 @@ def test_fit_batch_with_progress_a_corrupt_table_and_the_page(tables, tmp_path):
             assert f'{name}/{plot}' in page and (out / name / plot).exists()
     again = microcyl("fit-batch", src, *FIT, "--workers", "1", "--no-progress", "-o", out)
     assert again.returncode == 1 and "silk0:" not in again.stdout   # converged: not redone
+    assert "to fit" not in again.stderr         # only the corrupt table left: no estimate
 
 
 def _wait_for(path, timeout=60.0):

@@ -130,3 +130,24 @@ def test_measure_writes_a_readable_table(tmp_path):
     ref = gonio.measure(fab, "plane:warp:30", gonio.Instrument(snr=40), seed=2)
     assert len(table) == len(ref)
     assert np.allclose(table.values, ref.values, rtol=1e-6, atol=1e-7)   # float32 on disk
+
+
+def test_progress_shows_on_a_pipe_unless_turned_off(tmp_path):
+    """As a user runs it, stderr a pipe (not a terminal): tqdm's bar over the pairs, as
+    `microcyl fit` shows its own; --no-progress draws none."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    runs = {}
+    for flag in ([], ["--no-progress"]):
+        out = tmp_path / f"t{len(flag)}.exr"
+        r = subprocess.run([sys.executable, "-m", "reports", "measure", "velvet", "--geometry",
+                            "full:30", "--tangent-samples", "4", *flag, "-o", str(out)],
+                           env=env, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        assert len(gonio.read(out)) == 625                 # full:30: 625 pairs
+        runs[bool(flag)] = r.stderr
+    assert "measure:" in runs[False] and "625" in runs[False] and "pair" in runs[False]
+    assert "measure:" not in runs[True] and "%|" not in runs[True]

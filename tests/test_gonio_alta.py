@@ -265,3 +265,20 @@ def test_write_refuses_a_table_without_rows_to_keep(tmp_path):
     with pytest.raises(ValueError, match="digits must be an integer >= 1"):
         gonio.write_alta(t, tmp_path / "t.alta", digits=2.5)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("param", ["SPHERICAL_TL_PL_TV_PV", "RUSIN_TH_PH_TD_PD"])
+def test_directions_near_the_normal_round_trip(tmp_path, param):
+    """A direction 1e-8 rad off the normal came back on it (theta from arccos(z), whose
+    z = 1 - 5e-17 rounds to 1); now to the last digits (Rusinkiewicz: to 1e-12, where
+    phi_h is taken as 0)."""
+    wo = np.array([[1e-8, 0.0, 1.0], [3e-9, -4e-9, 1.0], [0.0, 0.0, 1.0]])
+    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    wi = np.array([[0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [0.0, 1e-10, 1.0]])
+    t = gonio.Table(wi, wo, np.full((3, 3), 0.25))
+    gonio.write(t, tmp_path / "t.alta", param=param)
+    back = gonio.read(tmp_path / "t.alta")
+    atol = 1e-15 if param.startswith("SPHERICAL") else 1e-12
+    np.testing.assert_allclose(back.wo, t.wo, rtol=0, atol=atol)
+    np.testing.assert_allclose(back.wi, t.wi, rtol=0, atol=atol)
+    assert back.wo[0, 0] > 0.99e-8 and np.array_equal(back.values, t.values)

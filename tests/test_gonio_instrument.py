@@ -168,3 +168,25 @@ def test_noise_parameters_whose_arithmetic_would_overflow_are_refused(kw, name):
     """An snr of 1e-213 made sigma infinite, 1e200 raised OverflowError in snr ** 2."""
     with pytest.raises(ValueError, match=f"^{name} must be"):
         Instrument(**kw)
+
+
+def test_sizes_are_checked_before_any_quadrature_is_built(monkeypatch):
+    """rings and azimuths each at most 256, a pair at most 2^22 evaluations (both cones
+    open: (rings x azimuths)^2), refused on construction with the size; no rule built."""
+    import gonio.instrument as instrument
+
+    def never(*args, **kw):
+        raise AssertionError("quadrature built during the checks")
+    monkeypatch.setattr(instrument, "cap_quadrature", never)
+    for kwargs, match in (({"rings": 10 ** 7}, r"rings must be an integer in 1\.\.256; got "
+                                               r"10000000"),
+                          ({"azimuths": 257}, r"azimuths must be an integer in 1\.\.256"),
+                          ({"cone_source": 2, "cone_detector": 2, "rings": 64,
+                            "azimuths": 33},   # 2,112 points a cone: 4,460,544 a pair
+                           r"64 x 33 points a cone.*4,460,544 evaluations for each pair "
+                           r"\(about [0-9.]+ GiB at once\); at most 4,194,304")):
+        with pytest.raises(ValueError, match=match):
+            Instrument(**kwargs)
+    ok = [Instrument(cone_source=2, cone_detector=2, rings=64, azimuths=32),   # 2^22
+          Instrument(cone_detector=2, rings=256, azimuths=256)]                 # one cone
+    assert [i.n_source * i.n_detector for i in ok] == [2048 ** 2, 256 * 256]

@@ -40,3 +40,27 @@ def test_write_needs_table(tmp_path):
         gonio.write(object(), tmp_path / "x.exr")
     with pytest.raises(ValueError, match="Table or an object with eval"):
         gonio.write(object(), tmp_path / "x.binary")
+
+
+def test_read_refuses_an_option_its_format_does_not_take(tmp_path, shared_data):
+    """Each option is checked against the file's format by name, before the file is read
+    (even a missing file is refused for its option first)."""
+    t = random_table(1)
+    gonio.write(t, tmp_path / "t.csv")
+    gonio.write(t, tmp_path / "t.exr")
+    cases = [(tmp_path / "t.csv", {"stride": 2}, r"stride applies to a MERL \.binary only, "
+                                                 r"not to t\.csv"),
+             (tmp_path / "t.exr", {"sample": 3}, r"sample applies to a CUReT abrdf\.dat only"),
+             (tmp_path / "t.csv", {"step": 5}, r"step applies to an RGL \.bsdf only"),
+             (tmp_path / "none.alta", {"stride": 2}, r"stride applies to a MERL"),
+             (tmp_path / "t.csv", {"colour": 1}, r"unknown option 'colour' for t\.csv; its "
+                                                 r"reader takes none"),
+             (shared_data / "curet" / "abrdf.dat", {"sample": 44, "step": 5},
+              r"step applies to an RGL \.bsdf only, not to abrdf\.dat")]
+    for path, options, message in cases:
+        with pytest.raises(ValueError, match=message):
+            gonio.read(path, **options)
+    with pytest.raises(ValueError, match=r"unknown option 'strid' for x\.binary; its reader "
+                                         r"takes stride, keep_missing"):
+        gonio.read(tmp_path / "x.binary", strid=2)
+    assert len(gonio.read(shared_data / "curet" / "abrdf.dat", sample=44)) == 205

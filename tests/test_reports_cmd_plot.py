@@ -261,3 +261,44 @@ def test_overview_figures_text_does_not_overlap(tmp_path):
     overview._lobes(page, reports)
     for fig in page.figures.values():
         assert_no_overlap(fig)
+
+
+def test_plot_table_draws_the_fits_model_with_its_tangent_and_overall_scales(tmp_path):
+    """A fit of relative data with tangent_scale1 = 1.5 and scale = 0.5: the curve drawn is
+    what the fit's own forward model predicts at the medians (analysis.fit.FabricModel with
+    tangent_scale, times scale), not the preset's f_r."""
+    from analysis.fit import FabricModel
+    from analysis.params import ParamSpec, defaults_from_fabric
+    from reports.cmd_plot import fitted_model
+    preset = "silk_crepe_de_chine"
+    folder = tmp_path / "fit"
+    folder.mkdir()
+    spec = ParamSpec(["kd1", "tangent_scale1", "scale"],
+                     defaults=defaults_from_fabric(brdf.fabric(preset)))
+    doc = {"schema": "microcyl-fit", "schema_version": 2, "converged": True, "reason": "",
+           "parameters": {"kd1": {"median": 0.05}, "tangent_scale1": {"median": 1.5},
+                          "scale": {"median": 0.5}},
+           "fit": {"ties": {}}, "quality": {}, "plots": {}}
+    (folder / "results.json").write_text(json.dumps(doc))
+    (folder / "fit_config.json").write_text(json.dumps(
+        {"config": {"spec": spec.describe(), "extra": {"fabric": preset, "options": {}}}}))
+    model, label = fitted_model(folder)
+    assert label == f"fit ({preset}, × 0.5)"
+    x = np.linspace(-90.0, 90.0, 19)
+    t = np.radians(np.abs(x))
+    wo = np.stack([np.sin(t) * np.sign(x), np.zeros_like(t), np.cos(t)], -1)  # plane φ = 0
+    wi = np.array([-np.sin(np.radians(30.0)), 0.0, np.cos(np.radians(30.0))])
+    base = brdf.fabric(preset)
+    fab0 = base.replace(threads=(base.threads[0].replace(kd=0.05),) + base.threads[1:])
+    ref = 0.5 * FabricModel(fab0, np.broadcast_to(wi, wo.shape), wo)(
+        tangent_scale=np.array([1.5, 1.0]))
+    table = Table(np.broadcast_to(wi, (5, 3)), wo[::4][:5], np.full((5, 3), 0.1))
+    from reports.plot_fit import plot_table_models
+    fig, ax = plot_table_models(table, {label: model}, 30.0, 0.0, resolution=19,
+                            log=False)
+    y = {l.get_gid(): l.get_ydata() for l in ax.get_lines()}[f"model {label}"]
+    lum = ref @ np.array([0.2126, 0.7152, 0.0722])
+    assert np.allclose(y[1:-1], lum[1:-1], rtol=1e-9)
+    unscaled = brdf.fabric(preset).eval(np.broadcast_to(wi, wo.shape), wo) @ \
+        np.array([0.2126, 0.7152, 0.0722])
+    assert not np.allclose(y[1:-1], unscaled[1:-1], rtol=1e-2)     # not the preset's f_r

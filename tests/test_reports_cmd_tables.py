@@ -37,6 +37,16 @@ def test_errors_are_one_line(tmp_path, capsys):
     assert not (tmp_path / "out.exr").exists()
     assert main(["info", str(tmp_path / "x.unknown")]) == 1
     assert "known: .exr" in capsys.readouterr().err
+    good = tmp_path / "t.csv"
+    gonio.write(random_table(0), good)
+    for argv, message in ((["info", str(good), "--stride", "2"],
+                           "--stride applies to a MERL .binary only, not to t.csv; drop it"),
+                          (["convert", str(good), str(tmp_path / "o.exr"), "--step", "5"],
+                           "--step applies to an RGL .bsdf only, not to t.csv; drop it")):
+        assert main(argv) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.strip().endswith(f"error: {message}"), err
+    assert not (tmp_path / "o.exr").exists()
 
 
 def test_convert_alta_param(tmp_path, capsys):

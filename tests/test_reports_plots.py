@@ -92,6 +92,46 @@ def test_lobe_planes_and_comparison(velvet, silk):
                        (ev(silk, sph(40.0, 270.0), wo) @ W)[1:-1])
 
 
+
+def _tick_texts(ax):
+    return [t.get_text() for t in ax.get_yticklabels()]
+
+
+def test_log_lobe_panels_share_their_decades(velvet, silk):
+    """Every panel of a log figure: one floor (the power of 10 four decades below the
+    figure's peak, found here from eval), so the same radius is the same f_r in each, and
+    the same radial limit and tick labels."""
+    from reports.plot_views import lobes_view
+    thetas, planes, n = (0.0, 30.0, 60.0), (0.0, 45.0, 90.0), 37
+    fig, axes = plots.plot_lobe_planes(velvet, thetas, planes, scale="log", resolution=n)
+    x = np.linspace(-90, 90, n)
+    lum = {}
+    for phi in planes:
+        wo = np.where((x >= 0)[:, None], sph(np.abs(x), phi), sph(np.abs(x), phi + 180.0))
+        for ti in thetas:
+            lum[phi, ti] = ev(velvet, sph(ti, phi + 180.0), wo) @ W
+    peaks = {phi: max(lum[phi, ti].max() for ti in thetas) for phi in planes}
+    assert max(peaks.values()) > 2 * min(peaks.values())   # the panels' own scales differ
+    floor = 10.0 ** np.floor(np.log10(max(peaks.values())) - 4)
+    for ax, phi in zip(axes, planes):
+        lines = lines_by_gid(ax)
+        for ti in thetas:
+            y = lines[f"lobe theta_i={ti:g} luminance"].get_ydata()
+            ref = np.log10(np.maximum(lum[phi, ti], floor) / floor)
+            assert np.allclose(y[1:-1], ref[1:-1], atol=1e-9)
+        assert ax.get_ylim() == axes[0].get_ylim()
+        assert list(ax.get_yticks()) == list(axes[0].get_yticks())
+        assert _tick_texts(ax) == _tick_texts(axes[0])
+    assert axes[0].get_ylim()[1] >= np.log10(max(peaks.values()) / floor)
+    # several fabrics: a grid of comparisons, one set of decades for all of it
+    fig = lobes_view({"velvet": velvet, "silk": silk}, theta_i=(30.0, 60.0), planes=(0.0, 90.0),
+                     resolution=n)
+    polar = [ax for ax in fig.axes if ax.name == "polar"]
+    assert len(polar) == 4
+    assert len({ax.get_ylim() for ax in polar}) == 1
+    assert len({tuple(_tick_texts(ax)) for ax in polar}) == 1
+
+
 def test_saves_only_when_given_a_filename(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     lam = Lambert()
@@ -159,6 +199,32 @@ def test_slice_image_equals_eval(velvet):
     wi, wo = plots.half_diff_to_io(np.radians(centres[c]), np.radians(centres[r]),
                                    np.radians(90.0))
     assert img[r, c] == pytest.approx(float(ev(velvet, wi, wo) @ W))
+
+
+
+def _bar_gap(fig, ax):
+    """(gap between the image's right edge and its colour bar's left edge, image width),
+    in pixels of the drawn figure; the bar is the axes holding a colour bar of the image."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    im = ax.images[0]
+    bar = im.colorbar.ax
+    img_box = ax.get_window_extent()
+    return bar.get_window_extent().x0 - img_box.x1, img_box.width
+
+
+def test_the_colour_bar_sits_beside_its_image(velvet):
+    """No wide gap between an image and its colour bar: at most a tenth of the image's
+    width, alone and in the slices view's grid (whose image keeps its aspect)."""
+    from reports.plot_views import slices_view
+    fig, ax = plots.plot_slice_image(velvet, 90.0, resolution=8)
+    gap, width = _bar_gap(fig, ax)
+    assert 0 <= gap <= 0.1 * width, (gap, width)
+    fig = slices_view({"velvet": velvet}, resolution=9)
+    ax = next(a for a in fig.axes if a.images)
+    gap, width = _bar_gap(fig, ax)
+    assert 0 <= gap <= 0.1 * width, (gap, width)
 
 
 def test_hemisphere_is_equal_area_and_equals_eval(silk):

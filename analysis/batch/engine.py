@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import os
 import signal
 import time
@@ -20,11 +21,12 @@ from typing import Callable
 
 from analysis.batch.jobs import BatchJob
 from analysis.batch.summary import BatchSummary
-from analysis.batch.worker import error_row, run_job
+from analysis.batch.worker import error_row, estimate_job, run_job
+from analysis.budget import format_seconds
 from analysis.folderlock import output_lock
 from gonio.progress import progress_bar
 
-__all__ = ["run_batch", "BatchInterrupted", "describe_row"]
+__all__ = ["run_batch", "BatchInterrupted", "describe_row", "estimate_batch"]
 
 
 class BatchInterrupted(KeyboardInterrupt):
@@ -87,9 +89,57 @@ def describe_row(row: dict) -> str:
     return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
 
 
+def estimate_batch(todo: list[BatchJob], workers: int | None = None,
+                   scheduler: str | None = None) -> str | None:
+    """One line: the estimated time of a batch, before it starts.
+
+    The fit of the first job whose table can be read is timed
+    (:func:`~analysis.batch.worker.estimate_job`: its steps and point estimate, at most
+    ``max_steps`` steps; at most ``time_limit`` when the job has one), and the batch takes
+    ``ceil(tables / workers)`` times that on a local cluster of ``workers`` processes
+    (default the cores); on a ``scheduler``, ``tables`` times it, shared by its workers.
+
+    Parameters
+    ----------
+    todo : list of BatchJob
+        The jobs to fit (not those already converged).
+    workers : int, optional
+        Worker processes of the local cluster (default: the cores).
+    scheduler : str, optional
+        The address of an existing scheduler (its workers unknown here).
+
+    Returns
+    -------
+    str or None
+        The line; None when there is nothing to fit or no table of ``todo`` can be read
+        (each such table's error is then the batch's to report).
+    """
+    for job in todo:
+        try:
+            per, _ = estimate_job(job)
+        except Exception:               # noqa: BLE001 - the batch reports this table's error
+            continue
+        break
+    else:
+        return None
+    limit = job.fit.get("time_limit")
+    capped = limit is not None and limit < per
+    per = min(per, limit) if capped else per
+    n = len(todo)
+    head = (f"fit-batch: {n} table{'s' * (n != 1)} to fit, up to {format_seconds(per)} each "
+            f"(estimated on {job.name}{', --time-limit' if capped else ''})")
+    if scheduler is not None:
+        return (f"{head}: up to {format_seconds(n * per)} of fitting in all, shared by the "
+                f"workers of {scheduler} (convergence usually stops a fit sooner)")
+    w = min(workers or os.cpu_count() or 1, n)
+    return (f"{head}, so up to {format_seconds(math.ceil(n / w) * per)} on {w} "
+            f"worker{'s' * (w != 1)} (convergence usually stops a fit sooner)")
+
+
 def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
-              echo: Callable[[str], None] | None = print) -> BatchSummary:
+              echo: Callable[[str], None] | None = print,
+              notify: Callable[[str], None] | None = None) -> BatchSummary:
     """Fit every job on Dask into ``out_dir/<name>``, keeping the summaries up to date.
 
     Jobs that converged before with the same inputs (:meth:`BatchSummary.done`) are not
@@ -109,6 +159,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
         One bar over the tables (stderr).
     echo : callable, optional
         Receives one line per table as it ends (None: silent).
+    notify : callable, optional
+        Receives the batch's estimated time (:func:`estimate_batch`) before it starts.
 
     Returns
     -------
@@ -132,6 +184,9 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
     with output_lock(out, "batch"):
         summary = BatchSummary(out)
         todo = [j for j in jobs if not summary.done(j)]
+        line = estimate_batch(todo, workers, scheduler) if notify and todo else None
+        if line is not None:
+            notify(line)
         with progress_bar(len(jobs), desc="fits", unit="table", enabled=progress,
                           initial=len(jobs) - len(todo)) as bar:
             say = (bar.write if progress else echo) if echo is not None else None

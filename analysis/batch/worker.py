@@ -6,9 +6,11 @@ import time
 from pathlib import Path
 
 from analysis.batch.jobs import BatchJob, read_job_table
+from analysis.fit.driver import estimate_fit_time
+from analysis.fit.posterior import FabricModel
 from analysis.fit.workflow import fit_fabric
 
-__all__ = ["run_job", "result_row", "error_row"]
+__all__ = ["run_job", "estimate_job", "result_row", "error_row"]
 
 
 def run_job(job: BatchJob, out_dir) -> dict:
@@ -48,6 +50,18 @@ def run_job(job: BatchJob, out_dir) -> dict:
     except Exception as exc:        # noqa: BLE001 - the batch records it and goes on
         return error_row(job, exc, time.perf_counter() - t0)
     return result_row(job, result, time.perf_counter() - t0)
+
+
+def estimate_job(job: BatchJob) -> tuple[float, str]:
+    """The estimated time of :func:`run_job`'s fit of ``job`` from scratch, as a worker runs
+    it (one thread): :func:`analysis.fit.driver.estimate_fit_time`'s (seconds at most, line).
+    Reads the table; raises what reading it or the fit's checks raise."""
+    table = read_job_table(job)
+    fab = job.fabric()
+    fit_kw = dict(job.fit)
+    fit_kw.setdefault("threads", 1)
+    return estimate_fit_time(table, job.param_spec(fab), FabricModel(fab, table.wi, table.wo),
+                             **fit_kw)
 
 
 def _base(job: BatchJob) -> dict:

@@ -59,7 +59,7 @@ from analysis.fit.convergence import Criteria, Diagnosis
 from analysis.fit.driver import FitOptions, fit
 from analysis.fit.ensemble import Chain, EnsembleRunner
 from analysis.fit.lockstep import LockStep
-from analysis.fit.medians import MedianFabric, median_fabric
+from analysis.fit.medians import FitModel, MedianFabric, median_fabric
 from analysis.fit.moves import EnsembleMoves
 from analysis.fit.optimize import point_estimate
 from analysis.fit.posterior import FabricModel, LogPosterior
@@ -74,4 +74,4 @@ __all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInter
            "FabricModel", "LogPosterior", "point_estimate", "LockStep", "Chain",
            "EnsembleRunner", "EnsembleMoves", "LaplaceMove", "Criteria", "Diagnosis",
            "FitFolder", "fit_quality", "albedo_colours", "albedo_delta_e", "CONFIG_FILE",
-           "CHECKPOINT_FILE", "SCHEMA_VERSION", "MedianFabric", "median_fabric"]
+           "CHECKPOINT_FILE", "SCHEMA_VERSION", "MedianFabric", "median_fabric", "FitModel"]

@@ -27,7 +27,7 @@ from analysis.likelihood import Likelihood
 from analysis.params import INTERNAL_LIMIT, ParamSpec
 from gonio.progress import progress_bar
 
-__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time"]
+__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time", "estimate_fit_time"]
 
 #: A fit that may take this many seconds or more says so before it starts (``notify``).
 ESTIMATE_MIN_S = 10.0
@@ -272,6 +272,55 @@ def estimate_time(logpost, opts: FitOptions, n_used: int,
     return est + step * opts.max_steps, line
 
 
+def estimate_fit_time(table, spec: ParamSpec, model: Callable,
+                      **fit_kw) -> tuple[float, str]:
+    """:func:`estimate_time` of the fit that ``fit(table, spec, model, **fit_kw)`` would
+    run from scratch (point estimate included), with its checks and no folder touched.
+
+    Parameters
+    ----------
+    table, spec, model
+        As :func:`fit`.
+    **fit_kw
+        Options of :func:`fit`; those that do not change the time (convergence criteria,
+        ``out_dir``, ``progress``, ``notify``...) are ignored.
+
+    Returns
+    -------
+    (float, str)
+        The seconds at most (``max_steps`` steps and the point estimate) and the line.
+
+    Raises
+    ------
+    ValueError
+        As :func:`fit`'s checks before sampling (too few values, bad options, memory).
+    """
+    names = {f.name for f in dataclasses.fields(FitOptions)} - {"criteria"}
+    opts = FitOptions(**{k: v for k, v in fit_kw.items() if k in names})
+    lik, spec, opts, logpost = _checked(table, spec, model, opts)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return estimate_time(_for_sampling(logpost, model, opts), opts, lik.n_used, True)
+
+
+def _checked(table, spec: ParamSpec, model, opts: FitOptions):
+    """The checks before any work: (likelihood, spec with its nuisance parameters, resolved
+    options, log-posterior), or the ValueError of the first that fails."""
+    lik = Likelihood(table, kind=opts.likelihood, nu=opts.nu)
+    spec = _with_nuisance(spec, lik)
+    _check_points(lik, spec.ndim)
+    opts = opts.resolve(spec.ndim)
+    _check_memory(opts, spec.ndim, lik.n_used)
+    return lik, spec, opts, LogPosterior(spec, lik, model)
+
+
+def _for_sampling(logpost: LogPosterior, model, opts: FitOptions) -> LogPosterior:
+    """The log-posterior the sampling evaluates: ``logpost`` with the model shading in
+    float32 when ``opts.shading`` asks for it and the model offers ``with_dtype``."""
+    if opts.shading == "float32" and hasattr(model, "with_dtype"):
+        return logpost.with_model(model.with_dtype(np.float32))
+    return logpost
+
+
 def _check_start(spec: ParamSpec, best, best_logp: float, notify=None) -> None:
     """A point estimate the walkers can start from, or a ValueError saying what to change;
     ``notify`` is told of parameters that ended on a bound."""
@@ -292,15 +341,8 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
          notify=None) -> FitResult:
     """:func:`fit` once its options are gathered: checks, start, sampling, result."""
     t0 = time.perf_counter()
-    lik = Likelihood(table, kind=opts.likelihood, nu=opts.nu)
-    spec = _with_nuisance(spec, lik)
-    _check_points(lik, spec.ndim)
-    opts = opts.resolve(spec.ndim)
-    _check_memory(opts, spec.ndim, lik.n_used)
-    logpost = LogPosterior(spec, lik, model)
-    sampling = logpost
-    if opts.shading == "float32" and hasattr(model, "with_dtype"):
-        sampling = logpost.with_model(model.with_dtype(np.float32))
+    lik, spec, opts, logpost = _checked(table, spec, model, opts)
+    sampling = _for_sampling(logpost, model, opts)
     config = opts.config(spec, table, lik, config_extra)
     folder = None if out_dir is None else FitFolder(out_dir)
     start = None if folder is None else folder.read_start(config)

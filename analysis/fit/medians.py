@@ -4,7 +4,9 @@ A fit folder holds ``results.json`` (each free parameter's median) and ``fit_con
 (the preset, the options, the spec: fixed values and ties). :func:`median_fabric` puts them
 together: free parameters at their medians, tied ones from their sources, fixed ones at the
 values the fit held them at, tangent offsets scaled by ``tangent_scale`` as the fit's model
-scales them (clipped to +-90 degrees).
+scales them (clipped to +-90 degrees). :attr:`MedianFabric.model` is what the fit's model
+predicts there: that fabric's f_r times the fit's overall ``scale`` (1 unless the table was
+relative), as :class:`analysis.fit.LogPosterior` predicts it.
 """
 
 from __future__ import annotations
@@ -20,7 +22,28 @@ from analysis.fit.checkpoint import CONFIG_FILE
 from analysis.fit.results import read_results
 from brdf import schema
 
-__all__ = ["MedianFabric", "median_fabric"]
+__all__ = ["MedianFabric", "median_fabric", "FitModel"]
+
+
+@dataclasses.dataclass(frozen=True)
+class FitModel:
+    """A fit's model at its medians, as a BRDF: ``scale`` times the median fabric's f_r.
+
+    Attributes
+    ----------
+    fabric : brdf.Fabric
+        The median fabric (tangent offsets already scaled by ``tangent_scale``).
+    scale : float
+        The fit's overall factor on f_r (its ``scale`` parameter; 1 for absolute data).
+    """
+
+    fabric: brdf.Fabric
+    scale: float = 1.0
+
+    def eval(self, wi, wo) -> np.ndarray:
+        """``scale`` x f_r (1/sr, or the fitted table's relative units), shape (..., 3)."""
+        f = self.fabric.eval(wi, wo)
+        return f if self.scale == 1.0 else f * self.scale
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,6 +69,17 @@ class MedianFabric:
     values: dict
     free: tuple
     converged: bool | None
+
+    @property
+    def scale(self) -> float:
+        """The fit's overall factor on f_r (``scale``: fitted for relative data, else 1)."""
+        return float(self.values.get("scale", 1.0))
+
+    @property
+    def model(self) -> FitModel:
+        """What the fit's model predicts at the medians (:class:`FitModel`): the fabric's
+        f_r times :attr:`scale`, to compare with the table that was fitted."""
+        return FitModel(self.fabric, self.scale)
 
 
 def _config(folder: Path) -> dict:

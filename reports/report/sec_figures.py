@@ -7,7 +7,8 @@ import numpy as np
 from reports._plotting import FONT, eval_brdf
 from reports.colour import luminance
 from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
-from reports.plot_lobes import plane_directions, plot_lobe_3d, plot_lobe_planes
+from reports.plot_lobe3d import plot_lobe_3d
+from reports.plot_lobes import plane_directions, plot_lobe_planes
 from reports.plot_masking import plot_masking_lobes
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)

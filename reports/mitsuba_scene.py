@@ -244,6 +244,9 @@ def _up_for(forward):
 
 def _sensor(camera, width, height, spp, seed):
     """The sensor dictionary of a PinholeCamera or OrthographicCamera (box pixel filter)."""
+    if not isinstance(camera, (PinholeCamera, OrthographicCamera)):
+        raise ValueError(f"camera {camera!r}: the Mitsuba engine takes a PinholeCamera or an "
+                         f"OrthographicCamera")
     look = mi.ScalarTransform4f().look_at(origin=list(map(float, camera.position)),
                                           target=list(map(float, camera.target)),
                                           up=list(map(float, camera.up)))
@@ -254,14 +257,11 @@ def _sensor(camera, width, height, spp, seed):
         return {"type": "perspective", "fov": float(camera.fov), "fov_axis": "y",
                 "near_clip": 1e-3, "far_clip": 1e4, "to_world": look, "film": film,
                 "sampler": sampler}
-    if isinstance(camera, OrthographicCamera):
-        # Mitsuba's orthographic view is 2 wide and 2 / aspect high before to_world's scale
-        s = 0.5 * camera.extent * width / height
-        return {"type": "orthographic", "near_clip": 1e-3, "far_clip": 1e4,
-                "to_world": look @ mi.ScalarTransform4f().scale([s, s, 1.0]),
-                "film": film, "sampler": sampler}
-    raise ValueError(f"camera {camera!r}: the Mitsuba engine takes a PinholeCamera or an "
-                     f"OrthographicCamera")
+    # Mitsuba's orthographic view is 2 wide and 2 / aspect high before to_world's scale
+    s = 0.5 * camera.extent * width / height
+    return {"type": "orthographic", "near_clip": 1e-3, "far_clip": 1e4,
+            "to_world": look @ mi.ScalarTransform4f().scale([s, s, 1.0]),
+            "film": film, "sampler": sampler}
 
 
 def sky_bitmap(env, rows: int = ENV_ROWS) -> np.ndarray:

@@ -14,11 +14,14 @@ Mitsuba's first tangent ``dp_du``, which the ``microcylinder`` BSDF takes as the
 Planes become rectangles 100 scene scales across. Cloth is the ``microcylinder`` BSDF, wrapped
 in ``twosided`` on open surfaces (curtain, rectangle: the built-in renderer's cloth is
 two-sided) and one-sided on closed ones (cylinder, sphere), whose inside no ray sees: Mitsuba's
-``twosided`` calls its BSDF once per side, which doubles the kernel that LLVM compiles. Diffuse
-surfaces are a two-sided ``diffuse``. Lights: a point light of the same intensity (W/sr), a disc light as a ``disk``
-area emitter of radiance ``I / (pi r^2)`` facing its target, a ``directional`` emitter of the
-same irradiance. The sky (:class:`reports.envlight.EnvironmentLight`) is an ``envmap`` whose
-rows hold its radiance: Mitsuba's row ``v`` looks along ``cos(theta) = w_y = cos(pi v)``.
+``twosided`` calls its BSDF once per side, which doubles the kernel that LLVM compiles. (On a
+back face ``twosided`` mirrors the frame to (s, t, -n) where the built-in renderer turns it to
+(warp, -t, -n); the two agree for fabrics symmetric under y -> -y, every preset among them.)
+Diffuse surfaces are a two-sided ``diffuse``. Lights: a point light of the same intensity
+(W/sr), a disc light as a ``disk`` area emitter of radiance ``I / (pi r^2)`` facing its
+target, a ``directional`` emitter of the same irradiance. The sky
+(:class:`reports.envlight.EnvironmentLight`) is an ``envmap`` whose rows hold its radiance:
+Mitsuba's row ``i`` of ``n`` looks along ``w_y = cos(pi i / (n - 1))``.
 Rays that escape show black (``hide_emitters``), as in the built-in renderer.
 
 Imports Mitsuba at its top: import it after ``mitsuba.set_variant``

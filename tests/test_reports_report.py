@@ -259,6 +259,10 @@ def test_renders_engine_is_mitsuba_where_it_runs(tmp_path, monkeypatch, usable):
     calls.clear()
     sec_renders.section_renders(Page(tmp_path, "standin", Lambert(), q))
     assert {c[0] for c in calls} == {"builtin"}
+    calls.clear()
+    fast = dict(rep.QUALITIES["fast"], render_engine="auto")   # no compile for previews
+    sec_renders.section_renders(Page(tmp_path, "velvet", brdf.fabric("velvet"), fast))
+    assert {c[0] for c in calls} == {"builtin"}
     if not usable:
         with pytest.raises(ValueError, match="needs mitsuba"):
             sec_renders.render_engine(brdf.fabric("velvet"), "mitsuba")

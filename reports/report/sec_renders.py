@@ -4,8 +4,9 @@ The renders are Mitsuba 3's (:func:`reports.mitsuba_render.render_mitsuba`: path
 bounces) where Mitsuba is installed with a usable LLVM (``llvm_ad_rgb``) and the fabric is a
 :class:`brdf.Fabric`, else the built-in renderer's (:func:`reports.render.render`: direct
 light); each caption names its engine. The quality's ``render`` sets the built-in size and
-spp, ``render_mitsuba`` Mitsuba's; ``render_engine`` (``auto``, ``builtin``, ``mitsuba``) in
-the quality dictionary overrides the choice.
+spp, ``render_mitsuba`` Mitsuba's (None: the built-in renderer unless ``mitsuba`` is asked
+for, at the built-in size); ``render_engine`` (``auto``, ``builtin``, ``mitsuba``) in the
+quality dictionary overrides the choice.
 """
 
 from __future__ import annotations
@@ -105,8 +106,12 @@ def _render(engine, scene, fab, width, height, spp):
 
 def section_renders(p: Page) -> Section:
     """Each of :data:`RENDERS` (the no-masking one only for a BRDF that can unmask) as PNG."""
-    engine = render_engine(p.fabric, p.q.get("render_engine", "auto"))
-    width, height, spp = p.q["render_mitsuba" if engine == "mitsuba" else "render"]
+    choice = p.q.get("render_engine", "auto")
+    if choice == "auto" and p.q.get("render_mitsuba") is None:
+        choice = "builtin"
+    engine = render_engine(p.fabric, choice)
+    width, height, spp = p.q.get("render_mitsuba" if engine == "mitsuba" else "render") \
+        or p.q["render"]
     out, stats, ref = [], {}, None
     for stem, scene, masking, caption in RENDERS:
         fab = p.fabric

@@ -52,6 +52,9 @@ def register(sub):
     p.add_argument("--quality", choices=("default", "high", "fast"), default="default",
                    help="figure and render resolution: default (renders 640 x 360), high "
                         "(1280 x 720, finer figures, slower) or fast (previews)")
+    p.add_argument("--render-engine", choices=("auto", "builtin", "mitsuba"), default="auto",
+                   help="renders by Mitsuba 3 (path tracing; auto: where it runs in "
+                        "llvm_ad_rgb) or the built-in renderer (direct light) (auto)")
     p.add_argument("--fit", action="append", metavar="FABRIC=RESULTS",
                    help="show a fit's results.json in FABRIC's page (repeatable)")
     p.add_argument("--measured", default=None, metavar="DIR",
@@ -138,7 +141,8 @@ def run_report(args):
             raise ValueError(f"--fit {item!r}: no such file {path!r}")
         fits[name] = path
     index = build_report(names, args.output, progress=not args.quiet, quality=args.quality,
-                         fit_results=fits, measured=args.measured)
+                         fit_results=fits, measured=args.measured,
+                         render_engine=args.render_engine)
     labels = [g[0] for g in STANDARD_GEOMETRIES]
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name in names:

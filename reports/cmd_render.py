@@ -4,11 +4,15 @@
         [--tangent-samples N] [--tangent-sampling midpoint|control_points]
         [--transmission half_angle|longitudinal] [--gap incident|outgoing] [--rotation DEG]
         [--width 1280] [--height 720] [--spp 16] [--exposure 0] [--seed 0]
-        [--light-radius R] [--workers N] [--quiet] -o out.exr
+        [--light-radius R] [--workers N] [--engine builtin|mitsuba] [--variant V]
+        [--max-depth N] [--quiet] -o out.exr
 
 ``-o out.exr`` writes the float32 linear EXR and an sRGB PNG beside it (``out.png``);
 ``-o out.png`` writes the PNG only.  Every argument is checked (scene, fabric and its
-options, size, output folder) before rendering starts.
+options, size, output folder, engine and variant) before rendering starts.
+``--engine mitsuba`` renders the same scene in Mitsuba 3 (:mod:`reports.mitsuba_render`: the
+``microcylinder`` BSDF, the path integrator with ``--max-depth`` bounces, ``--variant``
+llvm_ad_rgb where LLVM works, else scalar_rgb).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import math
 import sys
 from pathlib import Path
 
+import brdf
 from reports import cliutil
 from reports.lights import PointLight
 
@@ -58,6 +63,15 @@ def register(sub):
     p.add_argument("--light-radius", type=float, default=None, metavar="R",
                    help="turn the scene's point light into a disc of this radius")
     p.add_argument("--workers", type=int, default=None, help="processes (all cores)")
+    p.add_argument("--engine", default="builtin", metavar="ENGINE",
+                   help="builtin (direct light, NumPy) or mitsuba (Mitsuba 3 path tracing) "
+                        "(builtin)")
+    p.add_argument("--variant", default=None, metavar="V",
+                   help="Mitsuba variant: llvm_ad_rgb, scalar_rgb or cuda_ad_rgb (llvm_ad_rgb "
+                        "where LLVM works, else scalar_rgb); --engine mitsuba only")
+    p.add_argument("--max-depth", type=int, default=None, metavar="N",
+                   help="longest light path, 2 = direct light only, -1 unbounded (8); "
+                        "--engine mitsuba only")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", required=True, metavar="FILE",
                    help="out.exr (writes out.png beside it) or out.png")
@@ -89,6 +103,34 @@ def _fabric_options(args):
     return opts
 
 
+#: The engines of ``--engine``.
+ENGINES = ("builtin", "mitsuba")
+
+
+def _engine_options(args, fabric):
+    """Check ``--engine``, ``--variant`` and ``--max-depth``; return the Mitsuba variant and
+    depth (None, None for the built-in engine)."""
+    if args.engine not in ENGINES:
+        raise ValueError(f"--engine {args.engine!r}: must be one of {', '.join(ENGINES)}")
+    if args.engine == "builtin":
+        for name in ("variant", "max_depth"):
+            if getattr(args, name) is not None:
+                raise ValueError(f"--{name.replace('_', '-')}: only with --engine mitsuba "
+                                 f"(the built-in renderer computes direct light alone)")
+        return None, None
+    max_depth = 8 if args.max_depth is None else args.max_depth
+    if not (max_depth == -1 or 1 <= max_depth <= 1024):
+        raise ValueError(f"--max-depth {max_depth}: must be -1 (unbounded) or 1 to 1024")
+    if not isinstance(fabric, brdf.Fabric):
+        raise ValueError("--engine mitsuba renders a brdf.Fabric only")
+    from reports import mitsuba_render     # no Mitsuba import: that waits for the render
+    try:
+        variant = mitsuba_render.pick_variant(args.variant)
+    except ImportError as exc:
+        raise ValueError(str(exc)) from None
+    return variant, max_depth
+
+
 def run(args):
     """Check every argument, render, write the files; return 0."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
@@ -117,9 +159,15 @@ def run(args):
         scene = scene.replace(light=dataclasses.replace(scene.light, radius=args.light_radius))
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers {args.workers}: must be at least 1")
-
-    image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
-                   seed=args.seed, progress=not args.quiet, workers=args.workers)
+    variant, max_depth = _engine_options(args, fabric)
+    if args.engine == "mitsuba":
+        from reports.mitsuba_render import render_mitsuba
+        image = render_mitsuba(scene, fabric, width=args.width, height=args.height,
+                               spp=args.spp, seed=args.seed, max_depth=max_depth,
+                               variant=variant, workers=args.workers, progress=not args.quiet)
+    else:
+        image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
+                       seed=args.seed, progress=not args.quiet, workers=args.workers)
     written = []
     if suffix == ".exr":
         written.append(imageio.write_exr(out, image))

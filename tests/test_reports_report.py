@@ -61,8 +61,13 @@ def fake_providers(monkeypatch, calls):
         calls.append(("render", scene, getattr(fab, "options", {}).get("masking")))
         return np.full((height, width, 3), 0.25, dtype=np.float32)
 
+    def render_mitsuba(scene, fab, width, height, spp, variant, progress):
+        calls.append(("render", scene, getattr(fab, "options", {}).get("masking")))
+        return np.full((height, width, 3), 0.25, dtype=np.float32)
+
     monkeypatch.setattr(sec_energy, "energy_report", fake_energy_report(calls))
     monkeypatch.setattr(sec_renders, "render", render)
+    monkeypatch.setattr(sec_renders, "render_mitsuba", render_mitsuba)
 
 
 @pytest.fixture(scope="module")
@@ -224,6 +229,43 @@ def test_renders_size_per_quality(tmp_path, monkeypatch, quality, size):
         src = f"standin/render_{stem}.png"
         assert f'<a href="{src}"' in sec.html and f'<img src="{src}"' in sec.html
     assert (tmp_path / "standin" / "render_curtain.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("usable", [True, False])
+def test_renders_engine_is_mitsuba_where_it_runs(tmp_path, monkeypatch, usable):
+    """A preset is rendered by Mitsuba where llvm_ad_rgb runs (at the quality's
+    render_mitsuba size), by the built-in renderer otherwise; the caption and the summary
+    name the engine; any BRDF other than a brdf.Fabric goes to the built-in renderer."""
+    import brdf
+    from reports import mitsuba_render
+    calls = []
+    monkeypatch.setattr(mitsuba_render, "have_mitsuba", lambda: usable)
+    monkeypatch.setattr(mitsuba_render, "variant_works", lambda v: (usable, ""))
+    monkeypatch.setattr(sec_renders, "render", lambda scene, fab, width, height, spp, progress:
+                        calls.append(("builtin", width, height, spp))
+                        or np.full((height, width, 3), 0.25))
+    monkeypatch.setattr(sec_renders, "render_mitsuba",
+                        lambda scene, fab, width, height, spp, variant, progress:
+                        calls.append(("mitsuba", width, height, spp))
+                        or np.full((height, width, 3), 0.25))
+    q = rep.QUALITIES["default"]
+    sec = sec_renders.section_renders(Page(tmp_path, "velvet", brdf.fabric("velvet"), q))
+    engine = "mitsuba" if usable else "builtin"
+    size = q["render_mitsuba" if usable else "render"]
+    assert set(calls) == {(engine, *size)} and len(calls) == 3
+    assert sec_renders.ENGINES[engine] in sec.html
+    assert {r["engine"] for r in sec.data.summary()["renders"].values()
+            if isinstance(r, dict)} == {engine}
+    calls.clear()
+    sec_renders.section_renders(Page(tmp_path, "standin", Lambert(), q))
+    assert {c[0] for c in calls} == {"builtin"}
+    calls.clear()
+    fast = dict(rep.QUALITIES["fast"], render_engine="auto")   # no compile for previews
+    sec_renders.section_renders(Page(tmp_path, "velvet", brdf.fabric("velvet"), fast))
+    assert {c[0] for c in calls} == {"builtin"}
+    if not usable:
+        with pytest.raises(ValueError, match="needs mitsuba"):
+            sec_renders.render_engine(brdf.fabric("velvet"), "mitsuba")
 
 
 def test_page_is_a_grid_of_clickable_figures(built):

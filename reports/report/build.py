@@ -18,6 +18,8 @@ from reports.report.folder import MARKER, check_output_dir, swap_into_place, wri
 from reports.report.markup import nav, now, page, plain_json, swatch
 from reports.report.overview import overview
 from reports.report.page import Page
+from reports.report.sec_renders import ENGINES
+from reports.report.sec_renders import render_engine as render_engine_of
 from reports.report.sections import FabricReport, run_section
 from reports.report.settings import QUALITIES, SECTIONS, TITLES
 from reports.report_measured import measured_page, overview_table, read_measured
@@ -117,10 +119,10 @@ def _measured(tmp: Path, title: str, names, measured_fits) -> tuple[str, dict]:
 
 
 def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,
-           measured_fits, title: str, progress: bool) -> None:
+           measured_fits, title: str, progress: bool, render_engine: str = "auto") -> None:
     """Write the whole report into ``tmp``."""
     t_start = time.perf_counter()
-    q = QUALITIES[quality]
+    q = dict(QUALITIES[quality], render_engine=render_engine)
     names = list(resolved)
     has_measured = measured_fits is not None
     bar = progress_bar(len(names) * len(sections) + 1, desc="report", unit="section",
@@ -152,7 +154,7 @@ def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,
 
 def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True,
                  quality="default", fit_results=None, measured=None,
-                 title="microcyl report") -> Path:
+                 title="microcyl report", render_engine="auto") -> Path:
     """Write the HTML report on ``fabrics`` to ``out_dir``; return the path of index.html.
 
     Parameters
@@ -177,6 +179,9 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
         the measured felts and CUReT fabrics) and its table on the overview.
     title : str
         Title of the overview page.
+    render_engine : {"auto", "builtin", "mitsuba"}
+        The renders' engine (:func:`reports.report.sec_renders.render_engine`): ``auto`` is
+        Mitsuba 3 where it runs in llvm_ad_rgb, else the built-in renderer.
 
     Returns
     -------
@@ -201,6 +206,11 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     """
     if quality not in QUALITIES:
         raise ValueError(f"quality must be one of {', '.join(QUALITIES)}; got {quality!r}")
+    if render_engine not in ("auto", *ENGINES):
+        raise ValueError(f"render_engine must be auto, {', '.join(ENGINES)}; "
+                         f"got {render_engine!r}")
+    if render_engine == "mitsuba":
+        render_engine_of(brdf.fabric("velvet"), "mitsuba")     # refused now, not per page
     sections = _sections(sections)
     resolved = resolve_fabrics(fabrics)
     measured_fits = read_measured(measured) if measured is not None else None
@@ -214,7 +224,8 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
                           f"{exc.strerror or exc}") from None
         try:
             os.chmod(tmp, file_mode(0o777))
-            _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress)
+            _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress,
+                   render_engine)
             swap_into_place(tmp, out)
         except BaseException:
             shutil.rmtree(tmp, ignore_errors=True)

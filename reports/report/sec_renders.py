@@ -1,4 +1,13 @@
-"""The "renders" section: the curtain and the cylinder, masking on and off, one exposure."""
+"""The "renders" section: the curtain and the cylinder, masking on and off, one exposure.
+
+The renders are Mitsuba 3's (:func:`reports.mitsuba_render.render_mitsuba`: path tracing, 8
+bounces) where Mitsuba is installed with a usable LLVM (``llvm_ad_rgb``) and the fabric is a
+:class:`brdf.Fabric`, else the built-in renderer's (:func:`reports.render.render`: direct
+light); each caption names its engine. The quality's ``render`` sets the built-in size and
+spp, ``render_mitsuba`` Mitsuba's (None: the built-in renderer unless ``mitsuba`` is asked
+for, at the built-in size); ``render_engine`` (``auto``, ``builtin``, ``mitsuba``) in the
+quality dictionary overrides the choice.
+"""
 
 from __future__ import annotations
 
@@ -9,19 +18,25 @@ from typing import Any
 import matplotlib.image as mimage
 import numpy as np
 
+import brdf
+from reports import mitsuba_render
 from reports.colour import luminance, to_srgb
+from reports.mitsuba_render import render_mitsuba
 from reports.render import render
 from reports.report.folder import write_file
 from reports.report.page import Page, figure_html
 from reports.report.sec_figures import can_unmask
 from reports.report.settings import Section
 
-__all__ = ["RendersData", "RENDERS", "section_renders"]
+__all__ = ["RendersData", "RENDERS", "ENGINES", "section_renders", "render_engine"]
 
 #: Renders in the report: (file stem, scene, masking, caption).
 RENDERS = (("curtain", "curtain", True, "curtain"),
            ("cylinder", "cylinder", True, "cylinder, masking on"),
            ("cylinder_nomask", "cylinder", False, "cylinder, masking off"))
+#: The report's render engines and how each caption names them.
+ENGINES = {"builtin": "built-in renderer (direct light, MIS sky)",
+           "mitsuba": "Mitsuba 3 llvm_ad_rgb (path tracing, 8 bounces)"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -34,7 +49,8 @@ class RendersData:
         The 99th percentile of the first render's non-zero luminance; every render of the
         fabric is exposed so that it shows at 0.8.
     renders : dict
-        File stem -> scene, masking, width, height, spp, exposure (stops), mean_luminance.
+        File stem -> scene, masking, engine, width, height, spp, exposure (stops),
+        mean_luminance.
     """
 
     exposure_reference: float
@@ -57,9 +73,45 @@ def _png(img: np.ndarray, exposure: float) -> bytes:
     return buf.getvalue()
 
 
+def render_engine(fabric, choice: str = "auto") -> str:
+    """The engine of a fabric's renders: ``choice``, or for ``auto`` Mitsuba where it is
+    installed, llvm_ad_rgb runs and ``fabric`` is a :class:`brdf.Fabric`, else the built-in.
+
+    Raises
+    ------
+    ValueError
+        An unknown choice, or ``mitsuba`` where it cannot render this fabric.
+    """
+    if choice not in ("auto", *ENGINES):
+        raise ValueError(f"render engine {choice!r} is unknown; choose auto, "
+                         f"{', '.join(ENGINES)}")
+    usable = (isinstance(fabric, brdf.Fabric) and mitsuba_render.have_mitsuba()
+              and mitsuba_render.variant_works("llvm_ad_rgb")[0])
+    if choice == "mitsuba" and not usable:
+        raise ValueError("render engine mitsuba needs mitsuba with a usable LLVM "
+                         "(llvm_ad_rgb) and a brdf.Fabric")
+    if choice == "auto":
+        return "mitsuba" if usable else "builtin"
+    return choice
+
+
+def _render(engine, scene, fab, width, height, spp):
+    if engine == "mitsuba":
+        img = render_mitsuba(scene, fab, width=width, height=height, spp=spp,
+                             variant="llvm_ad_rgb", progress=False)
+    else:
+        img = render(scene, fab, width=width, height=height, spp=spp, progress=False)
+    return np.asarray(img, dtype=np.float64)
+
+
 def section_renders(p: Page) -> Section:
     """Each of :data:`RENDERS` (the no-masking one only for a BRDF that can unmask) as PNG."""
-    width, height, spp = p.q["render"]
+    choice = p.q.get("render_engine", "auto")
+    if choice == "auto" and p.q.get("render_mitsuba") is None:
+        choice = "builtin"
+    engine = render_engine(p.fabric, choice)
+    width, height, spp = p.q.get("render_mitsuba" if engine == "mitsuba" else "render") \
+        or p.q["render"]
     out, stats, ref = [], {}, None
     for stem, scene, masking, caption in RENDERS:
         fab = p.fabric
@@ -67,16 +119,16 @@ def section_renders(p: Page) -> Section:
             if not can_unmask(fab):
                 continue
             fab = fab.replace(masking=False)
-        img = np.asarray(render(scene, fab, width=width, height=height, spp=spp,
-                                progress=False), dtype=np.float64)
+        img = _render(engine, scene, fab, width, height, spp)
         if ref is None:  # one exposure for all renders of a fabric
             ref = _exposure_reference(img)
         exposure = float(np.log2(0.8 / ref))
         write_file(p.path(f"render_{stem}.png"), _png(img, exposure))
         out.append(figure_html(p.rel(f"render_{stem}.png"),
-                               f"{caption}, {width} × {height}, {spp} spp, exposure "
-                               f"{exposure:+.1f} stops (sRGB via colour-science)"))
-        stats[stem] = {"scene": scene, "masking": masking, "width": width, "height": height,
+                               f"{caption}, {ENGINES[engine]}, {width} × {height}, {spp} spp, "
+                               f"exposure {exposure:+.1f} stops (sRGB via colour-science)"))
+        stats[stem] = {"scene": scene, "masking": masking, "engine": engine,
+                       "width": width, "height": height,
                        "spp": spp, "exposure": exposure,
                        "mean_luminance": float(luminance(img).mean())}
     return Section("".join(out), RendersData(ref, stats))

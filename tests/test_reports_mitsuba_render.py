@@ -1,0 +1,119 @@
+"""Tests of reports.mitsuba_render: the Mitsuba engine agrees with the built-in renderer.
+
+Both renderers estimate the same integral when Mitsuba's paths stop after the first bounce
+(``max_depth=2``): the key light and the sky (the built-in by MIS of Fabric.sample and cosine
+directions, Mitsuba by MIS of the envmap's and the BSDF's draws). Their images' mean
+luminances then differ by Monte Carlo noise alone, plus the tessellation of the meshes and
+float32: the test allows 4 standard errors of the mean of the per-pixel difference (pixels
+are independent; the scene's structure cancels in the difference, so its spread is noise)
+plus 1 % of the mean. Tests that need llvm_ad_rgb skip where Dr.Jit finds no usable LLVM;
+scalar_rgb runs wherever Mitsuba is installed.
+"""
+
+import numpy as np
+import pytest
+
+import brdf
+from reports import mitsuba_render
+from reports.colour import luminance
+from reports.render import render
+from reports.scenes import make_scene
+from reports.tracing import intersect, occluded
+
+pytestmark = pytest.mark.skipif(not mitsuba_render.have_mitsuba(),
+                                reason="mitsuba is not installed")
+
+W, H, SPP = 64, 36, 4
+
+
+@pytest.fixture(scope="module")
+def llvm():
+    ok, why = mitsuba_render.variant_works("llvm_ad_rgb")
+    if not ok:
+        pytest.skip(f"no usable LLVM for Dr.Jit ({why}); install libllvm19 and set "
+                    f"DRJIT_LIBLLVM_PATH to its libLLVM-19.so")
+    return "llvm_ad_rgb"
+
+
+def shadow_mask(scene, width, height):
+    """Pixels whose camera ray (through the pixel centre) hits a diffuse surface that the key
+    light does not see: traced with the built-in renderer's geometry."""
+    ys, xs = np.mgrid[0:height, 0:width]
+    o, d = scene.camera.rays(xs.ravel() + 0.5, ys.ravel() + 0.5, width, height)
+    o = np.ascontiguousarray(o)
+    t, pid, part = intersect(scene.primitives, o, d, 1e-6)
+    hit = np.isfinite(t)
+    diffuse = hit & np.array([scene.primitives[k].material != "cloth" if h else False
+                              for k, h in zip(pid, hit)])
+    p = o + np.where(hit, t, 0.0)[:, None] * d
+    wi, dist, _ = scene.light.sample(p, None)
+    mask = np.zeros(len(p), bool)
+    k = np.nonzero(diffuse)[0]
+    mask[k] = occluded(scene.primitives, p[k] + 1e-4 * wi[k], wi[k], dist[k], 1e-6)
+    return mask.reshape(height, width)
+
+
+def agree(a, b, extra=0.01):
+    """|mean(L_a) - mean(L_b)| within 4 standard errors of the mean per-pixel difference plus
+    ``extra`` of mean(L_b); returns the relative difference."""
+    la, lb = luminance(a), luminance(b)
+    diff = la - lb
+    se = diff.std(ddof=1) / np.sqrt(diff.size)
+    assert abs(diff.mean()) <= 4 * se + extra * lb.mean(), (la.mean(), lb.mean(), se)
+    return diff.mean() / lb.mean()
+
+
+def test_direct_light_agrees_with_the_builtin_renderer(llvm):
+    fab = brdf.fabric("velvet")
+    a = mitsuba_render.render_mitsuba("cylinder", fab, W, H, SPP, max_depth=2, variant=llvm,
+                                      progress=False)
+    b = render("cylinder", fab, W, H, SPP, progress=False, workers=1)
+    assert a.shape == (H, W, 3) and a.dtype == np.float32 and np.all(np.isfinite(a))
+    agree(a, b)
+    shadow = shadow_mask(make_scene("cylinder"), W, H)
+    assert shadow.sum() >= 20
+    assert luminance(a)[shadow].mean() > 0.5 * luminance(b)[shadow].mean() > 0
+
+
+def test_scalar_variant_renders_without_llvm():
+    """scalar_rgb needs no LLVM: a tiny image, finite and lit."""
+    fab = brdf.fabric("velvet", tangent_samples=4)
+    img = mitsuba_render.render_mitsuba("cylinder", fab, 16, 9, 1, variant="scalar_rgb",
+                                        progress=False)
+    assert img.shape == (9, 16, 3) and np.all(np.isfinite(img)) and img.max() > 0
+
+
+def test_passes_split_large_sample_counts(monkeypatch):
+    """More samples than one pass holds are rendered in passes that add up to spp."""
+    monkeypatch.setattr(mitsuba_render, "PASS_SAMPLES", 16 * 9 * 2)
+    fab = brdf.fabric("velvet", tangent_samples=4)
+    img = mitsuba_render.render_mitsuba("sphere", fab, 16, 9, 5, variant="scalar_rgb",
+                                        progress=False)
+    assert np.all(np.isfinite(img)) and img.max() > 0
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(width=2000), "width=2000"), (dict(spp=0), "spp=0"), (dict(seed=-1), "seed=-1"),
+    (dict(max_depth=0), "max_depth=0"), (dict(variant="gpu_rgb"), "'gpu_rgb' is unknown"),
+    (dict(fabric="tweed"), "fabric 'tweed' is unknown"), (dict(scene="teapot"), "teapot"),
+])
+def test_bad_input_is_refused_before_rendering(kwargs, match):
+    args = dict(scene="cylinder", fabric="velvet", width=8, height=8, spp=1, progress=False)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        mitsuba_render.render_mitsuba(**args)
+
+
+def test_an_eval_only_brdf_is_refused():
+    class Lambert:
+        def eval(self, wi, wo):
+            return np.full(np.broadcast_shapes(np.shape(wi), np.shape(wo)), 0.1)
+
+    with pytest.raises(ValueError, match="brdf.Fabric"):
+        mitsuba_render.render_mitsuba("cylinder", Lambert(), 8, 8, 1, progress=False)
+
+
+def test_missing_mitsuba_is_one_clear_error(monkeypatch):
+    monkeypatch.setattr(mitsuba_render, "have_mitsuba", lambda: False)
+    with pytest.raises(ImportError, match=r"needs mitsuba \(pip install mitsuba\)"):
+        mitsuba_render.pick_variant()

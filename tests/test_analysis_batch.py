@@ -217,12 +217,15 @@ def _churn_faults():
     return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
 
 
-def test_local_workers_keep_the_allocators_adaptive_thresholds():
-    """Dask's default MALLOC_TRIM_THRESHOLD_ for its workers makes every large temporary a
-    fresh mapping (256 page faults per MiB each time); the batch's LocalCluster unsets it."""
+def test_workers_get_a_steady_allocator(monkeypatch):
+    """Dask's MALLOC_TRIM_THRESHOLD_ for its workers makes every large temporary a fresh
+    mapping (256 page faults per MiB each time); the batch's workers get fixed thresholds,
+    even when this process's environment carries Dask's setting (as after any other
+    LocalCluster in it)."""
     from analysis.batch.engine import _client
+    monkeypatch.setenv("MALLOC_TRIM_THRESHOLD_", "65536")
     with _client(2, None) as client:
         env = client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
         faults = client.run(_churn_faults)
-    assert set(env.values()) == {None}
+    assert set(env.values()) == {"65536"}               # the workers did inherit it
     assert max(faults.values()) < 2000, faults        # ~51,000 with Dask's default

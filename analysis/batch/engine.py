@@ -10,6 +10,7 @@ the checkpoint in its folder; a task whose workers die three times (Dask's
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import logging
 import math
 import os
@@ -25,6 +26,8 @@ from analysis.batch.worker import error_row, estimate_job, run_job
 from analysis.budget import format_seconds
 from analysis.folderlock import output_lock
 from gonio.progress import progress_bar
+
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3      # glibc's mallopt parameters
 
 __all__ = ["run_batch", "BatchInterrupted", "describe_row", "estimate_batch"]
 
@@ -58,25 +61,40 @@ def _client(workers: int | None, scheduler: str | None):
         except OSError as exc:
             raise OSError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
         try:
+            client.run(steady_allocator)
             yield client
         finally:
             client.close()
         return
     n = workers or os.cpu_count() or 1
     import dask
-    # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also turns off
-    # glibc's adaptive mmap threshold: every temporary over 128 KiB is then mapped and
-    # unmapped afresh. A felt fit took 22 million page faults and a quarter of its CPU in
-    # the kernel that way; unset, the workers keep the allocator's defaults.
+    # not Dask's MALLOC_TRIM_THRESHOLD_ for the workers (see steady_allocator), which the
+    # nanny would also set in this process's environment
     with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=":0", silence_logs=logging.ERROR)
     try:
         with Client(cluster) as client:
             client.run(_ignore_sigint)
+            client.run(steady_allocator)
             yield client
     finally:
         cluster.close()
+
+
+def steady_allocator() -> bool:
+    """Run in each worker: fixed glibc malloc thresholds (mmap 32 MiB, trim 256 MiB).
+
+    Dask's nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536``, which turns off
+    glibc's adaptive thresholds: every temporary over 128 KiB is then mapped and unmapped
+    afresh (a felt fit took 33 million page faults, a quarter of its CPU in the kernel).
+    Returns whether the allocator took the settings (False off glibc)."""
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        return bool(libc.mallopt(_M_MMAP_THRESHOLD, 32 << 20)
+                    and libc.mallopt(_M_TRIM_THRESHOLD, 256 << 20))
+    except (OSError, AttributeError):
+        return False
 
 
 def _ignore_sigint():

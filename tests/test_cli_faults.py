@@ -16,6 +16,7 @@ import pytest
 import brdf
 import gonio
 from analysis.folderlock import FolderBusy, output_lock
+from conftest import default_sigint
 
 REPO = Path(__file__).resolve().parents[1]
 ENV = dict(os.environ, PYTHONPATH=str(REPO), PYTHONUNBUFFERED="1")
@@ -23,6 +24,7 @@ ENV = dict(os.environ, PYTHONPATH=str(REPO), PYTHONUNBUFFERED="1")
 
 def _cli(*args, **kw):
     return subprocess.Popen([sys.executable, "-m", "reports", *map(str, args)], cwd=REPO,
+                            preexec_fn=default_sigint,
                             env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, **kw)
 

@@ -15,6 +15,7 @@ import pytest
 
 import brdf
 import gonio
+from conftest import default_sigint
 
 pytest.importorskip("distributed")
 ROOT = Path(__file__).resolve().parents[1]
@@ -118,7 +119,8 @@ def test_ctrl_c_stops_the_batch_and_the_same_command_resumes(slow_tables, tmp_pa
     args = [sys.executable, "-m", "reports", "fit-batch", str(slow_tables), "--fabric",
             "silk_crepe_de_chine", "--check-every", "25", "--workers", "2", "--no-plots",
             "-o", str(out)]
-    p = subprocess.Popen(args, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    p = subprocess.Popen(args, env=ENV, preexec_fn=default_sigint, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE,
                          text=True)
     _wait_for(out / "silk0" / "checkpoint.h5", timeout=120)
     p.send_signal(signal.SIGINT)
@@ -142,6 +144,7 @@ def test_a_second_batch_into_the_same_folder_is_refused_at_once(tables, tmp_path
             "--no-plots", "-o", str(out)]
     lock = out / ".microcyl.lock"
     first = subprocess.Popen([sys.executable, "-m", "reports", *args], env=ENV,
+                             preexec_fn=default_sigint,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         end = time.monotonic() + 120

@@ -19,6 +19,7 @@ import gonio
 from analysis.fit import FabricModel, FitFolder, fit
 from analysis.params import ParamSpec, defaults_from_fabric
 from _fitmodels import fabric_table
+from conftest import default_sigint
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -27,6 +28,7 @@ def _cli(*args, **kw):
     """Popen of ``python -m reports ...`` in the repository, stdout and stderr piped."""
     env = dict(os.environ, PYTHONPATH=str(REPO), PYTHONUNBUFFERED="1")
     return subprocess.Popen([sys.executable, "-m", "reports", *map(str, args)], cwd=REPO,
+                            preexec_fn=default_sigint,
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, **kw)
 
@@ -161,19 +163,10 @@ def test_sigkill_then_resume_loses_at_most_one_check(small_csv, tmp_path):
     assert a["parameters"] == b["parameters"] and a["reason"] == b["reason"]
 
 
-@pytest.fixture(scope="module")
-def silk_csv(tmp_path_factory):
-    """The default fit's table (3,721 pairs; 8 free parameters converge near step 350, some
-    seconds after the first checkpoint, so that Ctrl-C finds the fit running)."""
-    table = gonio.measure(brdf.fabric("silk_crepe_de_chine"), "full:15:30",
-                          gonio.Instrument(snr=20, floor=1e-4), seed=5, progress=False)
-    path = tmp_path_factory.mktemp("silk") / "silk.csv"
-    gonio.write(table, path)
-    return path
-
-
 def test_ctrl_c_prints_one_line_and_resumes(silk_csv, tmp_path):
-    args = ["fit", silk_csv, "--fabric", "silk_crepe_de_chine", "--check-every", "20",
+    """On the default fit's table (8 free parameters converge near step 350, seconds after
+    the first checkpoint, so that Ctrl-C finds the fit running)."""
+    args = ["fit", silk_csv[0], "--fabric", "silk_crepe_de_chine", "--check-every", "20",
             "--no-plots", "--no-progress", "-o", tmp_path / "c"]
     p = _cli(*args)
     _wait_for_checkpoint(p, tmp_path / "c", 40)

@@ -2,8 +2,6 @@
 
 from pathlib import Path
 
-import signal
-
 import pytest
 
 #: ../shared/data, the measured BRDF data kept beside this repository (never copied in).
@@ -17,9 +15,3 @@ def shared_data() -> Path:
         pytest.skip(f"measured data not found at {SHARED_DATA}")
     return SHARED_DATA
 
-
-def default_sigint():
-    """``preexec_fn`` for a CLI subprocess that a test interrupts: SIGINT at its default, as
-    a terminal gives it. (A suite run as a background job inherits SIGINT ignored, and an
-    ignored SIGINT stays ignored across exec, so Ctrl-C would never reach the command.)"""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -16,7 +16,7 @@ import pytest
 import brdf
 import gonio
 from analysis.folderlock import FolderBusy, output_lock
-from conftest import default_sigint
+from _signals import default_sigint
 
 REPO = Path(__file__).resolve().parents[1]
 ENV = dict(os.environ, PYTHONPATH=str(REPO), PYTHONUNBUFFERED="1")

@@ -15,7 +15,7 @@ import pytest
 
 import brdf
 import gonio
-from conftest import default_sigint
+from _signals import default_sigint
 
 pytest.importorskip("distributed")
 ROOT = Path(__file__).resolve().parents[1]

@@ -19,7 +19,7 @@ import gonio
 from analysis.fit import FabricModel, FitFolder, fit
 from analysis.params import ParamSpec, defaults_from_fabric
 from _fitmodels import fabric_table
-from conftest import default_sigint
+from _signals import default_sigint
 
 REPO = Path(__file__).resolve().parents[1]
 

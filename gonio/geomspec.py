@@ -9,8 +9,8 @@ from pathlib import Path
 from gonio.csvtable import ANGLES, parse_columns, read_rows
 from gonio.errors import FormatError
 from gonio.geometry import SPEC_HELP, Geometry
-from gonio.layouts import (PLANE_AZIMUTHS, full_grid, full_grid_pairs, merl, merl_pairs,
-                           pairs_from_angles, plane, rusinkiewicz, rusinkiewicz_pairs)
+from gonio.gridsize import full_grid_pairs, merl_pairs, rusinkiewicz_pairs
+from gonio.layouts import PLANE_AZIMUTHS, full_grid, merl, pairs_from_angles, plane, rusinkiewicz
 from gonio.numtext import NUMBER_FORM, parse_number
 
 __all__ = ["from_spec", "spec_pairs", "read_pairs_csv", "SPEC_HELP"]

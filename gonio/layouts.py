@@ -15,10 +15,12 @@ import numpy as np
 
 from brdf.frames import from_angles, half_diff_to_directions, plane_to_directions, to_angles
 from gonio.geometry import HORIZON_EPS, Geometry
+from gonio.gridsize import (check_pairs, full_steps, merl_stride, node_count, node_range,
+                            rus_steps, side_count, step_degrees)
 from gonio.numtext import parse_number
 
 __all__ = ["full_grid", "plane", "rusinkiewicz", "merl", "pairs", "pairs_from_angles",
-           "PLANE_AZIMUTHS", "full_grid_pairs", "rusinkiewicz_pairs", "merl_pairs"]
+           "PLANE_AZIMUTHS"]
 
 #: Named planes of incidence and their azimuths, degrees.
 PLANE_AZIMUTHS = {"warp": 0.0, "weft": 90.0, "45": 45.0}
@@ -37,106 +39,10 @@ def _build(kind, params, wi, wo, coords, rotation) -> Geometry:
                                      "dropped_below_horizon": int(n_layout - idx.size)})
 
 
-def _step(name, value, upper=90.0) -> float:
-    try:
-        v = parse_number(value.strip(" \t")) if isinstance(value, str) else float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number of degrees; got {value!r}") from None
-    if not (math.isfinite(v) and 0 < v <= upper):
-        raise ValueError(f"{name} must be in (0, {upper:g}] degrees; got {value!r}")
-    return v
-
-
-#: The most (wi, wo) pairs a grid layout builds (about 2 GB of float64 arrays): finer steps
-#: are refused before any allocation instead of exhausting memory.
-MAX_PAIRS = 20_000_000
-
-
-def _n(step, stop) -> int:
-    """Size of :func:`_range` (``step``, ``stop``), without building it."""
-    return int(math.ceil(stop / step - 1e-9))
-
-
-def _side(theta_step, phi_step) -> int:
-    """Directions of one side of a full grid: 1 + (n_theta - 1) n_phi."""
-    return 1 + (_n(theta_step, 90.0) - 1) * _n(phi_step, 360.0)
-
-
-def _full_steps(theta_step, phi_step, theta_o_step, phi_o_step):
-    ti_s = _step("theta_step", theta_step)
-    pi_s = _step("phi_step", ti_s if phi_step is None else phi_step, 360.0)
-    to_s = _step("theta_o_step", ti_s if theta_o_step is None else theta_o_step)
-    po_s = _step("phi_o_step", pi_s if phi_o_step is None else phi_o_step, 360.0)
-    return ti_s, pi_s, to_s, po_s
-
-
-def full_grid_pairs(theta_step: float = 10.0, phi_step: float | None = None, *,
-                    theta_o_step: float | None = None, phi_o_step: float | None = None) -> int:
-    """Number of pairs :func:`full_grid` builds for these steps (degrees), counted without
-    building them (an exact int, however large).
-
-    Examples
-    --------
-    >>> full_grid_pairs(45, 90)
-    25
-    """
-    ti_s, pi_s, to_s, po_s = _full_steps(theta_step, phi_step, theta_o_step, phi_o_step)
-    return _side(ti_s, pi_s) * _side(to_s, po_s)
-
-
-def _rus_steps(theta_h_step, phi_h_step, theta_d_step, phi_d_step):
-    th_s = _step("theta_h_step", theta_h_step)
-    ph_s = _step("phi_h_step", th_s if phi_h_step is None else phi_h_step, 360.0)
-    td_s = _step("theta_d_step", th_s if theta_d_step is None else theta_d_step)
-    pd_s = _step("phi_d_step", th_s if phi_d_step is None else phi_d_step, 360.0)
-    return th_s, ph_s, td_s, pd_s
-
-
-def rusinkiewicz_pairs(theta_h_step: float = 5.0, phi_h_step: float | None = None,
-                       theta_d_step: float | None = None,
-                       phi_d_step: float | None = None) -> int:
-    """Number of (theta_h, phi_h, theta_d, phi_d) nodes :func:`rusinkiewicz` places (before
-    it drops those below the horizon), counted without building them."""
-    th_s, ph_s, td_s, pd_s = _rus_steps(theta_h_step, phi_h_step, theta_d_step, phi_d_step)
-    return _n(th_s, 90.0) * _n(ph_s, 360.0) * _n(td_s, 90.0) * _n(pd_s, 360.0)
-
-
-def _merl_stride(stride) -> int:
-    if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or not 1 <= stride <= 90:
-        raise ValueError(f"MERL stride must be an integer in [1, 90]; got {stride!r}")
-    return int(stride)
-
-
-def merl_pairs(stride: int = 1) -> int:
-    """Number of MERL bins :func:`merl` places for ``stride`` (before the horizon).
-
-    Examples
-    --------
-    >>> merl_pairs(30)
-    54
-    """
-    s = _merl_stride(stride)
-    return _n(s, 90.0) ** 2 * _n(s, 180.0)
-
-
-def _check_size(kind, counts) -> None:
-    """ValueError if the product of ``counts`` exceeds :data:`MAX_PAIRS`."""
-    total = math.prod(int(c) for c in counts)
-    if total > MAX_PAIRS:
-        raise ValueError(f"{kind}: the steps give {total:,} direction pairs, more than "
-                         f"{MAX_PAIRS:,}; use coarser steps")
-
-
-def _range(step, stop) -> np.ndarray:
-    """Degrees 0, step, 2 step, ... strictly below ``stop`` (robust to rounding)."""
-    k = int(math.ceil(stop / step - 1e-9))
-    return step * np.arange(k)
-
-
 def _hemisphere(theta_step, phi_step, theta_max=90.0):
     """Directions of a (theta, phi) grid, one direction at theta = 0; degrees in, radians out."""
-    thetas = _range(theta_step, theta_max)
-    phis = _range(phi_step, 360.0)
+    thetas = node_range(theta_step, theta_max)
+    phis = node_range(phi_step, 360.0)
     t = [0.0] + [th for th in thetas[1:] for _ in phis]
     p = [0.0] + [ph for _ in thetas[1:] for ph in phis]
     return np.radians(t), np.radians(p)
@@ -175,8 +81,8 @@ def full_grid(theta_step: float = 10.0, phi_step: float | None = None, *,
     >>> float(np.degrees(g.coords["theta_i"]).max())
     45.0
     """
-    ti_s, pi_s, to_s, po_s = _full_steps(theta_step, phi_step, theta_o_step, phi_o_step)
-    _check_size("full_grid", (_side(ti_s, pi_s), _side(to_s, po_s)))
+    ti_s, pi_s, to_s, po_s = full_steps(theta_step, phi_step, theta_o_step, phi_o_step)
+    check_pairs("full_grid", (side_count(ti_s, pi_s), side_count(to_s, po_s)))
     ti, pi_ = _hemisphere(ti_s, pi_s)
     to, po = _hemisphere(to_s, po_s)
     TI = np.repeat(ti, to.size)
@@ -235,12 +141,12 @@ def plane(azimuth="warp", theta_o_step: float = 5.0,
         az = float(azimuth)
     if not math.isfinite(az):
         raise ValueError(f"plane azimuth must be finite degrees; got {azimuth!r}")
-    step = _step("theta_o_step", theta_o_step)
+    step = step_degrees("theta_o_step", theta_o_step)
     ti = np.atleast_1d(np.asarray(theta_i, float))
     if ti.ndim != 1 or ti.size == 0 or not np.all(np.isfinite(ti)) or np.any(np.abs(ti) >= 90):
         raise ValueError(f"theta_i must be a non-empty list of degrees in (-90, 90); "
                          f"got {theta_i!r}")
-    k = int(math.ceil(90.0 / step - 1e-9)) - 1
+    k = node_count(step, 90.0) - 1
     to = step * np.arange(-k, k + 1)
     TI = np.radians(np.repeat(ti, to.size))
     TO = np.radians(np.tile(to, ti.size))
@@ -277,11 +183,11 @@ def rusinkiewicz(theta_h_step: float = 5.0, phi_h_step: float | None = None,
     >>> g.info["n_layout"], len(g) + g.info["dropped_below_horizon"]
     (144, 144)
     """
-    th_s, ph_s, td_s, pd_s = _rus_steps(theta_h_step, phi_h_step, theta_d_step, phi_d_step)
-    _check_size("rusinkiewicz", [_n(s, stop) for s, stop in
+    th_s, ph_s, td_s, pd_s = rus_steps(theta_h_step, phi_h_step, theta_d_step, phi_d_step)
+    check_pairs("rusinkiewicz", [node_count(s, stop) for s, stop in
                                  ((th_s, 90.0), (ph_s, 360.0), (td_s, 90.0), (pd_s, 360.0))])
-    axes = [np.radians(_range(th_s, 90.0)), np.radians(_range(ph_s, 360.0)),
-            np.radians(_range(td_s, 90.0)), np.radians(_range(pd_s, 360.0))]
+    axes = [np.radians(node_range(th_s, 90.0)), np.radians(node_range(ph_s, 360.0)),
+            np.radians(node_range(td_s, 90.0)), np.radians(node_range(pd_s, 360.0))]
     TH, PH, TD, PD = (a.reshape(-1) for a in np.meshgrid(*axes, indexing="ij"))
     wi, wo = half_diff_to_directions(TH, PH, TD, PD)
     params = {"theta_h_step": th_s, "phi_h_step": ph_s, "theta_d_step": td_s, "phi_d_step": pd_s}
@@ -328,7 +234,7 @@ def merl(stride: int = 1, *, rotation: float = 0.0) -> Geometry:
     >>> np.degrees(g.coords["theta_h"][g.index == 30 * 180 * 90]).round(6).tolist()   # 30.5^2/90
     [10.336111]
     """
-    stride = _merl_stride(stride)
+    stride = merl_stride(stride)
     i = np.arange(0, 90, stride)
     j = np.arange(0, 90, stride)
     k = np.arange(0, 180, stride)

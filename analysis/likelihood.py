@@ -183,10 +183,21 @@ class Likelihood:
 
     def transform(self, model_values) -> np.ndarray:
         """Model f_r (B..., n, 3) -> the residual space at the used entries (B..., n_used)."""
-        m = self._at(model_values)
+        return self._mu(self._at(model_values), None, out=None)
+
+    def _mu(self, m, scale, out) -> np.ndarray:
+        """The residual space of model values ``m`` (B..., n_used) times ``scale`` (B...):
+        log f (relative) or log(1 + f cos theta_i), into ``out`` (a new array when None)."""
+        lo = 1e-300 if self.kind == "relative" else 0.0
+        if scale is None:
+            mu = np.maximum(m, lo, out=out)
+        else:
+            mu = np.multiply(m, np.asarray(scale, dtype=np.float64)[..., None], out=out)
+            np.maximum(mu, lo, out=mu)
         if self.kind == "relative":
-            return np.log(np.maximum(m, 1e-300))
-        return np.log1p(np.maximum(m, 0.0) * self.cos_i)
+            return np.log(mu, out=mu)
+        mu *= self.cos_i
+        return np.log1p(mu, out=mu)
 
     def __call__(self, model_values, scale=None, log_noise=None) -> np.ndarray:
         """Log-likelihood for model predictions.
@@ -215,18 +226,7 @@ class Likelihood:
         m = self._at(model_values)
         # one buffer for mu and the residuals, the rest in place: fresh large temporaries
         # cost page faults, which threads take in turn
-        lo = 1e-300 if self.kind == "relative" else 0.0
-        mu = self._scratch.array("mu", m.shape)
-        if scale is None:
-            np.maximum(m, lo, out=mu)
-        else:
-            np.multiply(m, np.asarray(scale, dtype=np.float64)[..., None], out=mu)
-            np.maximum(mu, lo, out=mu)
-        if self.kind == "relative":
-            np.log(mu, out=mu)
-        else:
-            mu *= self.cos_i
-            np.log1p(mu, out=mu)
+        mu = self._mu(m, scale, out=self._scratch.array("mu", m.shape))
         r = np.subtract(self.y, mu, out=mu)
         if self.kind == "student-t":
             out = self._student_t(r, log_noise)

@@ -11,7 +11,7 @@ from brdf import schema
 from brdf.frames import flat_pairs
 from brdf.kernel import ThreadGeometry
 from brdf.scratch import Scratch
-from brdf.shading import (SHADE_BLOCK, SHADE_DTYPES, combine_rgb, inverse_denominator,
+from brdf.shading import (SHADE_BLOCK, combine_rgb, inverse_denominator, shade_dtype,
                           thread_shade)
 
 if TYPE_CHECKING:                    # brdf.fabric imports this module
@@ -143,13 +143,7 @@ class Prepared:
 
     def _geometries(self, dtype) -> list[ThreadGeometry]:
         """The threads' geometry in ``dtype`` (float32 copies made once, on first use)."""
-        try:
-            dt = np.dtype(dtype)
-        except TypeError:
-            dt = None
-        if dt is None or dt not in SHADE_DTYPES:   # (np.dtype(float) == None is True)
-            raise ValueError(f"dtype must be numpy.float64 or numpy.float32; got {dtype!r}")
-        if dt == np.float64:
+        if shade_dtype(dtype) == np.float64:
             return self._geoms
         if self._geoms32 is None:
             self._geoms32 = [ThreadGeometry(*(None if a is None else _to_float32(a) for a in g))

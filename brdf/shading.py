@@ -16,7 +16,8 @@ import numpy as np
 from brdf.kernel import ThreadGeometry
 
 __all__ = ["thread_shade", "combine_rgb", "fresnel2_into", "surface_term", "volume_term",
-           "inverse_denominator", "GAUSS_NORM", "SHADE_BLOCK", "DENOM_MIN"]
+           "inverse_denominator", "shade_dtype", "GAUSS_NORM", "SHADE_BLOCK", "DENOM_MIN",
+           "SHADE_DTYPES"]
 
 GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
 
@@ -91,6 +92,21 @@ PARAM_CLAMP_32 = (2.0 ** -60, 2.0 ** 60)
 
 #: The precisions :func:`thread_shade` shades in (that of its geometry's arrays).
 SHADE_DTYPES = (np.dtype(np.float64), np.dtype(np.float32))
+
+
+def shade_dtype(dtype) -> np.dtype:
+    """``dtype`` as one of :data:`SHADE_DTYPES`, or a ValueError naming what is allowed.
+
+    >>> shade_dtype("float32").name
+    'float32'
+    """
+    try:
+        dt = np.dtype(dtype)
+    except TypeError:
+        dt = None
+    if dt is None or dt not in SHADE_DTYPES:   # (np.dtype(float) == None is True)
+        raise ValueError(f"dtype must be numpy.float64 or numpy.float32; got {dtype!r}")
+    return dt
 
 
 def _shade_params(eta, kd, gamma_s, gamma_v, dtype=np.float64) -> _ShadeParams:
@@ -249,9 +265,7 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
     and :math:`\theta_h^2 = \mathrm{th2}/4`. Where :math:`\gamma_v = 2\gamma_s` (Table II) the
     surface lobe is the volume lobe to the fourth power, one ``exp`` for both.
     """
-    dtype = geom.th2.dtype
-    if dtype not in SHADE_DTYPES:
-        raise ValueError(f"geom must hold float64 or float32 arrays; got {dtype}")
+    dtype = shade_dtype(geom.th2.dtype)
     params = [np.asarray(x, dtype=np.float64) for x in (eta, kd, gamma_s, gamma_v)]
     batch = np.broadcast_shapes(*(x.shape for x in params))
     nb = math.prod(batch)

@@ -155,12 +155,18 @@ def fitted_fabric(fit, preset=None) -> tuple[brdf.Fabric, str]:
     """The fabric of a fit's posterior medians and its preset
     (:func:`analysis.fit.median_fabric`); ``fit`` is a fit's folder or its ``results.json``,
     ``preset`` names the preset where ``fit_config.json`` does not."""
+    m = _medians(fit, preset)
+    return m.fabric, m.preset
+
+
+def _medians(fit, preset):
+    """:func:`analysis.fit.median_fabric` of ``fit`` (a fit's folder or its results.json),
+    its errors naming --fit."""
     path = Path(fit)
     try:
-        m = median_fabric(path if path.is_dir() else path.parent, preset=preset)
+        return median_fabric(path if path.is_dir() else path.parent, preset=preset)
     except ValueError as exc:
         raise ValueError(f"--fit {str(fit)!r}: {exc}") from None
-    return m.fabric, m.preset
 
 
 def fitted_model(fit, preset=None):
@@ -168,11 +174,7 @@ def fitted_model(fit, preset=None):
     the median fabric (tangent offsets scaled by the fit's ``tangent_scale``) times the fit's
     overall ``scale`` (:attr:`analysis.fit.MedianFabric.model`); the label names the preset
     and a scale other than 1."""
-    path = Path(fit)
-    try:
-        m = median_fabric(path if path.is_dir() else path.parent, preset=preset)
-    except ValueError as exc:
-        raise ValueError(f"--fit {str(fit)!r}: {exc}") from None
+    m = _medians(fit, preset)
     scale = "" if m.scale == 1.0 else f", × {m.scale:.3g}"
     return m.model, f"fit ({m.preset}{scale})"
 

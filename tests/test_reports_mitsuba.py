@@ -182,23 +182,14 @@ def test_register_needs_an_rgb_variant():
 
 
 # -- llvm_ad_rgb -------------------------------------------------------------------------
-_PROBE = ("import mitsuba as mi, drjit as dr; mi.set_variant('llvm_ad_rgb'); "
-          "x = dr.maximum(mi.Float([1, 2]), mi.Float([1.5, 0])); print(float(dr.sum(x)[0]))")
-
-
 @pytest.fixture(scope="module")
 def llvm():
-    """mitsuba in llvm_ad_rgb, after a probe in a subprocess (an unusable LLVM aborts)."""
+    """mitsuba in llvm_ad_rgb, after reports.mitsuba_render's probe in a subprocess (an
+    unusable LLVM aborts the process that tries it)."""
     if not HAVE_MITSUBA:
         pytest.skip("mitsuba is not installed")
-    try:
-        p = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True,
-                           timeout=120)
-        ok = p.returncode == 0 and p.stdout.strip() == "3.5"
-        lines = p.stderr.strip().splitlines() or [f"exit status {p.returncode}"]
-        why = next((ln for ln in lines if "LLVM ERROR" in ln or "LLVM" in ln), lines[-1])
-    except subprocess.TimeoutExpired:
-        ok, why = False, "the probe timed out"
+    from reports.mitsuba_render import variant_works
+    ok, why = variant_works("llvm_ad_rgb")
     if not ok:
         pytest.skip(f"no usable LLVM for Dr.Jit ({why}); install libllvm19 and set "
                     f"DRJIT_LIBLLVM_PATH to its libLLVM-19.so (LLVM 14 and 15 fail)")

@@ -67,12 +67,8 @@ def _client(workers: int | None, scheduler: str | None):
             client.close()
         return
     n = workers or os.cpu_count() or 1
-    import dask
-    # not Dask's MALLOC_TRIM_THRESHOLD_ for the workers (see steady_allocator), which the
-    # nanny would also set in this process's environment
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.ERROR)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=":0", silence_logs=logging.ERROR)
     try:
         with Client(cluster) as client:
             client.run(_ignore_sigint)

@@ -6,6 +6,7 @@ once (numpy releases the GIL; the only shared state, the evaluation count, is lo
 
 from __future__ import annotations
 
+import copy
 import threading
 from typing import Callable
 
@@ -13,6 +14,7 @@ import numpy as np
 
 from analysis.likelihood import Likelihood
 from analysis.params import ParamSpec
+from brdf.shading import shade_dtype
 
 __all__ = ["FabricModel", "LogPosterior"]
 
@@ -36,15 +38,12 @@ class FabricModel:
         self.wi = np.asarray(wi, dtype=np.float64)
         self.wo = np.asarray(wo, dtype=np.float64)
         self.prep = fab.prepare(self.wi, self.wo)
-        self.dtype = np.dtype(dtype)
-        self.prep.eval(dtype=self.dtype)          # a bad dtype is refused here, once
+        self.dtype = shade_dtype(dtype)
 
     def with_dtype(self, dtype) -> "FabricModel":
         """The same model (sharing its preparation) shading in ``dtype``."""
-        other = object.__new__(FabricModel)
-        other.__dict__.update(self.__dict__)
-        other.dtype = np.dtype(dtype)
-        other.prep.eval(dtype=other.dtype)
+        other = copy.copy(self)
+        other.dtype = shade_dtype(dtype)
         return other
 
     def __call__(self, tangent_scale=None, **kw) -> np.ndarray:
@@ -108,8 +107,7 @@ class LogPosterior:
     def with_model(self, model: Callable) -> "LogPosterior":
         """This posterior with another forward model (e.g. ``model.with_dtype(np.float32)``);
         its evaluations count in this one's :attr:`n_evals`."""
-        other = object.__new__(LogPosterior)
-        other.__dict__.update(self.__dict__)
+        other = copy.copy(self)                # shares the count, the spec, the likelihood
         other.model = model
         return other
 

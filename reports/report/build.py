@@ -18,8 +18,7 @@ from reports.report.folder import MARKER, check_output_dir, swap_into_place, wri
 from reports.report.markup import nav, now, page, plain_json, swatch
 from reports.report.overview import overview
 from reports.report.page import Page
-from reports.report.sec_renders import ENGINES
-from reports.report.sec_renders import render_engine as render_engine_of
+from reports.report.sec_renders import check_engine
 from reports.report.sections import FabricReport, run_section
 from reports.report.settings import QUALITIES, SECTIONS, TITLES
 from reports.report_measured import measured_page, overview_table, read_measured
@@ -206,11 +205,7 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     """
     if quality not in QUALITIES:
         raise ValueError(f"quality must be one of {', '.join(QUALITIES)}; got {quality!r}")
-    if render_engine not in ("auto", *ENGINES):
-        raise ValueError(f"render_engine must be auto, {', '.join(ENGINES)}; "
-                         f"got {render_engine!r}")
-    if render_engine == "mitsuba":
-        render_engine_of(brdf.fabric("velvet"), "mitsuba")     # refused now, not per page
+    check_engine(render_engine)                  # refused now, not page by page
     sections = _sections(sections)
     resolved = resolve_fabrics(fabrics)
     measured_fits = read_measured(measured) if measured is not None else None

@@ -28,7 +28,8 @@ from reports.report.page import Page, figure_html
 from reports.report.sec_figures import can_unmask
 from reports.report.settings import Section
 
-__all__ = ["RendersData", "RENDERS", "ENGINES", "section_renders", "render_engine"]
+__all__ = ["RendersData", "RENDERS", "ENGINES", "section_renders", "render_engine",
+           "check_engine"]
 
 #: Renders in the report: (file stem, scene, masking, caption).
 RENDERS = (("curtain", "curtain", True, "curtain"),
@@ -73,6 +74,21 @@ def _png(img: np.ndarray, exposure: float) -> bytes:
     return buf.getvalue()
 
 
+def check_engine(choice: str) -> None:
+    """Refuse an unknown engine, or ``mitsuba`` where Mitsuba cannot run llvm_ad_rgb
+    (ValueError, before any render)."""
+    if choice not in ("auto", *ENGINES):
+        raise ValueError(f"render engine {choice!r} is unknown; choose auto, "
+                         f"{', '.join(ENGINES)}")
+    if choice == "mitsuba" and not _mitsuba_usable():
+        raise ValueError("render engine mitsuba needs mitsuba with a usable LLVM "
+                         "(llvm_ad_rgb)")
+
+
+def _mitsuba_usable() -> bool:
+    return mitsuba_render.have_mitsuba() and mitsuba_render.variant_works("llvm_ad_rgb")[0]
+
+
 def render_engine(fabric, choice: str = "auto") -> str:
     """The engine of a fabric's renders: ``choice``, or for ``auto`` Mitsuba where it is
     installed, llvm_ad_rgb runs and ``fabric`` is a :class:`brdf.Fabric`, else the built-in.
@@ -80,18 +96,15 @@ def render_engine(fabric, choice: str = "auto") -> str:
     Raises
     ------
     ValueError
-        An unknown choice, or ``mitsuba`` where it cannot render this fabric.
+        An unknown choice (:func:`check_engine`), or ``mitsuba`` where it cannot render this
+        fabric.
     """
-    if choice not in ("auto", *ENGINES):
-        raise ValueError(f"render engine {choice!r} is unknown; choose auto, "
-                         f"{', '.join(ENGINES)}")
-    usable = (isinstance(fabric, brdf.Fabric) and mitsuba_render.have_mitsuba()
-              and mitsuba_render.variant_works("llvm_ad_rgb")[0])
-    if choice == "mitsuba" and not usable:
-        raise ValueError("render engine mitsuba needs mitsuba with a usable LLVM "
-                         "(llvm_ad_rgb) and a brdf.Fabric")
+    check_engine(choice)
+    is_fabric = isinstance(fabric, brdf.Fabric)
+    if choice == "mitsuba" and not is_fabric:
+        raise ValueError("render engine mitsuba renders a brdf.Fabric only")
     if choice == "auto":
-        return "mitsuba" if usable else "builtin"
+        return "mitsuba" if is_fabric and _mitsuba_usable() else "builtin"
     return choice
 
 

@@ -3,10 +3,13 @@ r"""The microcylinder model in Dr.Jit: f_r cos, the sampler's density and its dr
 The same equations as :mod:`brdf.kernel` and :mod:`brdf.shading` (MODEL.md, term by term),
 written with Dr.Jit operations so that they run in every Mitsuba 3 RGB variant: on Python
 floats in ``scalar_rgb``, on JIT arrays (one lane a direction pair) in ``llvm_ad_rgb`` and
-``cuda_ad_rgb``. The loops over the tangent samples are unrolled in Python: their number is a
-constant of the fabric (:class:`Consts`). Directions are in microcyl's local frame (n = +z, the
-warp along +x turned by the rotation angle); ``light`` is microcyl's wi (Mitsuba's ``wo``),
-``view`` its wo (Mitsuba's ``si.wi``).
+``cuda_ad_rgb``. The fabric's numbers never enter a kernel's code: in the JIT variants they
+are opaque values and arrays (:mod:`reports.mitsuba_consts`), and the sums over the tangent
+samples are Dr.Jit loops (``dr.while_loop``) over those arrays. One compiled kernel therefore
+serves every fabric with the same options (masking, reweighting, transmission, gap), presets
+and fitted fabrics alike, and its size does not grow with the number of tangent samples.
+Directions are in microcyl's local frame (n = +z, the warp along +x turned by the rotation
+angle); ``light`` is microcyl's wi (Mitsuba's ``wo``), ``view`` its wo (Mitsuba's ``si.wi``).
 
 Three formulas differ from the NumPy kernel in form only, for float32: theta_i + theta_r comes
 from ``atan2`` of its sine and cosine (``arccos`` of a cosine near 1 loses the angle's digits);
@@ -21,7 +24,7 @@ This module imports Mitsuba and Dr.Jit at its top: it is imported only through
 
 from __future__ import annotations
 
-import dataclasses
+import bisect
 import math
 from typing import NamedTuple
 
@@ -29,10 +32,10 @@ from typing import NamedTuple
 import drjit as dr
 import mitsuba as mi
 
-from brdf import sampling
 from brdf.terms import SIGMA_U
+from reports.mitsuba_consts import Consts, consts
 
-__all__ = ["Consts", "consts", "eval_cos", "pdf", "sample"]
+__all__ = ["Consts", "consts", "eval_cos", "pdf", "sample", "wide", "narrow"]
 
 _K_U = -0.5 / SIGMA_U**2            # u(x) = exp(_K_U x^2)
 _GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
@@ -40,70 +43,21 @@ _HALF_PI = 0.5 * math.pi
 _COS_MIN = 1e-12                    # as brdf.sampling: the 1/cos(theta) density stays finite
 
 
-@dataclasses.dataclass(frozen=True)
-class ThreadConsts:
-    """One thread's constants (Python floats): distinct tangent offsets and parameters."""
-
-    ca: tuple           # cos of the distinct tangent offsets
-    sa: tuple           # their sin
-    weight: tuple       # their weights (sum 1)
-    eta: float
-    kd: float
-    gamma_s: float      # radians
-    gamma_v: float      # radians
-    area: float
-    albedo: tuple       # RGB
+def _at(table, i, kind):
+    """table[i] (an index per lane): a gather in the JIT variants."""
+    return dr.gather(kind, table, i) if dr.is_jit_v(kind) else table[i]
 
 
-@dataclasses.dataclass(frozen=True)
-class Consts:
-    """Everything the kernel needs of a :class:`brdf.Fabric`, as Python floats.
+def _loop(n, body, *zeros):
+    """Sum ``body(i)`` (a tuple of terms) over i = 0 .. n - 1 in a Dr.Jit loop: symbolic (one
+    traced iteration, whatever n is) in the JIT variants, a Python loop in ``scalar_rgb``.
+    ``zeros`` are the sums' initial values."""
+    def step(i, *acc):
+        return (i + 1, *(a + b for a, b in zip(acc, body(i))))
 
-    ``comp_*`` is the sampler's flat component table (component 0 the cosine-weighted
-    hemisphere, then per thread, tangent offset and lobe) and ``comp_pmf`` its probabilities.
-    """
-
-    threads: tuple
-    masking: bool
-    reweighting: bool
-    transmission: str
-    gap: str
-    rotation: float     # radians
-    thread_p: tuple     # probability of each thread's lobes (brdf.sampling.lobe_probabilities)
-    lobe_p: tuple       # (2, 3): surface, volume, isotropic within each thread
-    comp_pmf: tuple
-    comp_thread: tuple
-    comp_ca: tuple
-    comp_sa: tuple
-    comp_kind: tuple    # -1 cosine, 0 surface, 1 volume, 2 isotropic
-    comp_sigma: tuple   # standard deviation of the longitudinal Gaussian, radians
-
-
-def consts(fabric) -> Consts:
-    """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric`)."""
-    threads = tuple(
-        ThreadConsts(tuple(map(float, c.ca)), tuple(map(float, c.sa)),
-                     tuple(map(float, c.weight)), float(t.eta), float(t.kd), float(c.gamma_s),
-                     float(c.gamma_v), float(t.area), tuple(map(float, t.albedo)))
-        for t, c in zip(fabric.threads, fabric._const))
-    thread_p, lobe_p = sampling.lobe_probabilities(fabric)
-    pmf, jj, ca, sa, kind, sig = [1.0 - float(thread_p.sum())], [0], [1.0], [0.0], [-1], [1.0]
-    for j, th in enumerate(threads):
-        if thread_p[j] == 0.0:
-            continue
-        for c, s, w in zip(th.ca, th.sa, th.weight):
-            for k in range(3):
-                pmf.append(float(thread_p[j] * w * lobe_p[j, k]))
-                jj.append(j)
-                ca.append(c)
-                sa.append(s)
-                kind.append(k)
-                sig.append(2.0 * (th.gamma_s if k == 0 else th.gamma_v))
-    opts = fabric.options
-    return Consts(threads, opts["masking"], opts["reweighting"], opts["transmission"],
-                  opts["gap"], float(opts["rotation"]), tuple(map(float, thread_p)),
-                  tuple(tuple(map(float, r)) for r in lobe_p), tuple(pmf), tuple(jj),
-                  tuple(ca), tuple(sa), tuple(kind), tuple(sig))
+    state = dr.while_loop(state=(mi.UInt32(0), *zeros), cond=lambda i, *acc: i < n,
+                          body=step, labels=("i",) + tuple(f"s{j}" for j in range(len(zeros))))
+    return state[1:]
 
 
 # -- frames --------------------------------------------------------------------------------
@@ -117,7 +71,7 @@ def thread_axes(w, c, s):
     return (t, b, w.z), (b, -t, w.z)
 
 
-def _wide(x):
+def wide(x):
     """x in double precision (JIT variants; Python floats are doubles already)."""
     return mi.Float64(x) if dr.is_jit_v(x) else x
 
@@ -130,7 +84,7 @@ class _Vec(NamedTuple):
     z: object
 
 
-def _narrow(x):
+def narrow(x):
     """x back in the variant's precision."""
     return mi.Float(x) if dr.is_jit_v(x) else x
 
@@ -144,9 +98,10 @@ def _blend(a, b, cos_delta):
     return prod + u * (dr.minimum(a, b) - prod)
 
 
-def _fresnel(eta2, c):
-    """Unpolarized Fresnel reflectance F_r and transmission 1 - F_r at incidence cosine c."""
-    g = dr.sqrt(eta2 - 1.0 + c * c)
+def _fresnel(eta2, eta2m1, c):
+    """Unpolarized Fresnel reflectance F_r and transmission 1 - F_r at incidence cosine c
+    (``eta2`` = eta^2, ``eta2m1`` = eta^2 - 1)."""
+    g = dr.sqrt(eta2m1 + c * c)
     e2c = eta2 * c
     rs, rp = (c - g) / (c + g), (e2c - g) / (e2c + g)
     a, b = c + g, e2c + g
@@ -164,13 +119,13 @@ def _sample_terms(th, ca, sa, light, view, k):
     ci_s, cr_s = dr.select(zero_i, 1.0, ci), dr.select(zero_r, 1.0, cr)
     ui_x, ui_y = dr.select(zero_i, 1.0, xi / ci_s), dr.select(zero_i, 0.0, bi / ci_s)
     ur_x, ur_y = dr.select(zero_r, 1.0, xr / cr_s), dr.select(zero_r, 0.0, bo / cr_s)
-    hp = _narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0, 1.0))
+    hp = narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0, 1.0))
     cc, ss = ci * cr, si * sr
-    c2d = _narrow(1.0 + cc + ss)                           # 2 cos^2(theta_d)
-    th2 = dr.square(_narrow(dr.atan2(si * cr + ci * sr, cc - ss)))   # (theta_i + theta_r)^2
-    ss = _narrow(ss)
-    si, xi, ci, sr, xr, cr, ui_x, ur_x = map(_narrow, (si, xi, ci, sr, xr, cr, ui_x, ur_x))
-    ti, zi, to, zo = map(_narrow, (ti, zi, to, zo))
+    c2d = narrow(1.0 + cc + ss)                           # 2 cos^2(theta_d)
+    th2 = dr.square(narrow(dr.atan2(si * cr + ci * sr, cc - ss)))   # (theta_i + theta_r)^2
+    ss = narrow(ss)
+    si, xi, ci, sr, xr, cr, ui_x, ur_x = map(narrow, (si, xi, ci, sr, xr, cr, ui_x, ur_x))
+    ti, zi, to, zo = map(narrow, (ti, zi, to, zo))
     cphi = 2.0 * hp - 1.0                                  # cos(phi_d)
     ok = c2d > 0.0
     c2d = dr.select(ok, c2d, 1.0)
@@ -185,14 +140,13 @@ def _sample_terms(th, ca, sa, light, view, k):
                    (xi * xr + ss) * irho_i * irho_r)
         geo *= p
     cg = dr.sqrt(0.5 * c2d * hp)                           # cos_g
-    eta2 = th.eta * th.eta
-    fr, tr = _fresnel(eta2, cg)
+    fr, tr = _fresnel(th.eta2, th.eta2m1, cg)
     if k.transmission == "half_angle":
         ft = tr * tr
     else:
-        ft = _fresnel(eta2, ci)[1] * _fresnel(eta2, cr)[1]
-    gs = dr.exp(th2 * (-0.125 / th.gamma_s**2)) * (_GAUSS_NORM / th.gamma_s)
-    gv = dr.exp(th2 * (-0.125 / th.gamma_v**2)) * ((1.0 - th.kd) * _GAUSS_NORM / th.gamma_v)
+        ft = _fresnel(th.eta2, th.eta2m1, ci)[1] * _fresnel(th.eta2, th.eta2m1, cr)[1]
+    gs = dr.exp(th2 * th.gs_k) * th.gs_c
+    gv = dr.exp(th2 * th.gv_k) * th.gv_c
     csum = ci + cr
     surf = fr * dr.sqrt(hp) * gs * geo
     vol = ft * (gv + th.kd) * geo / dr.select(csum > 0.0, csum, 1.0)
@@ -211,19 +165,22 @@ def eval_cos(k: Consts, light, view, rot_c, rot_s):
     (MODEL.md's f_r multiplied by n . wi), 0 where either direction is at or below the
     horizon or Q <= 0.
     """
-    rc, rs = _wide(rot_c), _wide(rot_s)
-    axes_l, axes_v = (thread_axes(_Vec(*map(_wide, (w.x, w.y, w.z))), rc, rs)
+    rc, rs = wide(rot_c), wide(rot_s)
+    axes_l, axes_v = (thread_axes(_Vec(*map(wide, (w.x, w.y, w.z))), rc, rs)
                       for w in (light, view))
     rgb = [0.0, 0.0, 0.0]
     q = 1.0
     if k.reweighting:
         gap = light.z if k.gap == "incident" else view.z
-        q = (1.0 - k.threads[0].area - k.threads[1].area) * gap
+        q = k.gap_area * gap
     for j, th in enumerate(k.threads):
-        surf = vol = pmean = 0.0
-        for ca, sa, w in zip(th.ca, th.sa, th.weight):
-            s, v, p = _sample_terms(th, ca, sa, axes_l[j], axes_v[j], k)
-            surf, vol, pmean = surf + w * s, vol + w * v, pmean + w * p
+        def terms(i, th=th, j=j):
+            s, v, p = _sample_terms(th, _at(th.ca, i, mi.Float64), _at(th.sa, i, mi.Float64),
+                                    axes_l[j], axes_v[j], k)
+            w = _at(th.weight, i, mi.Float)
+            return w * s, w * v, w * p
+
+        surf, vol, pmean = _loop(th.n, terms, *(mi.Float(0.0),) * 3)
         if k.reweighting:
             q = q + th.area * pmean
         for ch in range(3):
@@ -251,6 +208,23 @@ def _theta_r(axes_v, ca, sa):
     return dr.atan2(sr, dr.sqrt(xr * xr + bo * bo))
 
 
+def _thread_density(k, j, th, axes_l, axes_v, ca, sa):
+    """The density (1/sr) of thread j's lobes at the tangent offset (ca, sa), unweighted."""
+    ti, bi, zi = axes_l
+    si, xi = ti * ca + zi * sa, zi * ca - ti * sa
+    cth = dr.maximum(dr.sqrt(xi * xi + bi * bi), _COS_MIN)
+    mu = -_theta_r(axes_v, ca, sa)
+    th_i = dr.atan2(si, cth)
+    dens = 0.5 * th.lobe_p[2]
+    for lobe in (0, 1):
+        inv = th.inv_sig[lobe]
+        mass = _ndtr((_HALF_PI - mu) * inv) - _ndtr((-_HALF_PI - mu) * inv)
+        z = (th_i - mu) * inv
+        dens += th.lobe_p[lobe] * dr.exp(-0.5 * z * z) * (_GAUSS_NORM * inv) / (mass * cth)
+    pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
+    return dens * pphi
+
+
 def pdf(k: Consts, light, view, rot_c, rot_s):
     r"""Density (1/sr) of :func:`sample`'s light directions for the viewer ``view``.
 
@@ -258,50 +232,42 @@ def pdf(k: Consts, light, view, rot_c, rot_s):
     hemisphere (0 where either direction is at or below the horizon; the plugin also sets
     it to 0 where f_r is 0, see :mod:`reports.mitsuba`).
     """
-    total = (1.0 - sum(k.thread_p)) / math.pi * dr.maximum(light.z, 0.0)
+    total = k.cos_p * (1.0 / math.pi) * dr.maximum(light.z, 0.0)
     axes_l, axes_v = thread_axes(light, rot_c, rot_s), thread_axes(view, rot_c, rot_s)
     for j, th in enumerate(k.threads):
-        if k.thread_p[j] == 0.0:
+        if not k.sampled[j]:
             continue
-        ti, bi, zi = axes_l[j]
-        acc = 0.0
-        for ca, sa, w in zip(th.ca, th.sa, th.weight):
-            si, xi = ti * ca + zi * sa, zi * ca - ti * sa
-            cth = dr.maximum(dr.sqrt(xi * xi + bi * bi), _COS_MIN)
-            mu = -_theta_r(axes_v[j], ca, sa)
-            th_i = dr.atan2(si, cth)
-            dens = 0.5 * k.lobe_p[j][2]
-            for lobe, gamma in ((0, th.gamma_s), (1, th.gamma_v)):
-                sig = 2.0 * gamma
-                mass = _ndtr((_HALF_PI - mu) / sig) - _ndtr((-_HALF_PI - mu) / sig)
-                z = (th_i - mu) / sig
-                dens += k.lobe_p[j][lobe] * dr.exp(-0.5 * z * z) * (_GAUSS_NORM / sig) / (
-                    mass * cth)
-            pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
-            acc += w * dens * pphi
-        total += k.thread_p[j] * acc
+
+        def density(i, th=th, j=j):
+            ca, sa = _at(th.ca, i, mi.Float64), _at(th.sa, i, mi.Float64)
+            return (_at(th.weight, i, mi.Float)
+                    * _thread_density(k, j, th, axes_l[j], axes_v[j], narrow(ca),
+                                      narrow(sa)),)
+
+        total += k.thread_p[j] * _loop(th.n, density, mi.Float(0.0))[0]
     ok = (light.z > 0.0) & (view.z > 0.0)
     return dr.select(ok, total, 0.0)
 
 
-def _take(table, index):
-    """table[index] for a tuple of Python numbers: an index per lane."""
-    if isinstance(index, int):
-        return table[index]
-    return dr.gather(mi.Float, mi.Float(table), index)
+def _pick(k: Consts, u):
+    """The sampler's component for the uniform number ``u``: the first with cdf > u (a
+    binary search of log2(k.comp_size) steps in the JIT variants)."""
+    if not dr.is_jit_v(u):
+        return bisect.bisect_right(k.comp_cdf, u)
+    return dr.binary_search(0, k.comp_size - 1,
+                            lambda i: dr.gather(mi.Float, k.comp_cdf, i) <= u)
 
 
-def sample(k: Consts, dist, view, u1, u2, rot_c, rot_s):
+def sample(k: Consts, view, u1, u2, rot_c, rot_s):
     """A light direction (mi.Vector3f, local frame) for the viewer ``view``.
 
-    ``dist`` is an ``mi.DiscreteDistribution`` of ``k.comp_pmf``; ``u1`` picks the component,
-    ``u2`` (mi.Point2f) the longitudinal angle (x) and the azimuth (y), as
-    :func:`brdf.sampling.sample` does with its rescaled first and its second number.
+    ``u1`` picks the component, ``u2`` (mi.Point2f) the longitudinal angle (x) and the
+    azimuth (y), as :func:`brdf.sampling.sample` does with its rescaled first and its second
+    number.
     """
-    idx = dist.sample(u1)
-    idx = int(idx) if isinstance(u1, float) else idx
-    j, ca, sa = _take(k.comp_thread, idx), _take(k.comp_ca, idx), _take(k.comp_sa, idx)
-    kind, sig = _take(k.comp_kind, idx), _take(k.comp_sigma, idx)
+    idx = _pick(k, u1)
+    j, ca, sa = (_at(t, idx, mi.Float) for t in (k.comp_thread, k.comp_ca, k.comp_sa))
+    kind, sig = _at(k.comp_kind, idx, mi.Float), _at(k.comp_sigma, idx, mi.Float)
     second = j > 0.5
     # thread 1: t0 = (c, s, 0), b = (-s, c, 0); thread 2: t0 = (-s, c, 0), b = (-c, -s, 0)
     t0x, t0y = dr.select(second, -rot_s, rot_c), dr.select(second, rot_c, rot_s)

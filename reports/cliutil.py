@@ -1,8 +1,10 @@
-"""Pieces shared by the command-line verbs: fabric options, angle pairs, atomic writes."""
+"""Pieces shared by the command-line verbs: fabric options and sources, angle pairs, atomic
+writes."""
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import tempfile
@@ -20,7 +22,7 @@ from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
-__all__ = ["add_fabric_options", "fabric_from_args", "parse_angle_pair", "check_writable_dir",
+__all__ = ["add_fabric_options", "fabric_from_args", "fabric_source", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
@@ -183,6 +185,58 @@ def fabric_from_args(name: str, args: argparse.Namespace) -> brdf.Fabric:
                        tangent_sampling=args.tangent_sampling,
                        transmission=args.transmission, gap=args.gap,
                        rotation=math.radians(args.rotation))
+
+
+def fabric_source(text: str, what: str = "FABRIC") -> brdf.Fabric:
+    """The fabric that a FABRIC argument names: a preset, a fit, or an exported dictionary.
+
+    Parameters
+    ----------
+    text : str
+        A name in :data:`brdf.PRESETS`; a `microcyl fit` output folder (its posterior
+        medians, :func:`analysis.fit.median_fabric`: the fabric that ``microcyl export``
+        writes, without the fit's overall ``scale``, which only calibrates relative tables);
+        or a ``.json`` file of the Mitsuba plugin's dictionary (``microcyl export``'s, or one
+        written by hand: :func:`reports.mitsuba.fabric_from_dict`).
+    what : str
+        The argument's name in error messages.
+
+    Raises
+    ------
+    ValueError
+        One line naming the argument and the value: an unknown preset and no such file or
+        folder, a folder that is no fit, an unreadable or invalid dictionary.
+
+    Examples
+    --------
+    >>> fabric_source("velvet").name
+    'velvet'
+    """
+    if text in brdf.PRESETS:
+        return brdf.fabric(text)
+    path = Path(text)
+    if path.is_dir():
+        from analysis.fit.medians import median_fabric
+        try:
+            return median_fabric(path).fabric
+        except ValueError as exc:
+            raise ValueError(f"{what} {text!r}: not a fit folder: {exc}") from None
+    if path.is_file() and path.suffix.lower() == ".json":
+        from reports.mitsuba import fabric_from_dict    # needs no Mitsuba
+        try:
+            doc = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"{what} {text!r}: unreadable JSON ({exc})") from None
+        if not isinstance(doc, dict) or doc.get("type", "microcylinder") != "microcylinder":
+            kind = doc.get("type") if isinstance(doc, dict) else type(doc).__name__
+            raise ValueError(f"{what} {text!r}: must hold a microcylinder plugin dictionary "
+                             f"(a JSON object of type 'microcylinder'); got {kind!r}")
+        try:
+            return fabric_from_dict(doc)
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"{what} {text!r}: {exc}") from None
+    raise ValueError(f"{what} {text!r}: not a preset ({', '.join(brdf.PRESETS)}), a fit "
+                     f"folder or a .json dictionary of `microcyl export`")
 
 
 def parse_angle_pair(text: str) -> tuple[float, float]:

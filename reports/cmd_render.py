@@ -7,6 +7,9 @@
         [--light-radius R] [--workers N] [--engine builtin|mitsuba] [--variant V]
         [--max-depth N] [--quiet] -o out.exr
 
+FABRIC is a preset, a ``microcyl fit`` output folder (the fabric of its posterior medians, as
+``microcyl export`` writes it) or such an exported ``.json`` dictionary
+(:func:`reports.cliutil.fabric_source`); the variant options given change it further.
 ``-o out.exr`` writes the float32 linear EXR and an sRGB PNG beside it (``out.png``);
 ``-o out.png`` writes the PNG only.  Every argument is checked (scene, fabric and its
 options, size, output folder, engine and variant) before rendering starts.
@@ -45,7 +48,10 @@ def register(sub):
         description="Render a scene of cloth shaded with the microcylinder BRDF to a float32 "
                     "OpenEXR (linear RGB) and an sRGB PNG.")
     p.add_argument("scene", metavar="SCENE", help="curtain, cylinder, sphere or patch")
-    p.add_argument("fabric", metavar="FABRIC", help="a preset name (see `microcyl fabrics`)")
+    p.add_argument("fabric", metavar="FABRIC",
+                   help="a preset name (see `microcyl fabrics`), a `microcyl fit` output "
+                        "folder (its posterior medians) or a .json dictionary written by "
+                        "`microcyl export`")
     p.add_argument("--masking", metavar="on|off", help="shadowing and masking (default on)")
     p.add_argument("--reweighting", metavar="on|off",
                    help="reweighting by visible length (default on)")
@@ -150,7 +156,8 @@ def run(args):
     if suffix not in (".exr", ".png"):
         raise ValueError(f"-o {args.output}: the output must end in .exr or .png")
     imageio.check_output(out)
-    fabric = resolve_fabric(args.fabric, **_fabric_options(args))
+    fabric = resolve_fabric(cliutil.fabric_source(args.fabric, "fabric"),
+                            **_fabric_options(args))
     if args.light_radius is not None:
         if not (args.light_radius >= 0 and math.isfinite(args.light_radius)):
             raise ValueError(f"--light-radius {args.light_radius}: must be >= 0")

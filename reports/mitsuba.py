@@ -169,9 +169,15 @@ def fabric_from_dict(props: Mapping) -> brdf.Fabric:
             elif key in ("offsets", "lengths"):
                 v = _floats(f"{key}{j}", v)
             else:
-                v = float(v)
+                try:
+                    v = float(v)
+                except (TypeError, ValueError):
+                    raise ValueError(f"{key}{j} must be a number; got {v!r}") from None
             changes[key] = v
-        threads[j - 1] = threads[j - 1].replace(**changes)
+        try:
+            threads[j - 1] = threads[j - 1].replace(**changes)
+        except ValueError as exc:
+            raise ValueError(f"thread {j}: {exc}") from None
     options = {k: props[k] for k in OPTION_KEYS if k in props}
     if "rotation" in options:
         options["rotation"] = math.radians(float(options["rotation"]))

@@ -2,6 +2,7 @@
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 #: ../shared/data, the measured BRDF data kept beside this repository (never copied in).
@@ -15,3 +16,24 @@ def shared_data() -> Path:
         pytest.skip(f"measured data not found at {SHARED_DATA}")
     return SHARED_DATA
 
+
+@pytest.fixture(scope="session")
+def fit_folder(tmp_path_factory):
+    """A real (short) fit of velvet with a variant and a tie, written by fit_fabric: its
+    folder and its FitResult (free gamma_s1 and kd1, kd2 tied to kd1; masking off, rotation
+    0.25 rad)."""
+    tmp_path = tmp_path_factory.mktemp("fit")
+    import brdf
+    from analysis.fit import fit_fabric, fit_spec
+    from gonio.table import Table
+    fab = brdf.fabric("velvet", masking=False, rotation=0.25)
+    rng = np.random.default_rng(2)
+    wi = brdf.directions.from_angles(rng.uniform(0, 1.3, 300), rng.uniform(-3, 3, 300))
+    wo = brdf.directions.from_angles(rng.uniform(0, 1.3, 300), rng.uniform(-3, 3, 300))
+    f = fab.eval(wi, wo)
+    table = Table(wi, wo, f * (1 + 0.05 * rng.normal(size=f.shape)), sigma=0.05 * f + 1e-5)
+    spec = fit_spec(fab, "gamma_s1,kd1", ["kd2=kd1"], None)
+    out = tmp_path / "fit"
+    res = fit_fabric(table, fab, spec, out, max_steps=100, ensembles=2, progress=False,
+                     config_extra={"fabric": "velvet", "options": fab.options})
+    return out, res

@@ -34,7 +34,7 @@ def _one_line_error(capsys, status, expected_status=1):
 
 @pytest.mark.parametrize("argv, match", [
     (["teapot", "velvet"], "scene 'teapot' is unknown"),
-    (["cylinder", "tweed"], "fabric 'tweed' is unknown"),
+    (["cylinder", "tweed"], "fabric 'tweed': not a preset"),
     (["cylinder", "velvet", "--width", "1920"], "width=1920 is beyond the limit"),
     (["cylinder", "velvet", "--height", "1080"], "height=1080 is beyond the limit"),
     (["cylinder", "velvet", "--spp", "0"], "spp=0"),
@@ -178,3 +178,67 @@ def test_engine_mitsuba_end_to_end(tmp_path):
     from reports.colour import luminance
     shadow = shadow_mask(make_scene("cylinder"), 64, 36)
     assert luminance(img)[shadow].mean() > 0.5 * luminance(ref)[shadow].mean() > 0
+
+
+def _cli(*argv, cwd):
+    import os
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    return subprocess.run([sys.executable, "-m", "reports", *argv], cwd=cwd, timeout=300,
+                          env=dict(os.environ, PYTHONPATH=root), capture_output=True, text=True)
+
+
+@needs_brdf
+def test_render_a_fit_folder_and_its_export(fit_folder, tmp_path):
+    """`microcyl render sphere FIT_DIR` (progress bar on) renders the fit's median fabric: the
+    image of velvet with the fit's options and the medians of FitResult.summary put in here,
+    by hand; `microcyl export`'s JSON renders the same image, and a variant flag given on the
+    command line applies on top of the fit's options (its masking is off)."""
+    import brdf
+    from reports.render import render
+    folder, res = fit_folder
+    gs, kd = (res.summary[k]["median"] for k in ("gamma_s1", "kd1"))
+    base = brdf.fabric("velvet", masking=False, rotation=0.25)
+    t1, t2 = base.threads
+    want = base.replace(threads=[t1.replace(gamma_s=gs, kd=kd), t2.replace(kd=kd)])
+    size = ["--width", "48", "--height", "27", "--spp", "2", "--workers", "1"]
+    kw = dict(width=48, height=27, spp=2, progress=False, workers=1)
+    p = _cli("render", "sphere", str(folder), *size, "-o", "fit.exr", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "wrote" in p.stderr and "%" in p.stderr           # the progress bar and the files
+    got = imageio.read_exr(tmp_path / "fit.exr")
+    ref = render("sphere", want, **kw)
+    assert got.max() > 0 and np.array_equal(got, ref.astype(np.float32))
+    assert not np.array_equal(got, render("sphere", base, **kw).astype(np.float32))
+    assert _cli("export", str(folder), "-o", "fabric.json", cwd=tmp_path).returncode == 0
+    p = _cli("render", "sphere", "fabric.json", *size, "--quiet", "-o", "json.exr", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert np.array_equal(imageio.read_exr(tmp_path / "json.exr"), got)
+    p = _cli("render", "sphere", str(folder), *size, "--quiet", "--masking", "on", "-o",
+             "masked.exr", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    masked = render("sphere", want.replace(masking=True), **kw).astype(np.float32)
+    assert np.array_equal(imageio.read_exr(tmp_path / "masked.exr"), masked)
+    assert not np.array_equal(masked, got)
+
+
+@pytest.mark.parametrize("content, match", [
+    (None, "not a fit folder"),                       # a folder without results.json
+    ("[1, 2]", "must hold a microcylinder plugin dictionary"),
+    ('{"type": "diffuse"}', "got 'diffuse'"),
+    ('{"fabric": "velvet", "eta1": "glass"}', "eta1 must be a number; got 'glass'"),
+    ('{"fabric": "velvet", "eta2": 0.5}', "thread 2: eta must be"),
+    ("{nope", "unreadable JSON"),
+])
+def test_a_bad_fit_folder_or_dictionary_is_one_line(tmp_path, capsys, content, match):
+    source = tmp_path / "src"
+    if content is None:
+        source.mkdir()
+    else:
+        source = tmp_path / "fabric.json"
+        source.write_text(content)
+    status = main(["render", "patch", str(source), *SMALL, "-o", str(tmp_path / "x.png")])
+    line = _one_line_error(capsys, status)
+    assert match in line and str(source) in line
+    assert not (tmp_path / "x.png").exists()

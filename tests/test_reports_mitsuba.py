@@ -295,25 +295,6 @@ def test_mitsuba_chi2(llvm, name, theta, tmp_path, monkeypatch):
 
 
 # -- microcyl export and the README --------------------------------------------------------
-@pytest.fixture(scope="module")
-def fit_folder(tmp_path_factory):
-    """A real (short) fit of velvet with a variant and a tie, written by fit_fabric."""
-    tmp_path = tmp_path_factory.mktemp("fit")
-    from analysis.fit import fit_fabric, fit_spec
-    from gonio.table import Table
-    fab = brdf.fabric("velvet", masking=False, rotation=0.25)
-    rng = np.random.default_rng(2)
-    wi = brdf.directions.from_angles(rng.uniform(0, 1.3, 300), rng.uniform(-3, 3, 300))
-    wo = brdf.directions.from_angles(rng.uniform(0, 1.3, 300), rng.uniform(-3, 3, 300))
-    f = fab.eval(wi, wo)
-    table = Table(wi, wo, f * (1 + 0.05 * rng.normal(size=f.shape)), sigma=0.05 * f + 1e-5)
-    spec = fit_spec(fab, "gamma_s1,kd1", ["kd2=kd1"], None)
-    out = tmp_path / "fit"
-    res = fit_fabric(table, fab, spec, out, max_steps=100, ensembles=2, progress=False,
-                     config_extra={"fabric": "velvet", "options": fab.options})
-    return out, res
-
-
 def test_export_cli_writes_the_medians(fit_folder, tmp_path):
     out, res = fit_folder
     target = tmp_path / "fabric.json"

@@ -78,11 +78,9 @@ def _make_class():
         def eval_pdf(self, ctx, si, wo, active=True):
             """f_r cos and the density of valid draws: 0 where f_r cos is 0 (module notes)."""
             c, s = self._frame(si)
-            f = kern.eval_cos(self.k, wo, si.wi, c, s)
+            f, p = kern.eval_pdf(self.k, wo, si.wi, c, s)
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection)
-            cn, sn = kern.narrow(c), kern.narrow(s)
-            p = dr.select(on & (dr.max(f) > 0.0), kern.pdf(self.k, wo, si.wi, cn, sn), 0.0)
-            return dr.select(on, f, 0.0), p
+            return dr.select(on, f, 0.0), dr.select(on & (dr.max(f) > 0.0), p, 0.0)
 
         def eval(self, ctx, si, wo, active=True):
             c, s = self._frame(si)
@@ -97,8 +95,7 @@ def _make_class():
             c, s = self._frame(si)
             cn, sn = kern.narrow(c), kern.narrow(s)
             wo = kern.sample(self.k, si.wi, sample1, sample2, cn, sn)
-            p = kern.pdf(self.k, wo, si.wi, cn, sn)
-            f = kern.eval_cos(self.k, wo, si.wi, c, s)
+            f, p = kern.eval_pdf(self.k, wo, si.wi, c, s)
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection) & (p > 0.0) \
                 & (dr.max(f) > 0.0)
             bs = dr.zeros(mi.BSDFSample3f)

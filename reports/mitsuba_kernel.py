@@ -8,7 +8,8 @@ are opaque values and arrays (:mod:`reports.mitsuba_consts`), and the sums over 
 samples are Dr.Jit loops (``dr.while_loop``) over those arrays. One compiled kernel therefore
 serves every fabric with the same options (masking, reweighting, transmission, gap), presets
 and fitted fabrics alike, and its size does not grow with the number of tangent samples.
-Directions are in microcyl's local frame (n = +z, the warp along +x turned by the rotation
+:func:`eval_pdf` sums f_r cos and the sampler's density in one loop, sharing each sample's
+angles. Directions are in microcyl's local frame (n = +z, the warp along +x turned by the rotation
 angle); ``light`` is microcyl's wi (Mitsuba's ``wo``), ``view`` its wo (Mitsuba's ``si.wi``).
 
 Three formulas differ from the NumPy kernel in form only, for float32: theta_i + theta_r comes
@@ -35,7 +36,7 @@ import mitsuba as mi
 from brdf.terms import SIGMA_U
 from reports.mitsuba_consts import Consts, consts
 
-__all__ = ["Consts", "consts", "eval_cos", "pdf", "sample", "wide", "narrow"]
+__all__ = ["Consts", "consts", "eval_pdf", "eval_cos", "pdf", "sample", "wide", "narrow"]
 
 _K_U = -0.5 / SIGMA_U**2            # u(x) = exp(_K_U x^2)
 _GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
@@ -108,9 +109,10 @@ def _fresnel(eta2, eta2m1, c):
     return 0.5 * (rs * rs + rp * rp), 2.0 * c * g * (1.0 / (a * a) + eta2 / (b * b))
 
 
-def _sample_terms(th, ca, sa, light, view, k):
+def _sample_terms(th, ca, sa, light, view, k, density):
     """One tangent sample: (surface, volume / A, P) of MODEL.md, cos(theta_i) / cos^2(theta_d)
-    and M, P included."""
+    and M, P included, and with ``density`` the sampler's density of the thread's lobes at
+    this sample (:func:`_density`)."""
     (ti, bi, zi), (to, bo, zo) = light, view
     si, xi = ti * ca + zi * sa, zi * ca - ti * sa
     sr, xr = to * ca + zo * sa, zo * ca - to * sa
@@ -150,12 +152,15 @@ def _sample_terms(th, ca, sa, light, view, k):
     csum = ci + cr
     surf = fr * dr.sqrt(hp) * gs * geo
     vol = ft * (gv + th.kd) * geo / dr.select(csum > 0.0, csum, 1.0)
-    return surf, vol, p
+    if not density:
+        return surf, vol, p
+    return surf, vol, p, _density(k, th, si, xi, ci, sr, cr)
 
 
-def eval_cos(k: Consts, light, view, rot_c, rot_s):
-    r"""f_r(wi, wo) cos(theta_i), RGB, for the light direction ``light`` (microcyl's wi) and the
-    viewer ``view`` (its wo), unit mi.Vector3f in the local frame (n = +z).
+def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True):
+    r"""f_r(wi, wo) cos(theta_i), RGB, and the sampler's density, for the light direction
+    ``light`` (microcyl's wi) and the viewer ``view`` (its wo), unit mi.Vector3f in the local
+    frame (n = +z), in one pass over the tangent samples.
 
     ``rot_c``, ``rot_s``: cos and sin of the warp's angle from +x (the fabric's rotation and
     any per-hit turn). Returns an mi.Color3f, 1/sr times the cosine (dimensionless per sr):
@@ -163,7 +168,10 @@ def eval_cos(k: Consts, light, view, rot_c, rot_s):
     .. math:: f_r \cos\theta_i = \frac{a_1 S_1 + a_2 S_2}{Q}
 
     (MODEL.md's f_r multiplied by n . wi), 0 where either direction is at or below the
-    horizon or Q <= 0.
+    horizon or Q <= 0; and the density (1/sr) of :func:`sample`'s light directions, the
+    mixture of :func:`brdf.sampling.pdf` term by term, 0 where either direction is at or
+    below the horizon (the plugin also sets it to 0 where f_r is 0, see
+    :mod:`reports.mitsuba`), or None without ``with_pdf``.
     """
     rc, rs = wide(rot_c), wide(rot_s)
     axes_l, axes_v = (thread_axes(_Vec(*map(wide, (w.x, w.y, w.z))), rc, rs)
@@ -173,21 +181,34 @@ def eval_cos(k: Consts, light, view, rot_c, rot_s):
     if k.reweighting:
         gap = light.z if k.gap == "incident" else view.z
         q = k.gap_area * gap
+    total = k.cos_p * (1.0 / math.pi) * dr.maximum(light.z, 0.0)
     for j, th in enumerate(k.threads):
-        def terms(i, th=th, j=j):
-            s, v, p = _sample_terms(th, _at(th.ca, i, mi.Float64), _at(th.sa, i, mi.Float64),
-                                    axes_l[j], axes_v[j], k)
-            w = _at(th.weight, i, mi.Float)
-            return w * s, w * v, w * p
+        density = with_pdf and k.sampled[j]
 
-        surf, vol, pmean = _loop(th.n, terms, *(mi.Float(0.0),) * 3)
+        def terms(i, th=th, j=j, density=density):
+            out = _sample_terms(th, _at(th.ca, i, mi.Float64), _at(th.sa, i, mi.Float64),
+                                axes_l[j], axes_v[j], k, density)
+            w = _at(th.weight, i, mi.Float)
+            return tuple(w * x for x in out)
+
+        sums = _loop(th.n, terms, *(mi.Float(0.0),) * (4 if density else 3))
+        surf, vol, pmean = sums[:3]
+        if density:
+            total += k.thread_p[j] * sums[3]
         if k.reweighting:
             q = q + th.area * pmean
         for ch in range(3):
             rgb[ch] = rgb[ch] + th.area * (surf + th.albedo[ch] * vol)
-    ok = (light.z > 0.0) & (view.z > 0.0) & (q > 0.0)
+    up = (light.z > 0.0) & (view.z > 0.0)
+    ok = up & (q > 0.0)
     inv = dr.select(ok, 1.0 / dr.select(ok, q, 1.0), 0.0)
-    return mi.Color3f(rgb[0] * inv, rgb[1] * inv, rgb[2] * inv)
+    f = mi.Color3f(rgb[0] * inv, rgb[1] * inv, rgb[2] * inv)
+    return f, (dr.select(up, total, 0.0) if with_pdf else None)
+
+
+def eval_cos(k: Consts, light, view, rot_c, rot_s):
+    """f_r(wi, wo) cos(theta_i) alone (:func:`eval_pdf`)."""
+    return eval_pdf(k, light, view, rot_c, rot_s, with_pdf=False)[0]
 
 
 # -- the sampler (brdf/sampling.py) --------------------------------------------------------
@@ -201,19 +222,13 @@ def _ndtri(p):
     return math.sqrt(2.0) * dr.erfinv(dr.clip(2.0 * p - 1.0, -1.0, 1.0))
 
 
-def _theta_r(axes_v, ca, sa):
-    """Longitudinal angle of the viewer about the tangent (ca, sa) of one thread."""
-    to, bo, zo = axes_v
-    sr, xr = to * ca + zo * sa, zo * ca - to * sa
-    return dr.atan2(sr, dr.sqrt(xr * xr + bo * bo))
-
-
-def _thread_density(k, j, th, axes_l, axes_v, ca, sa):
-    """The density (1/sr) of thread j's lobes at the tangent offset (ca, sa), unweighted."""
-    ti, bi, zi = axes_l
-    si, xi = ti * ca + zi * sa, zi * ca - ti * sa
-    cth = dr.maximum(dr.sqrt(xi * xi + bi * bi), _COS_MIN)
-    mu = -_theta_r(axes_v, ca, sa)
+def _density(k, th, si, xi, ci, sr, cr):
+    """The density (1/sr) of a thread's lobes at one tangent sample, unweighted: the
+    light's longitudinal angle (sine ``si``, cosine ``ci``; ``xi`` its cosine's component
+    along the normal's side) under the Gaussians about the mirror of the viewer's (``sr``,
+    ``cr``), times the azimuth's density (brdf.sampling)."""
+    cth = dr.maximum(ci, _COS_MIN)
+    mu = -dr.atan2(sr, cr)
     th_i = dr.atan2(si, cth)
     dens = 0.5 * th.lobe_p[2]
     for lobe in (0, 1):
@@ -226,27 +241,8 @@ def _thread_density(k, j, th, axes_l, axes_v, ca, sa):
 
 
 def pdf(k: Consts, light, view, rot_c, rot_s):
-    r"""Density (1/sr) of :func:`sample`'s light directions for the viewer ``view``.
-
-    The mixture of :func:`brdf.sampling.pdf`, term by term, restricted to the upper
-    hemisphere (0 where either direction is at or below the horizon; the plugin also sets
-    it to 0 where f_r is 0, see :mod:`reports.mitsuba`).
-    """
-    total = k.cos_p * (1.0 / math.pi) * dr.maximum(light.z, 0.0)
-    axes_l, axes_v = thread_axes(light, rot_c, rot_s), thread_axes(view, rot_c, rot_s)
-    for j, th in enumerate(k.threads):
-        if not k.sampled[j]:
-            continue
-
-        def density(i, th=th, j=j):
-            ca, sa = _at(th.ca, i, mi.Float64), _at(th.sa, i, mi.Float64)
-            return (_at(th.weight, i, mi.Float)
-                    * _thread_density(k, j, th, axes_l[j], axes_v[j], narrow(ca),
-                                      narrow(sa)),)
-
-        total += k.thread_p[j] * _loop(th.n, density, mi.Float(0.0))[0]
-    ok = (light.z > 0.0) & (view.z > 0.0)
-    return dr.select(ok, total, 0.0)
+    """The sampler's density (1/sr) alone (:func:`eval_pdf`)."""
+    return eval_pdf(k, light, view, rot_c, rot_s)[1]
 
 
 def _pick(k: Consts, u):

@@ -181,20 +181,26 @@ def test_register_needs_an_rgb_variant():
         mi.set_variant("scalar_rgb")
 
 
-# -- llvm_ad_rgb -------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def llvm():
-    """mitsuba in llvm_ad_rgb, after reports.mitsuba_render's probe in a subprocess (an
-    unusable LLVM aborts the process that tries it)."""
+# -- the JIT variants: llvm_ad_rgb, and cuda_ad_rgb where a GPU is -------------------------
+#: Why a JIT variant cannot run, by variant: what to install.
+JIT_NEEDS = {"llvm_ad_rgb": "install libllvm19 and set DRJIT_LIBLLVM_PATH to its libLLVM-19.so "
+                            "(LLVM 14 and 15 fail)",
+             "cuda_ad_rgb": "it needs an NVIDIA GPU and its driver"}
+
+
+@pytest.fixture(scope="module", params=list(JIT_NEEDS))
+def jit(request):
+    """mitsuba in a JIT variant (llvm_ad_rgb, cuda_ad_rgb), after reports.mitsuba_render's
+    probe in a subprocess (an unusable LLVM aborts the process that tries it); skips with the
+    probe's reason where the variant does not run."""
     if not HAVE_MITSUBA:
         pytest.skip("mitsuba is not installed")
     from reports.mitsuba_render import variant_works
-    ok, why = variant_works("llvm_ad_rgb")
+    ok, why = variant_works(request.param)
     if not ok:
-        pytest.skip(f"no usable LLVM for Dr.Jit ({why}); install libllvm19 and set "
-                    f"DRJIT_LIBLLVM_PATH to its libLLVM-19.so (LLVM 14 and 15 fail)")
+        pytest.skip(f"{request.param} does not run here ({why}): {JIT_NEEDS[request.param]}")
     import mitsuba as mi
-    mi.set_variant("llvm_ad_rgb")
+    mi.set_variant(request.param)
     from reports import mitsuba as plugin
     plugin.register()
     yield mi
@@ -203,14 +209,14 @@ def llvm():
 
 #: Every preset under every variant: one kernel serves every fabric of a variant
 #: (test_one_kernel_serves_every_fabric), so this costs one compilation per variant.
-LLVM_CASES = CASES
+JIT_CASES = CASES
 
 
 @needs_mitsuba
-@pytest.mark.parametrize("name,variant", LLVM_CASES,
-                         ids=[f"{p}-{_id(v)}" for p, v in LLVM_CASES])
-def test_llvm_eval_matches_fabric_float32(llvm, name, variant):
-    mi, dr = llvm, pytest.importorskip("drjit")
+@pytest.mark.parametrize("name,variant", JIT_CASES,
+                         ids=[f"{p}-{_id(v)}" for p, v in JIT_CASES])
+def test_jit_eval_matches_fabric_float32(jit, name, variant):
+    mi, dr = jit, pytest.importorskip("drjit")
     rng = np.random.default_rng(zlib.crc32(f"llvm{name}{variant}".encode()))
     n = 10_000
     light, view = _hemi(rng, n), _hemi(rng, n)
@@ -219,7 +225,7 @@ def test_llvm_eval_matches_fabric_float32(llvm, name, variant):
     si.wi = mi.Vector3f(view[:, 0], view[:, 1], view[:, 2])
     out = bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(light[:, 0], light[:, 1], light[:, 2]))
     out = np.asarray(out.numpy(), dtype=np.float64).T
-    assert mi.Float is dr.llvm.ad.Float                  # float32 lanes
+    assert dr.is_jit_v(mi.Float) and dr.type_v(mi.Float) == dr.VarType.Float32
     assert _worst(out, _reference(name, variant, light, view)) < RTOL
 
 
@@ -247,10 +253,10 @@ def _kernel_hashes(mi, dr, props, light, view, u):
 
 
 @needs_mitsuba
-def test_one_kernel_serves_every_fabric(llvm):
+def test_one_kernel_serves_every_fabric(jit):
     """The fabric's numbers are kernel parameters, not code: every preset, and a fitted-like
     fabric of other tangent offsets, launch the same kernels; another option does not."""
-    mi, dr = llvm, pytest.importorskip("drjit")
+    mi, dr = jit, pytest.importorskip("drjit")
     rng = np.random.default_rng(11)
     light, view = (mi.Vector3f(*_jit(mi, dr, *_hemi(rng, 512).T)) for _ in range(2))
     args = (light, view, _jit(mi, dr, *rng.random((3, 512))))
@@ -275,11 +281,11 @@ CHI2_CASES = [(p, th) for p in brdf.PRESETS for th in (30.0, 75.0)]
 @needs_mitsuba
 @pytest.mark.slow
 @pytest.mark.parametrize("name,theta", CHI2_CASES, ids=[f"{p}-{t:g}" for p, t in CHI2_CASES])
-def test_mitsuba_chi2(llvm, name, theta, tmp_path, monkeypatch):
+def test_mitsuba_chi2(jit, name, theta, tmp_path, monkeypatch):
     """Mitsuba's own chi-square test of sample against pdf through BSDFAdapter. The pdf
     grows like 1/cos(theta) toward each tangent sample (brdf.sampling), so the cells are
     integrated with ires=16 (the default 4 overestimates them by ~1%)."""
-    mi = llvm
+    mi = jit
     monkeypatch.chdir(tmp_path)                 # a failed test writes chi2_data.py here
     from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
     t = math.radians(theta)

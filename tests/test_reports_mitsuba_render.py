@@ -6,7 +6,8 @@ directions, Mitsuba by MIS of the envmap's and the BSDF's draws). Their images' 
 luminances then differ by Monte Carlo noise alone, plus the tessellation of the meshes and
 float32: the test allows 4 standard errors of the mean of the per-pixel difference (pixels
 are independent; the scene's structure cancels in the difference, so its spread is noise)
-plus 1 % of the mean. Tests that need llvm_ad_rgb skip where Dr.Jit finds no usable LLVM;
+plus 1 % of the mean. The JIT tests run in llvm_ad_rgb and cuda_ad_rgb and skip where the
+variant does not run (no usable LLVM, no GPU);
 scalar_rgb runs wherever Mitsuba is installed.
 """
 
@@ -26,13 +27,15 @@ pytestmark = pytest.mark.skipif(not mitsuba_render.have_mitsuba(),
 W, H, SPP = 64, 36, 4
 
 
-@pytest.fixture(scope="module")
-def llvm():
-    ok, why = mitsuba_render.variant_works("llvm_ad_rgb")
+@pytest.fixture(scope="module", params=["llvm_ad_rgb", "cuda_ad_rgb"])
+def jit(request):
+    """A JIT variant that runs here (llvm_ad_rgb: a usable LLVM; cuda_ad_rgb: a GPU)."""
+    ok, why = mitsuba_render.variant_works(request.param)
     if not ok:
-        pytest.skip(f"no usable LLVM for Dr.Jit ({why}); install libllvm19 and set "
-                    f"DRJIT_LIBLLVM_PATH to its libLLVM-19.so")
-    return "llvm_ad_rgb"
+        need = ("install libllvm19 and set DRJIT_LIBLLVM_PATH to its libLLVM-19.so"
+                if request.param == "llvm_ad_rgb" else "it needs an NVIDIA GPU")
+        pytest.skip(f"{request.param} does not run here ({why}): {need}")
+    return request.param
 
 
 def shadow_mask(scene, width, height):
@@ -63,9 +66,9 @@ def agree(a, b, extra=0.01):
     return diff.mean() / lb.mean()
 
 
-def test_direct_light_agrees_with_the_builtin_renderer(llvm):
+def test_direct_light_agrees_with_the_builtin_renderer(jit):
     fab = brdf.fabric("velvet")
-    a = mitsuba_render.render_mitsuba("cylinder", fab, W, H, SPP, max_depth=2, variant=llvm,
+    a = mitsuba_render.render_mitsuba("cylinder", fab, W, H, SPP, max_depth=2, variant=jit,
                                       progress=False)
     b = render("cylinder", fab, W, H, SPP, progress=False, workers=1)
     assert a.shape == (H, W, 3) and a.dtype == np.float32 and np.all(np.isfinite(a))

@@ -5,7 +5,10 @@ After :func:`register` (with a Mitsuba RGB variant set),
 thread parameter and option is a key of the same dictionary (:data:`THREAD_KEYS`,
 :data:`OPTION_KEYS`): ``eta1``, ``albedo2`` (a number or ``{"type": "rgb", "value": [r, g,
 b]}``), ``offsets1`` (degrees, a comma-separated string), ``masking``, ``rotation`` (degrees),
-... Keys left out keep the preset's values and microcyl's defaults. The kernel is written in
+... Keys left out keep the preset's values and microcyl's defaults. ``mi.traverse`` exposes each
+thread's ``eta``, ``albedo``, ``kd``, ``gamma_s``, ``gamma_v`` and ``area`` (1 or 2 appended) and
+``rotation`` for editing (:data:`reports.mitsuba_bsdf.TRAVERSED_THREAD_KEYS`); a JIT variant
+then reuses its compiled kernel. The kernel is written in
 Dr.Jit (:mod:`reports.mitsuba_kernel`) and runs in ``scalar_rgb``, ``llvm_ad_rgb`` and
 ``cuda_ad_rgb``.
 

@@ -10,14 +10,18 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
+import brdf
+
 # optional dependencies: this module is imported only by reports.mitsuba.register()
 import drjit as dr
 import mitsuba as mi
 
 from reports import mitsuba_kernel as kern
-from reports.mitsuba import fabric_from_dict
+from reports.mitsuba import PLUGIN_NAME, fabric_from_dict
 
-__all__ = ["bsdf_class"]
+__all__ = ["bsdf_class", "TRAVERSED_THREAD_KEYS", "TRAVERSED_OPTION_KEYS"]
 
 _CLASSES: dict = {}
 
@@ -51,6 +55,66 @@ def _warp(si, rotation):
     return c * cr - s * sr, s * cr + c * sr
 
 
+#: The parameters that ``mi.traverse`` exposes, per thread (with 1 or 2 appended), and the
+#: options; gammas and rotation in degrees, as in the plugin's dictionary. The tangent curves
+#: (offsets, lengths) and the other options shape the kernel: change them by loading anew.
+TRAVERSED_THREAD_KEYS = ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area")
+TRAVERSED_OPTION_KEYS = ("rotation",)
+
+
+def _param(value):
+    """A traversable holder of ``value``: Color3f for RGB, else a one-entry array that
+    ``SceneParameters`` can write (a Python float it cannot)."""
+    if isinstance(value, tuple):
+        return mi.Color3f(*value)
+    return mi.Float(value) if dr.is_jit_v(mi.Float) else dr.scalar.Array1f(value)
+
+
+def _read(holder):
+    """The Python float, or RGB tuple, that a :func:`_param` holder holds now."""
+    v = np.asarray(holder, dtype=np.float64).ravel()
+    return tuple(float(x) for x in v) if v.size == 3 else float(v[0])
+
+
+def _params_of(fabric) -> dict:
+    """The traversed parameters of ``fabric``, as :func:`_param` holders."""
+    out = {}
+    for j, t in enumerate(fabric.threads, start=1):
+        for key in TRAVERSED_THREAD_KEYS:
+            v = getattr(t, key)
+            out[f"{key}{j}"] = _param(tuple(map(float, v)) if key == "albedo" else float(v))
+    out["rotation"] = _param(math.degrees(fabric.options["rotation"]))
+    return out
+
+
+def _write(params, fabric) -> None:
+    """Put ``fabric``'s values into the holders ``params``, in place (the SceneParameters of
+    an earlier ``mi.traverse`` keep them)."""
+    for key, fresh in _params_of(fabric).items():
+        value = _read(fresh)
+        holder = params[key]
+        for i, x in enumerate(value if isinstance(value, tuple) else (value,)):
+            holder[i] = x
+
+
+def _fabric_with(fabric, params, keys) -> brdf.Fabric:
+    """``fabric`` with the values that the holders ``params`` of ``keys`` hold now (the
+    others as they were: a holder is float32); ValueError where one is out of range, naming
+    its thread."""
+    keys = set(keys)
+    threads = []
+    for j, t in enumerate(fabric.threads, start=1):
+        changes = {k: _read(params[f"{k}{j}"]) for k in TRAVERSED_THREAD_KEYS
+                   if f"{k}{j}" in keys}
+        try:
+            threads.append(t.replace(**changes))
+        except ValueError as exc:
+            raise ValueError(f"{PLUGIN_NAME}: thread {j}: {exc}") from None
+    rotation = (math.radians(_read(params["rotation"])) if "rotation" in keys
+                else fabric.options["rotation"])
+    return fabric.replace(threads=threads, rotation=rotation)
+
+
 def bsdf_class():
     """The ``microcylinder`` BSDF class of the variant that is set."""
     variant = mi.variant()
@@ -69,8 +133,26 @@ def _make_class():
             mi.BSDF.__init__(self, props)
             self.fabric = fabric_from_dict(_props_dict(props))
             self.k = kern.consts(self.fabric)
+            self.params = _params_of(self.fabric)
             self.m_components = [flags]
             self.m_flags = flags
+
+        def traverse(self, callback):
+            """Expose :data:`TRAVERSED_THREAD_KEYS` and :data:`TRAVERSED_OPTION_KEYS` to
+            ``mi.traverse`` (not differentiable)."""
+            for key, holder in self.params.items():
+                callback.put(key, holder, mi.ParamFlags.NonDifferentiable)
+
+        def parameters_changed(self, keys):
+            """Rebuild the fabric and its constants from the traversed values: the kernel
+            takes them as parameters, so the next render reuses it. An out-of-range value
+            raises ValueError and leaves the BSDF as it was."""
+            try:
+                fabric = _fabric_with(self.fabric, self.params, keys)
+            except ValueError:
+                _write(self.params, self.fabric)        # back to the values in use
+                raise
+            self.fabric, self.k = fabric, kern.consts(fabric)
 
         def _frame(self, si):
             return _warp(si, self.k.rotation)

@@ -238,8 +238,9 @@ def _jit(mi, dr, *columns):
 
 
 def _kernel_hashes(mi, dr, props, light, view, u):
-    """Hashes of the JIT kernels that eval, pdf and sample of the plugin ``props`` launch."""
-    bsdf = mi.load_dict({"type": "microcylinder", **props})
+    """Hashes of the JIT kernels that eval, pdf and sample of the plugin ``props`` (a dict,
+    or a loaded BSDF) launch."""
+    bsdf = mi.load_dict({"type": "microcylinder", **props}) if isinstance(props, dict) else props
     si = dr.zeros(mi.SurfaceInteraction3f, dr.width(view))
     si.wi = view
     si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
@@ -273,6 +274,80 @@ def test_one_kernel_serves_every_fabric(jit):
     assert first and all(h == first for h in seen.values()), seen
     assert other == first
     assert unmasked != first
+
+
+def _edited(name, **changes):
+    """brdf.fabric(name) with thread values changed ({key}{j}, as the plugin names them) and
+    a rotation in degrees: what an edit through mi.traverse should give."""
+    fab = brdf.fabric(name, rotation=math.radians(changes.pop("rotation", 0.0)))
+    threads = [t.replace(**{k[:-1]: v for k, v in changes.items() if k.endswith(str(j))})
+               for j, t in enumerate(fab.threads, start=1)]
+    return fab.replace(threads=threads)
+
+
+TRAVERSED = sorted(f"{k}{j}" for j in (1, 2)
+                   for k in ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area")) + ["rotation"]
+
+
+@needs_mitsuba
+def test_traverse_edits_the_fabric(scalar):
+    """mi.traverse exposes every thread's numbers and the rotation; an edit, once updated,
+    gives the fabric with those values (Mitsuba holds them as float32); an out-of-range one
+    is refused with the thread named and changes nothing."""
+    mi = scalar
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": "silk_shot"})
+    params = mi.traverse(bsdf)
+    assert sorted(params.keys()) == TRAVERSED
+    params["eta1"] = 1.7
+    params["albedo2"] = mi.Color3f(0.1, 0.2, 0.3)
+    params["gamma_s2"] = 9.0
+    params["rotation"] = 30.0
+    params.update()
+    f32 = lambda x: float(np.float32(x))  # noqa: E731
+    want = _edited("silk_shot", eta1=f32(1.7), albedo2=tuple(map(f32, (0.1, 0.2, 0.3))),
+                   gamma_s2=9.0, rotation=30.0)
+    rng = np.random.default_rng(21)
+    light, view = _hemi(rng, 60), _hemi(rng, 60)
+    got = _scalar_eval(mi, bsdf, light, view)
+    ref = want.eval(light.astype(float), view.astype(float)) * light[:, 2:3]
+    assert _worst(got, ref) < RTOL
+    assert _worst(got, _reference("silk_shot", {}, light, view)) > 1e-2     # it did change
+    params["kd1"] = 1.5
+    with pytest.raises(ValueError, match="thread 1: kd"):
+        params.update()
+    assert float(np.ravel(params["kd1"])[0]) == f32(want.threads[0].kd)     # put back
+    np.testing.assert_array_equal(_scalar_eval(mi, bsdf, light, view), got)
+
+
+@needs_mitsuba
+def test_traverse_edit_reuses_the_kernel(jit):
+    """In a JIT variant an edit changes the kernel's parameters, not its code: the same
+    kernels run, and they compute the edited fabric (float32, 1e-5)."""
+    mi, dr = jit, pytest.importorskip("drjit")
+    rng = np.random.default_rng(12)
+    light_np, view_np = _hemi(rng, 2000), _hemi(rng, 2000)
+    light, view = (mi.Vector3f(*_jit(mi, dr, *x.T)) for x in (light_np, view_np))
+    args = (light, view, _jit(mi, dr, *rng.random((3, 2000))))
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": "velvet"})
+    dr.set_flag(dr.JitFlag.KernelHistory, True)
+    try:
+        before = _kernel_hashes(mi, dr, bsdf, *args)
+        params = mi.traverse(bsdf)
+        params["kd2"] = 0.6
+        params["gamma_v1"] = 20.0
+        params["area1"] = 0.4
+        params.update()
+        after = _kernel_hashes(mi, dr, bsdf, *args)
+    finally:
+        dr.set_flag(dr.JitFlag.KernelHistory, False)
+    assert before and after == before
+    si = dr.zeros(mi.SurfaceInteraction3f, 2000)
+    si.wi = view
+    out = np.asarray(bsdf.eval(mi.BSDFContext(), si, light).numpy(), dtype=np.float64).T
+    want = _edited("velvet", kd2=float(np.float32(0.6)), gamma_v1=20.0,
+                   area1=float(np.float32(0.4)))
+    ref = want.eval(light_np.astype(float), view_np.astype(float)) * light_np[:, 2:3]
+    assert _worst(out, ref) < RTOL
 
 
 CHI2_CASES = [(p, th) for p in brdf.PRESETS for th in (30.0, 75.0)]
@@ -350,3 +425,6 @@ def test_readme_mitsuba_example(scalar, tmp_path, monkeypatch):
     img = np.asarray(ns["image"])
     assert img.shape[-1] == 3 and np.isfinite(img).all() and img.mean() > 0
     assert (tmp_path / "velvet.exr").exists()      # write_async=False: written at once
+    edited = np.asarray(ns["edited"])               # after the edit through mi.traverse
+    assert np.isfinite(edited).all() and edited.mean() > 0
+    assert np.abs(edited - img).max() > 0.01 * img.max()

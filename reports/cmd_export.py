@@ -1,12 +1,14 @@
 """The ``microcyl export`` verb: a fit's posterior medians as a Mitsuba plugin dictionary.
 
-``microcyl export FIT_DIR -o fabric.json``
+``microcyl export FIT_DIR -o fabric.json`` (or ``-o fabric.xml``)
 
 Reads ``FIT_DIR/results.json`` and ``FIT_DIR/fit_config.json``
 (:func:`analysis.fit.medians.median_fabric`) and writes the ``microcylinder`` BSDF's
 dictionary (:func:`reports.mitsuba.plugin_dict`: every thread parameter and option spelled
-out) as JSON, atomically. ``mi.load_dict(json.load(open("fabric.json")))`` renders it after
-``reports.mitsuba.register()``. Needs no Mitsuba.
+out) as JSON, or as a Mitsuba XML ``<bsdf>`` element where FILE ends in ``.xml``
+(:func:`reports.mitsuba.plugin_xml`), atomically. After ``reports.mitsuba.register()``,
+``mi.load_dict(json.load(open("fabric.json")))`` loads the first, and a scene file holding the
+second refers to it by ``<ref id="fabric"/>``. Needs no Mitsuba.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from pathlib import Path
 from analysis.fit.medians import median_fabric
 from gonio import atomic_write
 from gonio.jsonplain import plain
-from reports.mitsuba import plugin_dict
+from reports.mitsuba import plugin_dict, plugin_xml
 
 __all__ = ["register", "run"]
 
@@ -34,7 +36,8 @@ def register(sub):
                     "dictionary of the Mitsuba 3 BSDF 'microcylinder' (reports.mitsuba).")
     p.add_argument("fit_dir", metavar="FIT_DIR", help="a `microcyl fit` output folder")
     p.add_argument("-o", "--output", required=True, metavar="FILE",
-                   help="JSON file to write (e.g. fabric.json)")
+                   help="file to write: fabric.json (the dictionary for mi.load_dict) or "
+                        "fabric.xml (a <bsdf> element for Mitsuba scene files)")
     p.set_defaults(func=run)
 
 
@@ -47,9 +50,12 @@ def run(args) -> int:
     out = Path(args.output)
     if not out.parent.is_dir():
         raise ValueError(f"{out.parent}: output folder does not exist")
-    doc = plain(plugin_dict(med.fabric, med.preset))
+    if out.suffix.lower() == ".xml":
+        text = plugin_xml(med.fabric, med.preset)
+    else:
+        text = json.dumps(plain(plugin_dict(med.fabric, med.preset)), indent=2) + "\n"
     with atomic_write(out, "w") as fh:
-        fh.write(json.dumps(doc, indent=2) + "\n")
+        fh.write(text)
     log.info("wrote %s", out)
     verdict = "converged" if med.converged else "NOT converged (medians of an unfinished fit)"
     print(f"{med.preset}: medians of {', '.join(med.free)} ({verdict}) -> {out}")

@@ -25,20 +25,21 @@ as it does for velvet seen at grazing angles: every tangent sample then faces aw
 light or the viewer). The BSDF is one-sided (``FrontSide``); wrap it in Mitsuba's
 ``twosided`` for cloth seen from both sides.
 
-:func:`plugin_dict` and :func:`fabric_from_dict` need no Mitsuba: they turn a
-:class:`brdf.Fabric` into the plugin's dictionary and back (``microcyl export`` writes one for a
-fit's posterior medians).
+:func:`plugin_dict`, :func:`plugin_xml` and :func:`fabric_from_dict` need no Mitsuba: they
+turn a :class:`brdf.Fabric` into the plugin's dictionary (or its XML ``<bsdf>`` element, for
+scene files) and back (``microcyl export`` writes either for a fit's posterior medians).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from xml.sax.saxutils import quoteattr
 
 import brdf
 from brdf.fabric import OPTIONS
 
-__all__ = ["register", "plugin_dict", "fabric_from_dict", "PLUGIN_NAME", "THREAD_KEYS",
+__all__ = ["register", "plugin_dict", "plugin_xml", "fabric_from_dict", "PLUGIN_NAME", "THREAD_KEYS",
            "OPTION_KEYS", "RGB_VARIANTS"]
 
 #: The plugin's name in Mitsuba's registry.
@@ -88,6 +89,47 @@ def plugin_dict(fabric: brdf.Fabric, preset: str | None = None) -> dict:
     for key, v in fabric.options.items():
         out[key] = math.degrees(v) if key == "rotation" else v
     return out
+
+
+def plugin_xml(fabric: brdf.Fabric, preset: str | None = None, bsdf_id: str = "fabric") -> str:
+    """The plugin's dictionary of ``fabric`` as a Mitsuba 3 XML ``<bsdf>`` element.
+
+    Parameters
+    ----------
+    fabric : brdf.Fabric
+    preset : str, optional
+        As in :func:`plugin_dict`.
+    bsdf_id : str
+        The element's ``id``, for ``<ref id="..."/>`` in a scene file.
+
+    Returns
+    -------
+    str
+        A ``<bsdf type="microcylinder">`` element with every key of :func:`plugin_dict`
+        (``boolean``, ``integer``, ``float``, ``string`` and ``rgb`` properties), to paste
+        into a scene file that is loaded after :func:`register`.
+
+    Examples
+    --------
+    >>> print(plugin_xml(brdf.fabric("velvet")).splitlines()[1])
+        <string name="fabric" value="velvet"/>
+    """
+    lines = [f'<bsdf type="{PLUGIN_NAME}" id={quoteattr(bsdf_id)}>']
+    for key, v in plugin_dict(fabric, preset).items():
+        if key == "type":
+            continue
+        if isinstance(v, bool):
+            tag, text = "boolean", "true" if v else "false"
+        elif isinstance(v, int):
+            tag, text = "integer", str(v)
+        elif isinstance(v, float):
+            tag, text = "float", repr(v)
+        elif isinstance(v, Mapping):
+            tag, text = "rgb", ", ".join(repr(float(c)) for c in v["value"])
+        else:
+            tag, text = "string", str(v)
+        lines.append(f'    <{tag} name="{key}" value={quoteattr(text)}/>')
+    return "\n".join(lines + ["</bsdf>"]) + "\n"
 
 
 def _number(x) -> str:

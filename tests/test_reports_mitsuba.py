@@ -411,6 +411,32 @@ def test_export_dict_loads_in_mitsuba(fit_folder, scalar):
     assert _worst(got, ref) < RTOL
 
 
+@needs_mitsuba
+def test_export_xml_loads_in_a_scene_file(fit_folder, scalar, tmp_path):
+    """`microcyl export FIT -o fabric.xml` writes a <bsdf> element that a Mitsuba scene file
+    takes as it is (pasted in, referred to by id) and that evaluates the median fabric."""
+    mi = scalar
+    out, _ = fit_folder
+    target = tmp_path / "fabric.xml"
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    p = subprocess.run([sys.executable, "-m", "reports", "export", str(out), "-o", str(target)],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    element = target.read_text()
+    assert element.startswith('<bsdf type="microcylinder" id="fabric">')
+    scene = mi.load_string('<scene version="3.0.0">\n' + element
+                           + '<shape type="rectangle"><ref id="fabric"/></shape>\n</scene>')
+    bsdf = scene.shapes()[0].bsdf()
+    from analysis.fit import median_fabric
+    med = median_fabric(out)
+    rng = np.random.default_rng(19)
+    light, view = _hemi(rng, 30), _hemi(rng, 30)
+    got = _scalar_eval(mi, bsdf, light, view)
+    ref = med.fabric.eval(light.astype(float), view.astype(float)) * light[:, 2:3]
+    assert _worst(got, ref) < RTOL
+    assert not med.fabric.options["masking"]        # the fit's variant came through
+
+
 def test_readme_mitsuba_example(scalar, tmp_path, monkeypatch):
     """The README's "Mitsuba 3" example (a ```py block, kept out of test_readme's run because
     the main venv may lack Mitsuba) runs and renders a non-black image."""

@@ -350,6 +350,39 @@ def test_traverse_edit_reuses_the_kernel(jit):
     assert _worst(out, ref) < RTOL
 
 
+def _two_cloths(mi, left, right):
+    """A scene of two rectangles side by side, with the plugin dictionaries left and right."""
+    T = mi.ScalarTransform4f()
+    return mi.load_dict({
+        "type": "scene", "integrator": {"type": "path", "max_depth": 4},
+        "sensor": {"type": "perspective", "fov": 60,
+                   "to_world": T.look_at(origin=[0, -2.5, 2], target=[0, 0, 0], up=[0, 0, 1]),
+                   "film": {"type": "hdrfilm", "width": 64, "height": 32},
+                   "sampler": {"type": "independent", "sample_count": 8}},
+        "a": {"type": "rectangle", "to_world": T.translate([-1.1, 0, 0]),
+              "bsdf": {"type": "microcylinder", **left}},
+        "b": {"type": "rectangle", "to_world": T.translate([1.1, 0, 0]),
+              "bsdf": {"type": "microcylinder", **right}},
+        "lamp": {"type": "point", "position": [0, -1, 3],
+                 "intensity": {"type": "rgb", "value": [20, 20, 20]}},
+        "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.2]}}})
+
+
+@needs_mitsuba
+def test_two_fabrics_in_one_scene_keep_their_own_numbers(jit):
+    """Two instances of the plugin share one kernel but not their numbers: each half of a
+    scene with velvet on the left and linen on the right is the half of the scene with that
+    fabric on both sides (same seed, same paths)."""
+    mi = jit
+    velvet, linen = {"fabric": "velvet"}, {"fabric": "linen_plain"}
+    both = np.asarray(mi.render(_two_cloths(mi, velvet, linen), seed=3))
+    left = np.asarray(mi.render(_two_cloths(mi, velvet, velvet), seed=3))
+    right = np.asarray(mi.render(_two_cloths(mi, linen, linen), seed=3))
+    assert both[:, :32].mean() > 0 and both[:, 32:].mean() > 1.5 * both[:, :32].mean()
+    np.testing.assert_allclose(both[:, :32], left[:, :32], rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(both[:, 32:], right[:, 32:], rtol=1e-5, atol=1e-7)
+
+
 CHI2_CASES = [(p, th) for p in brdf.PRESETS for th in (30.0, 75.0)]
 
 

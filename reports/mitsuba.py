@@ -5,7 +5,9 @@ After :func:`register` (with a Mitsuba RGB variant set),
 thread parameter and option is a key of the same dictionary (:data:`THREAD_KEYS`,
 :data:`OPTION_KEYS`): ``eta1``, ``albedo2`` (a number or ``{"type": "rgb", "value": [r, g,
 b]}``), ``offsets1`` (degrees, a comma-separated string), ``masking``, ``rotation`` (degrees),
-... Keys left out keep the preset's values and microcyl's defaults. ``mi.traverse`` exposes each
+... Keys left out keep the preset's values and microcyl's defaults. ``albedo1`` and ``albedo2``
+also take a Mitsuba texture (``bitmap``, ``checkerboard``, ...): f_r uses its value at each
+hit, the sampler its mean (:data:`reports.mitsuba_bsdf.TEXTURED_KEYS`). ``mi.traverse`` exposes each
 thread's ``eta``, ``albedo``, ``kd``, ``gamma_s``, ``gamma_v`` and ``area`` (1 or 2 appended) and
 ``rotation`` for editing (:data:`reports.mitsuba_bsdf.TRAVERSED_THREAD_KEYS`); a JIT variant
 then reuses its compiled kernel. The kernel is written in

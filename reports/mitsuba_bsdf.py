@@ -21,24 +21,38 @@ import mitsuba as mi
 from reports import mitsuba_kernel as kern
 from reports.mitsuba import PLUGIN_NAME, fabric_from_dict
 
-__all__ = ["bsdf_class", "TRAVERSED_THREAD_KEYS", "TRAVERSED_OPTION_KEYS"]
+__all__ = ["bsdf_class", "TRAVERSED_THREAD_KEYS", "TRAVERSED_OPTION_KEYS", "TEXTURED_KEYS"]
 
 _CLASSES: dict = {}
 
 
-def _props_dict(props) -> dict:
-    """Mitsuba properties as a plain dict (RGB values as tuples)."""
-    out = {}
+#: The keys that take a Mitsuba texture (``bitmap``, ``checkerboard``, ...) as well as an RGB
+#: value: the albedo then varies over the surface, evaluated at each hit.
+TEXTURED_KEYS = ("albedo1", "albedo2")
+
+
+def _props_dict(props) -> tuple[dict, dict]:
+    """Mitsuba properties as a plain dict (RGB values as tuples), and the textures given for
+    :data:`TEXTURED_KEYS` (each stands in the plain dict as its mean, clipped to [0, 1]: the
+    sampler's lobe probabilities use it)."""
+    out, textures = {}, {}
     for key in props.keys():
         v = props[key]
-        if not isinstance(v, (bool, int, float, str)):
+        if isinstance(v, mi.Texture):
+            if key not in TEXTURED_KEYS:
+                raise ValueError(f"{PLUGIN_NAME}: parameter {key!r} cannot be a texture; "
+                                 f"only {' and '.join(TEXTURED_KEYS)} can")
+            textures[key] = v
+            v = min(max(float(np.ravel(v.mean())[0]), 0.0), 1.0)
+        elif not isinstance(v, (bool, int, float, str)):
             try:
                 v = tuple(float(v[i]) for i in range(3))
             except (TypeError, IndexError, ValueError):
-                raise ValueError(f"microcylinder: parameter {key!r} must be a number, a string "
-                                 f"or an RGB value; got {type(v).__name__}") from None
+                raise ValueError(f"{PLUGIN_NAME}: parameter {key!r} must be a number, a "
+                                 f"string, an RGB value or (albedo) a texture; got "
+                                 f"{type(v).__name__}") from None
         out[key] = v
-    return out
+    return out, textures
 
 
 def _warp(si, rotation):
@@ -76,11 +90,14 @@ def _read(holder):
     return tuple(float(x) for x in v) if v.size == 3 else float(v[0])
 
 
-def _params_of(fabric) -> dict:
-    """The traversed parameters of ``fabric``, as :func:`_param` holders."""
+def _params_of(fabric, textured=()) -> dict:
+    """The traversed parameters of ``fabric``, as :func:`_param` holders (not the keys
+    ``textured``: their textures are traversed instead)."""
     out = {}
     for j, t in enumerate(fabric.threads, start=1):
         for key in TRAVERSED_THREAD_KEYS:
+            if f"{key}{j}" in textured:
+                continue
             v = getattr(t, key)
             out[f"{key}{j}"] = _param(tuple(map(float, v)) if key == "albedo" else float(v))
     out["rotation"] = _param(math.degrees(fabric.options["rotation"]))
@@ -90,9 +107,9 @@ def _params_of(fabric) -> dict:
 def _write(params, fabric) -> None:
     """Put ``fabric``'s values into the holders ``params``, in place (the SceneParameters of
     an earlier ``mi.traverse`` keep them)."""
-    for key, fresh in _params_of(fabric).items():
-        value = _read(fresh)
-        holder = params[key]
+    fresh_all = _params_of(fabric)
+    for key, holder in params.items():
+        value = _read(fresh_all[key])
         for i, x in enumerate(value if isinstance(value, tuple) else (value,)):
             holder[i] = x
 
@@ -105,7 +122,7 @@ def _fabric_with(fabric, params, keys) -> brdf.Fabric:
     threads = []
     for j, t in enumerate(fabric.threads, start=1):
         changes = {k: _read(params[f"{k}{j}"]) for k in TRAVERSED_THREAD_KEYS
-                   if f"{k}{j}" in keys}
+                   if f"{k}{j}" in keys and f"{k}{j}" in params}
         try:
             threads.append(t.replace(**changes))
         except ValueError as exc:
@@ -131,9 +148,10 @@ def _make_class():
 
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            self.fabric = fabric_from_dict(_props_dict(props))
+            plain, self.textures = _props_dict(props)
+            self.fabric = fabric_from_dict(plain)
             self.k = kern.consts(self.fabric)
-            self.params = _params_of(self.fabric)
+            self.params = _params_of(self.fabric, self.textures)
             self.m_components = [flags]
             self.m_flags = flags
 
@@ -142,6 +160,8 @@ def _make_class():
             ``mi.traverse`` (not differentiable)."""
             for key, holder in self.params.items():
                 callback.put(key, holder, mi.ParamFlags.NonDifferentiable)
+            for key, texture in self.textures.items():
+                callback.put(key, texture, mi.ParamFlags.NonDifferentiable)
 
         def parameters_changed(self, keys):
             """Rebuild the fabric and its constants from the traversed values: the kernel
@@ -157,16 +177,21 @@ def _make_class():
         def _frame(self, si):
             return _warp(si, self.k.rotation)
 
+        def _albedo(self, si, active):
+            """Each thread's albedo texture evaluated at ``si`` (None: its constant)."""
+            return tuple(self.textures[f"albedo{j}"].eval(si, active)
+                         if f"albedo{j}" in self.textures else None for j in (1, 2))
+
         def eval_pdf(self, ctx, si, wo, active=True):
             """f_r cos and the density of valid draws: 0 where f_r cos is 0 (module notes)."""
             c, s = self._frame(si)
-            f, p = kern.eval_pdf(self.k, wo, si.wi, c, s)
+            f, p = kern.eval_pdf(self.k, wo, si.wi, c, s, albedo=self._albedo(si, active))
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection)
             return dr.select(on, f, 0.0), dr.select(on & (dr.max(f) > 0.0), p, 0.0)
 
         def eval(self, ctx, si, wo, active=True):
             c, s = self._frame(si)
-            value = kern.eval_cos(self.k, wo, si.wi, c, s)
+            value = kern.eval_cos(self.k, wo, si.wi, c, s, albedo=self._albedo(si, active))
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection)
             return dr.select(on, value, 0.0)
 
@@ -177,7 +202,7 @@ def _make_class():
             c, s = self._frame(si)
             cn, sn = kern.narrow(c), kern.narrow(s)
             wo = kern.sample(self.k, si.wi, sample1, sample2, cn, sn)
-            f, p = kern.eval_pdf(self.k, wo, si.wi, c, s)
+            f, p = kern.eval_pdf(self.k, wo, si.wi, c, s, albedo=self._albedo(si, active))
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection) & (p > 0.0) \
                 & (dr.max(f) > 0.0)
             bs = dr.zeros(mi.BSDFSample3f)

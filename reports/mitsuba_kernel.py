@@ -157,10 +157,11 @@ def _sample_terms(th, ca, sa, light, view, k, density):
     return surf, vol, p, _density(k, th, si, xi, ci, sr, cr)
 
 
-def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True):
+def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True, albedo=(None, None)):
     r"""f_r(wi, wo) cos(theta_i), RGB, and the sampler's density, for the light direction
     ``light`` (microcyl's wi) and the viewer ``view`` (its wo), unit mi.Vector3f in the local
-    frame (n = +z), in one pass over the tangent samples.
+    frame (n = +z), in one pass over the tangent samples. ``albedo``: per thread, an
+    mi.Color3f per lane (a texture's values at the hits) in place of its constant albedo.
 
     ``rot_c``, ``rot_s``: cos and sin of the warp's angle from +x (the fabric's rotation and
     any per-hit turn). Returns an mi.Color3f, 1/sr times the cosine (dimensionless per sr):
@@ -197,8 +198,9 @@ def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True):
             total += k.thread_p[j] * sums[3]
         if k.reweighting:
             q = q + th.area * pmean
+        alb = th.albedo if albedo[j] is None else (albedo[j].x, albedo[j].y, albedo[j].z)
         for ch in range(3):
-            rgb[ch] = rgb[ch] + th.area * (surf + th.albedo[ch] * vol)
+            rgb[ch] = rgb[ch] + th.area * (surf + alb[ch] * vol)
     up = (light.z > 0.0) & (view.z > 0.0)
     ok = up & (q > 0.0)
     inv = dr.select(ok, 1.0 / dr.select(ok, q, 1.0), 0.0)
@@ -206,9 +208,9 @@ def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True):
     return f, (dr.select(up, total, 0.0) if with_pdf else None)
 
 
-def eval_cos(k: Consts, light, view, rot_c, rot_s):
+def eval_cos(k: Consts, light, view, rot_c, rot_s, albedo=(None, None)):
     """f_r(wi, wo) cos(theta_i) alone (:func:`eval_pdf`)."""
-    return eval_pdf(k, light, view, rot_c, rot_s, with_pdf=False)[0]
+    return eval_pdf(k, light, view, rot_c, rot_s, with_pdf=False, albedo=albedo)[0]
 
 
 # -- the sampler (brdf/sampling.py) --------------------------------------------------------

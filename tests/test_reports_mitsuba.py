@@ -350,6 +350,42 @@ def test_traverse_edit_reuses_the_kernel(jit):
     assert _worst(out, ref) < RTOL
 
 
+@needs_mitsuba
+def test_albedo_texture_varies_over_the_surface(jit):
+    """albedo1 given as a Mitsuba texture (a checkerboard of two RGB values): eval at each hit
+    is brdf.Fabric's with thread 1's albedo the texture's value there (Mitsuba's own
+    checkerboard, evaluated apart); a texture for another key is refused by name."""
+    mi, dr = jit, pytest.importorskip("drjit")
+    a, b = (0.1, 0.4, 0.2), (0.6, 0.1, 0.05)
+    checker = {"type": "checkerboard", "color0": {"type": "rgb", "value": list(a)},
+               "color1": {"type": "rgb", "value": list(b)}}
+    bsdf = mi.load_dict({"type": "microcylinder", "fabric": "linen_plain", "albedo1": checker})
+    rng = np.random.default_rng(31)
+    n = 4000
+    light, view, uv = _hemi(rng, n), _hemi(rng, n), rng.random((n, 2)).astype(np.float32)
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(*view.T)
+    si.uv = mi.Point2f(*uv.T)
+    out = np.asarray(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(*light.T)).numpy(),
+                     dtype=np.float64).T
+    tex = np.asarray(mi.load_dict(checker).eval(si).numpy()).T          # (n, 3)
+    first = np.all(np.isclose(tex, np.float32(a)), axis=1)
+    assert 0.3 < first.mean() < 0.7 and np.all(first | np.all(np.isclose(tex, b), axis=1))
+    ref = np.empty_like(out)
+    for mask, rgb in ((first, a), (~first, b)):
+        t1, t2 = brdf.fabric("linen_plain").threads
+        fab = brdf.fabric("linen_plain").replace(
+            threads=[t1.replace(albedo=tuple(float(np.float32(x)) for x in rgb)), t2])
+        li, vi = light[mask].astype(float), view[mask].astype(float)
+        ref[mask] = fab.eval(li, vi) * li[:, 2:3]
+    assert _worst(out, ref) < RTOL
+    image = np.asarray(mi.render(_two_cloths(mi, {"fabric": "linen_plain"},
+                                             {"fabric": "linen_plain", "albedo1": checker})))
+    assert np.isfinite(image).all() and image[:, 32:].std() > 0     # it renders, and varies
+    with pytest.raises(RuntimeError, match="'eta1' cannot be a texture"):
+        mi.load_dict({"type": "microcylinder", "eta1": checker})
+
+
 def _two_cloths(mi, left, right):
     """A scene of two rectangles side by side, with the plugin dictionaries left and right."""
     T = mi.ScalarTransform4f()

@@ -21,7 +21,7 @@ import mitsuba as mi
 from reports import mitsuba_kernel as kern
 from reports.mitsuba import PLUGIN_NAME, fabric_from_dict
 
-__all__ = ["bsdf_class", "TRAVERSED_THREAD_KEYS", "TRAVERSED_OPTION_KEYS", "TEXTURED_KEYS"]
+__all__ = ["bsdf_class", "TRAVERSED_THREAD_KEYS", "TEXTURED_KEYS"]
 
 _CLASSES: dict = {}
 
@@ -71,11 +71,24 @@ def _warp(si, rotation):
     return c * cr - s * sr, s * cr + c * sr
 
 
-#: The parameters that ``mi.traverse`` exposes, per thread (with 1 or 2 appended), and the
-#: options; gammas and rotation in degrees, as in the plugin's dictionary. The tangent curves
-#: (offsets, lengths) and the other options shape the kernel: change them by loading anew.
+#: The thread parameters that ``mi.traverse`` exposes (with 1 or 2 appended), beside
+#: ``rotation``; gammas and rotation in degrees, as in the plugin's dictionary. The tangent
+#: curves (offsets, lengths) and the other options shape the kernel: change them by loading
+#: anew.
 TRAVERSED_THREAD_KEYS = ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area")
-TRAVERSED_OPTION_KEYS = ("rotation",)
+
+
+def _values_of(fabric, textured=()) -> dict:
+    """The traversed values of ``fabric``: floats, RGB tuples for the albedos (not the keys
+    ``textured``: their textures are traversed instead)."""
+    out = {}
+    for j, t in enumerate(fabric.threads, start=1):
+        for key in TRAVERSED_THREAD_KEYS:
+            if f"{key}{j}" not in textured:
+                v = getattr(t, key)
+                out[f"{key}{j}"] = tuple(map(float, v)) if key == "albedo" else float(v)
+    out["rotation"] = math.degrees(fabric.options["rotation"])
+    return out
 
 
 def _param(value):
@@ -92,26 +105,12 @@ def _read(holder):
     return tuple(float(x) for x in v) if v.size == 3 else float(v[0])
 
 
-def _params_of(fabric, textured=()) -> dict:
-    """The traversed parameters of ``fabric``, as :func:`_param` holders (not the keys
-    ``textured``: their textures are traversed instead)."""
-    out = {}
-    for j, t in enumerate(fabric.threads, start=1):
-        for key in TRAVERSED_THREAD_KEYS:
-            if f"{key}{j}" in textured:
-                continue
-            v = getattr(t, key)
-            out[f"{key}{j}"] = _param(tuple(map(float, v)) if key == "albedo" else float(v))
-    out["rotation"] = _param(math.degrees(fabric.options["rotation"]))
-    return out
-
-
 def _write(params, fabric) -> None:
     """Put ``fabric``'s values into the holders ``params``, in place (the SceneParameters of
     an earlier ``mi.traverse`` keep them)."""
-    fresh_all = _params_of(fabric)
+    values = _values_of(fabric)
     for key, holder in params.items():
-        value = _read(fresh_all[key])
+        value = values[key]
         for i, x in enumerate(value if isinstance(value, tuple) else (value,)):
             holder[i] = x
 
@@ -153,12 +152,13 @@ def _make_class():
             plain, self.textures = _props_dict(props)
             self.fabric = fabric_from_dict(plain)
             self.k = kern.consts(self.fabric)
-            self.params = _params_of(self.fabric, self.textures)
+            self.params = {key: _param(v)
+                           for key, v in _values_of(self.fabric, self.textures).items()}
             self.m_components = [flags]
             self.m_flags = flags
 
         def traverse(self, callback):
-            """Expose :data:`TRAVERSED_THREAD_KEYS` and :data:`TRAVERSED_OPTION_KEYS` to
+            """Expose :data:`TRAVERSED_THREAD_KEYS`, ``rotation`` and the albedo textures to
             ``mi.traverse`` (not differentiable)."""
             for key, holder in self.params.items():
                 callback.put(key, holder, mi.ParamFlags.NonDifferentiable)

@@ -22,9 +22,10 @@ import mitsuba as mi
 
 from brdf import sampling
 
-__all__ = ["Consts", "ThreadConsts", "consts", "MIN_COMPONENTS"]
+__all__ = ["Consts", "ThreadConsts", "consts", "MIN_COMPONENTS", "GAUSS_NORM"]
 
-_GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
+#: 1 / sqrt(2 pi), the normal density's factor.
+GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
 #: The sampler's component table is padded to a power of two at least this long: the binary
 #: search that picks a component has as many steps as the table has bits, and every preset
 #: (at most 1 + 3 x 64 components) then shares one kernel.
@@ -93,7 +94,7 @@ def opaque(x, kind=None):
     return dr.opaque(kind, x)
 
 
-def _thread_consts(t, c, lobe_p, sampled) -> ThreadConsts:
+def _thread_consts(t, c, lobe_p) -> ThreadConsts:
     """:class:`ThreadConsts` of the thread ``t`` with the tangent constants ``c``."""
     kd, gs, gv, eta2 = float(t.kd), float(c.gamma_s), float(c.gamma_v), float(t.eta) ** 2
     # a table of one entry would be a scalar to Dr.Jit, and another kernel: each gets an
@@ -104,9 +105,9 @@ def _thread_consts(t, c, lobe_p, sampled) -> ThreadConsts:
         opaque(len(c.ca), mi.UInt32), opaque(ca, mi.Float64), opaque(sa, mi.Float64),
         opaque(w), opaque(eta2), opaque(eta2 - 1.0), opaque(kd), opaque(float(t.area)),
         tuple(opaque(float(a)) for a in t.albedo),
-        opaque(-0.125 / gs**2), opaque(_GAUSS_NORM / gs), opaque(-0.125 / gv**2),
-        opaque((1.0 - kd) * _GAUSS_NORM / gv), (opaque(0.5 / gs), opaque(0.5 / gv)),
-        tuple(opaque(float(p)) for p in lobe_p) if sampled else (0.0, 0.0, 0.0))
+        opaque(-0.125 / gs**2), opaque(GAUSS_NORM / gs), opaque(-0.125 / gv**2),
+        opaque((1.0 - kd) * GAUSS_NORM / gv), (opaque(0.5 / gs), opaque(0.5 / gv)),
+        tuple(opaque(float(p)) for p in lobe_p))
 
 
 def _components(fabric, thread_p, lobe_p) -> list:
@@ -125,7 +126,7 @@ def _components(fabric, thread_p, lobe_p) -> list:
 def consts(fabric) -> Consts:
     """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric`) for the variant set."""
     thread_p, lobe_p = sampling.lobe_probabilities(fabric)
-    threads = tuple(_thread_consts(t, c, lobe_p[j], thread_p[j] > 0.0)
+    threads = tuple(_thread_consts(t, c, lobe_p[j])
                     for j, (t, c) in enumerate(zip(fabric.threads, fabric._const)))
     rows = _components(fabric, thread_p, lobe_p)
     size = max(MIN_COMPONENTS, 1 << (len(rows) - 1).bit_length())

@@ -34,12 +34,11 @@ import drjit as dr
 import mitsuba as mi
 
 from brdf.terms import SIGMA_U
-from reports.mitsuba_consts import Consts, consts
+from reports.mitsuba_consts import GAUSS_NORM, Consts, consts
 
-__all__ = ["Consts", "consts", "eval_pdf", "eval_cos", "pdf", "sample", "wide", "narrow"]
+__all__ = ["Consts", "consts", "eval_pdf", "eval_cos", "sample", "wide", "narrow"]
 
 _K_U = -0.5 / SIGMA_U**2            # u(x) = exp(_K_U x^2)
-_GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
 _HALF_PI = 0.5 * math.pi
 _COS_MIN = 1e-12                    # as brdf.sampling: the 1/cos(theta) density stays finite
 
@@ -237,14 +236,9 @@ def _density(k, th, si, xi, ci, sr, cr):
         inv = th.inv_sig[lobe]
         mass = _ndtr((_HALF_PI - mu) * inv) - _ndtr((-_HALF_PI - mu) * inv)
         z = (th_i - mu) * inv
-        dens += th.lobe_p[lobe] * dr.exp(-0.5 * z * z) * (_GAUSS_NORM * inv) / (mass * cth)
+        dens += th.lobe_p[lobe] * dr.exp(-0.5 * z * z) * (GAUSS_NORM * inv) / (mass * cth)
     pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
     return dens * pphi
-
-
-def pdf(k: Consts, light, view, rot_c, rot_s):
-    """The sampler's density (1/sr) alone (:func:`eval_pdf`)."""
-    return eval_pdf(k, light, view, rot_c, rot_s)[1]
 
 
 def _pick(k: Consts, u):

@@ -445,12 +445,17 @@ def test_mitsuba_chi2(jit, name, theta, tmp_path, monkeypatch):
 
 
 # -- microcyl export and the README --------------------------------------------------------
+def _export(folder, target):
+    """`microcyl export FOLDER -o TARGET` run as a user runs it, in TARGET's folder."""
+    return subprocess.run([sys.executable, "-m", "reports", "export", str(folder), "-o",
+                           str(target)], cwd=target.parent, capture_output=True, text=True,
+                          timeout=120, env=dict(os.environ, PYTHONPATH=str(REPO)))
+
+
 def test_export_cli_writes_the_medians(fit_folder, tmp_path):
     out, res = fit_folder
     target = tmp_path / "fabric.json"
-    env = dict(os.environ, PYTHONPATH=str(REPO))
-    p = subprocess.run([sys.executable, "-m", "reports", "export", str(out), "-o", str(target)],
-                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    p = _export(out, target)
     assert p.returncode == 0, p.stderr
     assert f"wrote {target}" in p.stderr and "velvet: medians of gamma_s1, kd1" in p.stdout
     doc = json.loads(target.read_text())
@@ -460,9 +465,7 @@ def test_export_cli_writes_the_medians(fit_folder, tmp_path):
     assert doc["gamma_v1"] == 12.0 and doc["masking"] is False
     assert doc["rotation"] == pytest.approx(math.degrees(0.25))
     assert [f.name for f in tmp_path.iterdir() if f.name.startswith(".")] == []
-    bad = subprocess.run([sys.executable, "-m", "reports", "export", str(tmp_path), "-o",
-                          str(target)], cwd=tmp_path, env=env, capture_output=True, text=True,
-                         timeout=120)
+    bad = _export(tmp_path, target)
     assert bad.returncode == 1 and "results.json" in bad.stderr
     assert "Traceback" not in bad.stderr
 
@@ -487,9 +490,7 @@ def test_export_xml_loads_in_a_scene_file(fit_folder, scalar, tmp_path):
     mi = scalar
     out, _ = fit_folder
     target = tmp_path / "fabric.xml"
-    env = dict(os.environ, PYTHONPATH=str(REPO))
-    p = subprocess.run([sys.executable, "-m", "reports", "export", str(out), "-o", str(target)],
-                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    p = _export(out, target)
     assert p.returncode == 0, p.stderr
     element = target.read_text()
     assert element.startswith('<bsdf type="microcylinder" id="fabric">')

@@ -45,6 +45,7 @@ import numpy as np
 
 from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
+from analysis.measuredjson import load_measured_json
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write
@@ -244,6 +245,7 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     ------
     ValueError
         An unknown dataset name (before any fit).
+        A ``measured.json`` in ``out_dir`` that is out of its schema (before any fit).
     FileNotFoundError
         A missing data file (before any fit).
     """
@@ -254,11 +256,12 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     root = (Path(data_dir) if data_dir is not None else default_data_dir()).resolve()
     tables = {n: load_measured(n, root, rgl_step=rgl_step) for n in names}
     out = Path(out_dir)
+    spath = out / SUMMARY_FILE
+    _read_summary(spath)                # a damaged summary is refused before any fit
     jobs = [_job(n, root, rgl_step, plots, {"seed": seed, "max_steps": max_steps,
                                             "time_limit": time_limit}) for n in names]
     summary = run_batch(jobs, out, workers=workers, scheduler=scheduler, progress=progress,
                         echo=echo)
-    spath = out / SUMMARY_FILE
     # read just before writing: another fit-measured run may have added its datasets
     doc = _read_summary(spath)
     for n in names:
@@ -298,12 +301,9 @@ def _entry(n: str, table, row: dict, out: Path) -> dict:
 
 
 def _read_summary(path: Path) -> dict:
-    """The summary document at ``path`` ({"datasets": {}} when missing or unreadable)."""
-    try:
-        doc = json.loads(path.read_text()) if path.exists() else {}
-    except ValueError:
-        doc = {}
-    if not isinstance(doc, dict):
-        doc = {}
-    doc.setdefault("datasets", {})
-    return doc
+    """The summary document at ``path`` ({"datasets": {}} when missing), read through its
+    schema (:func:`analysis.measuredjson.check_measured_doc`: a damaged or hostile one is
+    refused with one line naming the file and the field, never silently replaced)."""
+    if not path.exists():
+        return {"datasets": {}}
+    return load_measured_json(path.parent)

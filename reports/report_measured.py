@@ -10,11 +10,12 @@ predictive lobes over the data points, the residual map, the corner and the trac
 from __future__ import annotations
 
 import html
-import json
 import shutil
 from pathlib import Path
 
 from analysis.fit.results import read_results
+from analysis.measuredjson import load_measured_json, results_path
+from gonio.safenames import check_component, check_inside
 
 __all__ = ["read_measured", "measured_page", "PLOTS"]
 
@@ -32,34 +33,52 @@ PLOTS = {
 def read_measured(folder) -> dict:
     """Read ``folder/measured.json`` and every ``results.json`` it names.
 
+    measured.json is read through its schema (:mod:`analysis.measuredjson`): every dataset
+    name a safe file name, every ``results`` path inside ``folder`` (links resolved), and the
+    ``plots`` of each results.json safe file names of files inside ``folder``.
+
     Returns
     -------
     dict
-        name -> entry of measured.json with ``results`` replaced by the results document and
-        ``folder`` the dataset's folder.
+        name -> entry of measured.json with ``results`` replaced by the results document,
+        ``folder`` the dataset's folder (resolved), ``plot_files`` the checked
+        ``{plot: path}`` of its results and ``data_files`` its results.json and results.csv.
 
     Raises
     ------
     ValueError
-        The folder holds no readable ``measured.json`` (the message names it).
+        The folder holds no readable ``measured.json``, or a field of it or of a
+        results.json is out of its schema (the message names the file and the field).
     """
     folder = Path(folder)
-    path = folder / "measured.json"
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-        datasets = doc["datasets"]
-    except FileNotFoundError:
-        raise ValueError(f"{path}: not found; run `microcyl fit-measured -o {folder}` first") \
-            from None
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise ValueError(f"{path}: unreadable ({exc})") from None
+    doc = load_measured_json(folder)
+    source = folder / "measured.json"
     out = {}
-    for name, entry in datasets.items():
+    for name, entry in doc["datasets"].items():
         e = dict(entry)
-        rpath = folder / e.get("results", f"{name}/results.json")
+        rpath = results_path(folder, name, e, source)
         e["results"] = read_results(rpath)
         e["folder"] = rpath.parent
+        e["plot_files"] = _plot_files(e["results"], rpath)
+        e["data_files"] = [check_inside(rpath.parent / f, rpath.parent, source=source,
+                                        entry=f"datasets.{name}")
+                           for f in ("results.json", "results.csv")
+                           if (rpath.parent / f).is_file()]
         out[name] = e
+    return out
+
+
+def _plot_files(doc: dict, rpath: Path) -> dict:
+    """The ``plots`` of a results document: each a safe file name of a file beside it (links
+    resolved)."""
+    plots = doc.get("plots", {})
+    if not isinstance(plots, dict):
+        raise ValueError(f"{rpath}: plots must be an object; got {plots!r:.60}")
+    out = {}
+    for key, file in plots.items():
+        check_component(file, source=rpath, entry=f"plots.{key}")
+        check_inside(rpath.parent / file, rpath.parent, source=rpath, entry=f"plots.{key}")
+        out[key] = rpath.parent / file
     return out
 
 
@@ -119,24 +138,19 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
                  f"[{_f(res[k]['lo95'])}, {_f(res[k]['hi95'])}]", res[k].get("unit", ""),
                  _f(res[k].get("tau"), ".1f"), _f(res[k].get("rhat"), ".4f"),
                  _f(res[k].get("ess"), ".0f")] for k in params]
-        dest = root / folder / name
+        dest = check_inside(root / folder / name, root)     # name: a safe component
         dest.mkdir(parents=True, exist_ok=True)
         figs = []
-        plots = doc.get("plots", {})
         for key, caption in PLOTS.items():
-            src = plots.get(key)
-            if src is None:
+            src = e["plot_files"].get(key)
+            if src is None or not src.is_file():
                 continue
-            src = Path(e["folder"]) / Path(src).name
-            if not src.is_file():
-                continue
-            shutil.copyfile(src, dest / src.name)
+            shutil.copyfile(src, check_inside(dest / src.name, root))
             rel = f"{folder}/{name}/{src.name}"
             figs.append(f'<figure><img src="{html.escape(rel)}" alt="{html.escape(key)}">'
                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
-        for data in ("results.json", "results.csv"):
-            if (Path(e["folder"]) / data).is_file():
-                shutil.copyfile(Path(e["folder"]) / data, dest / data)
+        for src in e["data_files"]:
+            shutil.copyfile(src, check_inside(dest / src.name, root))
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
         body.append(

@@ -100,3 +100,175 @@ def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeyp
     on_disk = json.loads((tmp_path / "measured.json").read_text())
     assert set(on_disk["datasets"]) == set(doc["datasets"]) == {"curet_07_velvet",
                                                                "curet_44_linen"}
+
+
+# ------------------------------------------------------------- hostile measured.json
+def _fake_fit(folder, plots=None, extra_files=()):
+    """A fit folder as fit-measured writes one: results.json, results.csv and plot files."""
+    folder.mkdir(parents=True, exist_ok=True)
+    plots = plots if plots is not None else {"lobes": "lobes.png"}
+    (folder / "results.json").write_text(json.dumps(
+        {"schema": "microcyl-fit", "schema_version": 2, "converged": True, "reason": "ok",
+         "parameters": {"kd1": {"median": 0.2, "lo68": 0.1, "hi68": 0.3, "lo95": 0.05,
+                                "hi95": 0.4, "tau": 10.0, "rhat": 1.0, "ess": 900.0,
+                                "unit": ""}},
+         "fit": {}, "quality": {}, "plots": plots}))
+    (folder / "results.csv").write_text("parameter,median\nkd1,0.2\n")
+    for name in list(plots.values()) + list(extra_files):
+        (folder / name).write_bytes(b"\x89PNG planted " + name.encode())
+
+
+def _measured_dir(root, datasets):
+    """DIR/measured.json naming ``datasets`` (name -> entry overrides), every fit in DIR/good."""
+    root.mkdir(parents=True, exist_ok=True)
+    doc = {"datasets": {n: dict({"title": "t", "preset": "linen_plain", "source": "x",
+                                 "pairs": 3, "free": ["kd1"], "ties": [], "converged": True,
+                                 "reason": "ok", "steps": 10, "wall_s": 1.0,
+                                 "results": "good/results.json", "values_used": 3,
+                                 "quality": {}, "albedo_delta_e2000": None}, **e)
+                        for n, e in datasets.items()}}
+    (root / "measured.json").write_text(json.dumps(doc))
+    return root
+
+
+def _report(tmp_path, measured):
+    from reports.report import build_report
+    return build_report(["velvet"], tmp_path / "site" / "rep", sections=["parameters"],
+                        progress=False, quality="fast", measured=measured)
+
+
+def _files_under(folder):
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+@pytest.mark.parametrize("hostile", ["../../escape_target", "../escape_target", "/ABS",
+                                     ".hidden", "a/b", "..", "x\ny"])
+def test_a_hostile_dataset_name_is_refused_and_nothing_written_outside(tmp_path, hostile):
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (victim / "authorized_keys").write_text("ssh-ed25519 AAAA the owner's key\n")
+    name = str(victim) if hostile == "/ABS" else hostile
+    mdir = _measured_dir(tmp_path / "m", {name: {}})
+    _fake_fit(mdir / "good", plots={"lobes": "authorized_keys"})
+    before = _files_under(tmp_path)
+    with pytest.raises(ValueError) as err:
+        _report(tmp_path, mdir)
+    msg = str(err.value)
+    assert "\n" not in msg.replace(repr(name)[1:-1], "")     # one line (the name as repr)
+    assert str(mdir / "measured.json") in msg and "datasets" in msg and "refused" in msg
+    assert _files_under(tmp_path) == before                  # not one file written anywhere
+    assert (victim / "authorized_keys").read_text() == "ssh-ed25519 AAAA the owner's key\n"
+
+
+@pytest.mark.parametrize("entry", [{"results": "/etc/results.json"},
+                                   {"results": "../outside/results.json"},
+                                   {"results": ["good", "results.json"]}])
+def test_a_results_path_outside_the_folder_is_refused(tmp_path, entry):
+    (tmp_path / "outside").mkdir()
+    _fake_fit(tmp_path / "outside")
+    mdir = _measured_dir(tmp_path / "m", {"felt": entry})
+    with pytest.raises(ValueError, match=r"measured\.json: datasets\.felt\.results"):
+        _report(tmp_path, mdir)
+
+
+def test_a_planted_link_is_not_followed_out_of_the_folder(tmp_path):
+    """A plot (and a dataset folder) that is a symbolic link to a file outside the measured
+    folder is refused: the report never copies a stranger's file into itself."""
+    secret = tmp_path / "secret.txt"
+    secret.write_text("private")
+    mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json"}})
+    _fake_fit(mdir / "felt", plots={"lobes": "lobes.png"})
+    (mdir / "felt" / "lobes.png").unlink()
+    (mdir / "felt" / "lobes.png").symlink_to(secret)
+    with pytest.raises(ValueError, match=r"felt.*outside.*refused"):
+        _report(tmp_path, mdir)
+    assert not (tmp_path / "site" / "rep").exists()
+    elsewhere = tmp_path / "elsewhere"
+    _fake_fit(elsewhere)
+    mdir2 = _measured_dir(tmp_path / "m2", {"felt": {"results": "felt/results.json"}})
+    (mdir2 / "felt").symlink_to(elsewhere, target_is_directory=True)
+    with pytest.raises(ValueError, match=r"datasets\.felt\.results.*outside"):
+        _report(tmp_path, mdir2)
+
+
+@pytest.mark.parametrize("plot", ["../../x.png", "/tmp/x.png", ".x.png", "a/b.png"])
+def test_a_hostile_plot_name_in_results_json_is_refused(tmp_path, plot):
+    mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json"}})
+    _fake_fit(mdir / "felt", plots={"lobes": "lobes.png"})
+    doc = json.loads((mdir / "felt" / "results.json").read_text())
+    doc["plots"]["corner"] = plot
+    (mdir / "felt" / "results.json").write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match=r"results\.json: plots\.corner: name .* refused"):
+        _report(tmp_path, mdir)
+
+
+def test_safe_names_still_make_the_page(tmp_path):
+    mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json"}})
+    _fake_fit(mdir / "felt", plots={"lobes": "lobes.png", "corner": "corner.png"})
+    index = _report(tmp_path, mdir)
+    root = index.parent
+    assert (root / "measured" / "felt" / "lobes.png").read_bytes().startswith(b"\x89PNG")
+    assert (root / "measured" / "felt" / "results.json").is_file()
+    page = (root / "measured.html").read_text()
+    assert 'src="measured/felt/lobes.png"' in page and 'src="measured/felt/corner.png"' in page
+
+
+def test_the_report_cli_refuses_a_climbing_name_in_one_line(tmp_path):
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    mdir = _measured_dir(tmp_path / "m", {"../../escape_target": {}})
+    _fake_fit(mdir / "good")
+    root = Path(__file__).resolve().parents[1]
+    r = subprocess.run([sys.executable, "-m", "reports", "report", "--fabric", "velvet",
+                        "--quality", "fast", "--measured", str(mdir), "-o",
+                        str(tmp_path / "site" / "rep")], capture_output=True, text=True,
+                       env=dict(os.environ, PYTHONPATH=str(root)), timeout=300)
+    assert r.returncode != 0
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "measured.json: datasets" in lines[0] \
+        and "escape_target" in lines[0] and "Traceback" not in r.stderr
+    assert not (tmp_path / "escape_target").exists() and not (tmp_path / "site").exists()
+
+
+@pytest.mark.parametrize("field, value, named", [
+    ("values_used", "<script>alert(1)</script>", "datasets.felt.values_used"),
+    ("pairs", 3.5, "datasets.felt.pairs"),
+    ("steps", -1, "datasets.felt.steps"),
+    ("converged", "yes", "datasets.felt.converged"),
+    ("quality", {"rms_residual": [1, 2]}, "datasets.felt.quality.rms_residual"),
+    ("quality", {"rms_normalized": float("nan")}, "datasets.felt.quality.rms_normalized"),
+    ("quality", "good", "datasets.felt.quality"),
+    ("albedo_delta_e2000", float("inf"), "datasets.felt.albedo_delta_e2000"),
+    ("albedo_delta_e2000", "<b>2</b>", "datasets.felt.albedo_delta_e2000"),
+    ("ties", "eta2=eta1", "datasets.felt.ties"),
+    ("title", 7, "datasets.felt.title"),
+])
+def test_a_field_of_measured_json_out_of_its_schema_is_one_line(tmp_path, field, value,
+                                                                named):
+    mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json",
+                                                   field: value}})
+    _fake_fit(mdir / "felt")
+    with pytest.raises(ValueError) as err:
+        _report(tmp_path, mdir)
+    msg = str(err.value)
+    assert msg.startswith(f"{mdir / 'measured.json'}: {named} must be") and "\n" not in msg
+    assert not (tmp_path / "site" / "rep").exists()
+
+
+@pytest.mark.parametrize("doc", [[1, 2], {"datasets": [1]}, {"datasets": {"x": 3}},
+                                 {"datasets": {"../x": {}}}])
+def test_fit_measured_refuses_a_damaged_summary_before_any_fit(tmp_path, shared_data, doc,
+                                                              monkeypatch):
+    import analysis.measured
+    from analysis.measured import fit_measured
+
+    def no_batch(*a, **kw):
+        raise AssertionError("a fit started")
+
+    monkeypatch.setattr(analysis.measured, "run_batch", no_batch)
+    (tmp_path / "measured.json").write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match=r"measured\.json: "):
+        fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, plots=None,
+                     progress=False, workers=1)

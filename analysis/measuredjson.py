@@ -1,0 +1,130 @@
+"""``measured.json`` read through its schema: the summary ``microcyl fit-measured`` writes
+beside its per-dataset folders, and ``microcyl report --measured`` reads.
+
+The file may come from someone else (a shared fit folder), so every field a reader uses is
+checked here for type and finiteness, every dataset name is a safe file name
+(:func:`gonio.safenames.check_component`: it names the dataset's folder, and is refused when
+absolute, climbing or hidden), and every ``results`` path resolves inside the folder (links
+included). A bad entry is one ``ValueError`` line naming the file and the field.
+
+The document: ``{"datasets": {NAME: ENTRY}}``, each ENTRY (every field optional, as older
+versions wrote fewer): ``title``, ``preset``, ``source``, ``reason``, ``error`` (strings),
+``pairs``, ``values_used``, ``steps`` (integers >= 0, ``values_used`` and ``pairs`` may be
+null), ``converged`` (true/false), ``wall_s`` (a finite number >= 0 or null), ``free`` and
+``ties`` (lists of strings), ``quality`` (an object whose ``rms_residual``,
+``rms_normalized`` and ``albedo_delta_e2000`` are finite numbers >= 0 or null),
+``albedo_delta_e2000`` (the same) and ``results`` (the relative path of the dataset's
+``results.json``, default ``NAME/results.json``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path, PurePosixPath
+
+from gonio.safenames import check_component, check_inside
+
+__all__ = ["load_measured_json", "check_measured_doc", "results_path"]
+
+_STRINGS = ("title", "preset", "source", "reason", "error")
+_COUNTS = ("pairs", "values_used", "steps")
+_LISTS = ("free", "ties")
+_QUALITY = ("rms_residual", "rms_normalized", "albedo_delta_e2000")
+
+
+def _bad(path, field: str, allowed: str, value) -> ValueError:
+    text = repr(value)
+    text = text if len(text) <= 60 else text[:57] + "..."
+    return ValueError(f"{path}: {field} must be {allowed}; got {text}")
+
+
+def _number(path, field: str, value) -> None:
+    """A finite number >= 0, or null."""
+    if value is None:
+        return
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
+            math.isfinite(value) and value >= 0):
+        raise _bad(path, field, "a finite number >= 0 or null", value)
+
+
+def _entry(path, name: str, e) -> None:
+    where = f"datasets.{name}"
+    if not isinstance(e, dict):
+        raise _bad(path, where, "an object", e)
+    for k in _STRINGS:
+        if k in e and not isinstance(e[k], str):
+            raise _bad(path, f"{where}.{k}", "a string", e[k])
+    for k in _COUNTS:
+        v = e.get(k)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 0):
+            raise _bad(path, f"{where}.{k}", "an integer >= 0", v)
+    for k in _LISTS:
+        if k in e and not (isinstance(e[k], list) and all(isinstance(x, str) for x in e[k])):
+            raise _bad(path, f"{where}.{k}", "a list of strings", e[k])
+    if "converged" in e and not isinstance(e["converged"], bool):
+        raise _bad(path, f"{where}.converged", "true or false", e["converged"])
+    _number(path, f"{where}.wall_s", e.get("wall_s"))
+    _number(path, f"{where}.albedo_delta_e2000", e.get("albedo_delta_e2000"))
+    q = e.get("quality", {})
+    if not isinstance(q, dict):
+        raise _bad(path, f"{where}.quality", "an object", q)
+    for k in _QUALITY:
+        _number(path, f"{where}.quality.{k}", q.get(k))
+    if "results" in e and not isinstance(e["results"], str):
+        raise _bad(path, f"{where}.results", "a relative path (a string)", e["results"])
+
+
+def check_measured_doc(doc, path) -> dict:
+    """``doc`` (a parsed ``measured.json``, read from ``path``) when every field is as the
+    module's schema says; else a ValueError naming the file and the field.
+
+    Examples
+    --------
+    >>> check_measured_doc({"datasets": {"felt": {"steps": 3}}}, "m.json")["datasets"]
+    {'felt': {'steps': 3}}
+    >>> check_measured_doc({"datasets": {"felt": {"steps": "3"}}}, "m.json")
+    Traceback (most recent call last):
+    ...
+    ValueError: m.json: datasets.felt.steps must be an integer >= 0; got '3'
+    """
+    if not isinstance(doc, dict) or not isinstance(doc.get("datasets"), dict):
+        raise ValueError(f"{path}: not a fit-measured summary (no \"datasets\" object)")
+    for name, e in doc["datasets"].items():
+        check_component(name, source=path, entry="datasets")
+        _entry(path, name, e)
+    return doc
+
+
+def results_path(folder, name: str, entry: dict, source) -> Path:
+    """The ``results.json`` of dataset ``name``: ``folder/entry["results"]`` (default
+    ``NAME/results.json``), every part a safe name and the whole inside ``folder`` once
+    links are resolved; else a ValueError naming ``source`` and the field."""
+    rel = entry.get("results", f"{name}/results.json")
+    field = f"datasets.{name}.results"
+    parts = PurePosixPath(rel).parts if isinstance(rel, str) else ()
+    if not parts:
+        raise _bad(source, field, "a relative path inside the folder", rel)
+    for p in parts:
+        check_component(p, source=source, entry=field)
+    return check_inside(Path(folder).joinpath(*parts), folder, source=source, entry=field)
+
+
+def load_measured_json(folder) -> dict:
+    """``folder/measured.json``, parsed and checked (:func:`check_measured_doc`).
+
+    Raises
+    ------
+    ValueError
+        Missing (saying how to make it), unreadable, not JSON, or a field out of the schema;
+        one line naming the file.
+    """
+    path = Path(folder) / "measured.json"
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ValueError(f"{path}: not found; run `microcyl fit-measured -o {folder}` first") \
+            from None
+    except (OSError, ValueError, RecursionError) as exc:
+        raise ValueError(f"{path}: unreadable ({exc})") from None
+    return check_measured_doc(doc, path)

@@ -14,6 +14,7 @@ from pathlib import Path
 from analysis.batch.summary import SUMMARY_CSV, SUMMARY_JSON, BatchSummary
 from analysis.fit.results import read_results
 from gonio import atomic_write
+from gonio.safenames import check_component, check_inside
 
 __all__ = ["write_batch_page", "PAGE", "CAPTIONS"]
 
@@ -42,7 +43,7 @@ def _params(rows) -> list[str]:
 
 
 def _cell(row, name) -> str:
-    if f"{name}_median" not in row or row[f"{name}_median"] is None:
+    if any(row.get(f"{name}_{k}") is None for k in ("median", "lo95", "hi95")):
         return "<td></td>"
     m, lo, hi = (row[f"{name}_{k}"] for k in ("median", "lo95", "hi95"))
     return f'<td class="num">{m:.4g} <small>[{lo:.4g}, {hi:.4g}]</small></td>'
@@ -66,17 +67,26 @@ def _table(rows, names) -> str:
 
 
 def _fit_section(out: Path, row) -> str:
-    """One fit: its verdict and its plots, linked."""
-    folder = out / row["folder"]
+    """One fit: its verdict and its plots, linked. The row's folder and the plots of its
+    results.json are safe names inside ``out`` (links resolved), else a ValueError."""
+    source = out / SUMMARY_JSON
+    folder = check_inside(out / row["folder"], out, source=source,
+                          entry=f"the folder of {row['name']}")
     name = html.escape(row["name"])
     try:
         doc = read_results(folder / "results.json")
     except ValueError as exc:
         return f'<h3 id="{name}">{name}</h3><p>{html.escape(str(exc))}</p>'
+    plots = doc.get("plots", {})
+    if not isinstance(plots, dict):
+        raise ValueError(f"{folder / 'results.json'}: plots must be an object; got "
+                         f"{plots!r:.60}")
     figs = []
-    for what, file in sorted(doc.get("plots", {}).items()):
+    for what, file in sorted(plots.items()):
+        check_component(file, source=folder / "results.json", entry=f"plots.{what}")
         rel = f"{row['folder']}/{file}"
-        if (out / rel).exists():
+        if check_inside(out / rel, folder, source=folder / "results.json",
+                        entry=f"plots.{what}").exists():
             figs.append(f'<figure><a href="{html.escape(rel)}"><img src="{html.escape(rel)}" '
                         f'alt="{html.escape(what)} of {name}" loading="lazy"></a>'
                         f"<figcaption>{html.escape(CAPTIONS.get(what, what))}</figcaption></figure>")

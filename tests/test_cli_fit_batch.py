@@ -162,3 +162,60 @@ def test_a_second_batch_into_the_same_folder_is_refused_at_once(tables, tmp_path
         first.send_signal(signal.SIGINT)
         first.communicate(timeout=120)
     assert not lock.exists()
+
+
+# ------------------------------------------------------------- hostile summary.json
+def _fake_batch(out, rows, plots=None):
+    """A batch folder as fit-batch writes one: summary.json and a fit folder ``good``."""
+    (out / "good").mkdir(parents=True)
+    (out / "good" / "results.json").write_text(json.dumps(
+        {"schema": "microcyl-fit", "schema_version": 2, "converged": True, "reason": "ok",
+         "parameters": {}, "fit": {}, "quality": {},
+         "plots": plots if plots is not None else {"corner": "corner.png"}}))
+    (out / "good" / "corner.png").write_bytes(b"\x89PNG")
+    base = {"name": "good", "status": "converged", "error": "", "steps": 10, "wall_s": 1.0,
+            "path": "t.csv", "sample": None, "preset": "velvet", "reason": "ok",
+            "folder": "good", "kd1_median": 0.2, "kd1_lo95": 0.1, "kd1_hi95": 0.3}
+    (out / "summary.json").write_text(json.dumps(
+        {"schema": "microcyl-batch", "version": 1, "counts": {},
+         "tables": [dict(base, **r) for r in rows]}))
+    return out
+
+
+@pytest.mark.parametrize("row, plots, named", [
+    ({"name": "../../escape_target"}, None, "tables[0].name: name '../../escape_target'"),
+    ({"folder": "/etc"}, None, "tables[0].folder: name '/etc'"),
+    ({"folder": ".."}, None, "tables[0].folder: name '..'"),
+    ({"status": "<script>x</script>"}, None, "tables[0].status must be one of"),
+    ({"steps": "<script>x</script>"}, None, "tables[0].steps must be an integer"),
+    ({"wall_s": [1]}, None, "tables[0].wall_s must be a finite number"),
+    ({"kd1_median": "<b>"}, None, "tables[0].kd1_median must be a finite number"),
+    ({"error": 3}, None, "tables[0].error must be a string"),
+    ({}, {"corner": "../../../x.png"}, "results.json: plots.corner: name '../../../x.png'"),
+    ({}, {"corner": "/etc/passwd"}, "results.json: plots.corner: name '/etc/passwd'"),
+])
+def test_report_batch_refuses_a_hostile_summary_in_one_line(tmp_path, row, plots, named):
+    from reports.report_batch import write_batch_page     # in-process: ten cases, fast
+    out = _fake_batch(tmp_path / "b", [row], plots)
+    with pytest.raises(ValueError) as err:
+        write_batch_page(out)
+    assert named in str(err.value) and "\n" not in str(err.value)
+    assert not (out / "index.html").exists()
+
+
+def test_report_batch_cli_refuses_names_and_planted_links_in_one_line(tmp_path):
+    out = _fake_batch(tmp_path / "b", [{"name": "../../escape_target"}])
+    r = microcyl("report", "--batch", out)
+    assert r.returncode != 0 and "Traceback" not in r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "summary.json: tables[0].name" in lines[0], r.stderr
+    (tmp_path / "elsewhere").mkdir()
+    out = _fake_batch(tmp_path / "c", [{"name": "linked", "folder": "linked"}])
+    (out / "linked").symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+    r = microcyl("report", "--batch", out)
+    assert r.returncode != 0 and "outside" in r.stderr and "linked" in r.stderr
+    assert not (out / "index.html").exists()
+    good = _fake_batch(tmp_path / "ok", [{}])
+    r = microcyl("report", "--batch", good)
+    assert r.returncode == 0, r.stderr
+    assert 'src="good/corner.png"' in (good / "index.html").read_text()

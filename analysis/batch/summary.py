@@ -9,17 +9,81 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 from pathlib import Path
 
 import gonio
+from gonio.safenames import check_component
 
-__all__ = ["BatchSummary", "SUMMARY_CSV", "SUMMARY_JSON", "SCHEMA", "FIRST_COLUMNS"]
+__all__ = ["BatchSummary", "SUMMARY_CSV", "SUMMARY_JSON", "SCHEMA", "FIRST_COLUMNS",
+           "STATUSES", "check_row"]
 
 SUMMARY_CSV = "summary.csv"
 SUMMARY_JSON = "summary.json"
 SCHEMA = ("microcyl-batch", 1)
 #: The columns every row has, first in the CSV.
 FIRST_COLUMNS = ("name", "status", "error", "steps", "wall_s")
+#: The statuses of a row.
+STATUSES = ("converged", "not_converged", "error")
+_STRINGS = ("error", "preset", "reason", "key")
+_STATS = ("_median", "_lo95", "_hi95")
+
+
+def _bad(path, field: str, allowed: str, value) -> ValueError:
+    text = repr(value)
+    text = text if len(text) <= 60 else text[:57] + "..."
+    return ValueError(f"{path}: {field} must be {allowed}; got {text}")
+
+
+def _count(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool) and v >= 0
+
+
+def check_row(row, path, i: int) -> dict:
+    """Row ``i`` of ``path``'s ``tables`` when every field a reader uses is as written by
+    :func:`analysis.batch.worker.result_row`; else a ValueError naming the file and the field.
+
+    ``name`` and ``folder`` (default the name) are safe file names
+    (:func:`gonio.safenames.check_component`: they name the fit's folder); ``status`` one of
+    :data:`STATUSES`; ``error``, ``preset``, ``reason``, ``key`` strings; ``path`` a string or
+    null; ``steps``, ``resumed_from`` integers >= 0, ``sample`` an integer or null;
+    ``wall_s`` a finite number >= 0 or null; every ``*_median``, ``*_lo95``, ``*_hi95`` a
+    finite number or null.
+
+    Examples
+    --------
+    >>> check_row({"name": "t0", "status": "converged", "steps": 4}, "s.json", 0)["name"]
+    't0'
+    >>> check_row({"name": "t0", "status": "<b>", "steps": 4}, "s.json", 0)
+    Traceback (most recent call last):
+    ...
+    ValueError: s.json: tables[0].status must be one of converged, not_converged, error; got '<b>'
+    """
+    where = f"tables[{i}]"
+    if not isinstance(row, dict):
+        raise _bad(path, where, "an object", row)
+    check_component(row.get("name"), source=path, entry=f"{where}.name")
+    check_component(row.get("folder", row["name"]), source=path, entry=f"{where}.folder")
+    if row.get("status") not in STATUSES:
+        raise _bad(path, f"{where}.status", f"one of {', '.join(STATUSES)}", row.get("status"))
+    for k in _STRINGS:
+        if k in row and not isinstance(row[k], str):
+            raise _bad(path, f"{where}.{k}", "a string", row[k])
+    if row.get("path") is not None and not isinstance(row["path"], str):
+        raise _bad(path, f"{where}.path", "a string", row["path"])
+    for k in ("steps", "resumed_from"):
+        if k in row and not _count(row[k]):
+            raise _bad(path, f"{where}.{k}", "an integer >= 0", row[k])
+    if row.get("sample") is not None and not _count(row["sample"]):
+        raise _bad(path, f"{where}.sample", "an integer >= 0 or null", row["sample"])
+    for k, v in row.items():
+        wall = k == "wall_s"
+        if (wall or k.endswith(_STATS)) and v is not None and (
+                isinstance(v, bool) or not isinstance(v, (int, float))
+                or not math.isfinite(v) or (wall and v < 0)):
+            raise _bad(path, f"{where}.{k}", "a finite number" + (" >= 0" if wall else "")
+                       + " or null", v)
+    return row
 
 
 class BatchSummary:
@@ -33,7 +97,8 @@ class BatchSummary:
     Raises
     ------
     ValueError
-        ``summary.json`` exists but is not a batch summary (naming the file).
+        ``summary.json`` exists but is not a batch summary, or a row is out of its schema
+        (:func:`check_row`; naming the file and the field).
     """
 
     def __init__(self, out_dir):
@@ -45,11 +110,15 @@ class BatchSummary:
                 doc = json.loads(path.read_text(encoding="utf-8"))
                 ok = (isinstance(doc, dict) and doc.get("schema") == SCHEMA[0]
                       and isinstance(doc.get("tables"), list))
-            except (OSError, ValueError) as exc:
+            except (OSError, ValueError, RecursionError) as exc:
                 raise ValueError(f"{path}: cannot read the batch summary ({exc})") from None
             if not ok:
                 raise ValueError(f"{path}: not a microcyl batch summary")
-            self.rows = {r["name"]: r for r in doc["tables"]}
+            for i, r in enumerate(doc["tables"]):
+                check_row(r, path, i)
+                if r["name"] in self.rows:
+                    raise ValueError(f"{path}: tables[{i}].name {r['name']!r} is given twice")
+                self.rows[r["name"]] = r
 
     def done(self, job) -> bool:
         """Whether ``job`` converged before with the same key and its results are there."""

@@ -90,8 +90,13 @@ def check_measured_doc(doc, path) -> dict:
     """
     if not isinstance(doc, dict) or not isinstance(doc.get("datasets"), dict):
         raise ValueError(f"{path}: not a fit-measured summary (no \"datasets\" object)")
+    seen: dict[str, str] = {}
     for name, e in doc["datasets"].items():
         check_component(name, source=path, entry="datasets")
+        if name.casefold() in seen:             # one folder on a case-insensitive disk
+            raise ValueError(f"{path}: datasets: {name!r} and {seen[name.casefold()]!r} "
+                             f"differ only in case; refused")
+        seen[name.casefold()] = name
         _entry(path, name, e)
     return doc
 

@@ -3,9 +3,11 @@ table, a worker killed mid-fit, reruns that resume; and the inputs refused up fr
 
 import json
 import os
+import random
 import signal
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
@@ -13,7 +15,9 @@ import brdf
 import gonio
 from analysis.batch import (BatchJob, BatchSummary, jobs_from_inputs, parse_samples,
                             run_batch)
+from analysis.batch.jobs import table_names
 from analysis.params import defaults_from_fabric
+from gonio.safenames import name_problem
 
 distributed = pytest.importorskip("distributed")
 
@@ -150,11 +154,50 @@ def test_globs_dedupe_names_and_the_per_table_toml(tmp_path, inputs):
     (tmp_path / "a").mkdir()
     (tmp_path / "a" / "t0.csv").write_bytes((inputs / "t0.csv").read_bytes())
     jobs = jobs_from_inputs([str(inputs / "t*.csv"), str(tmp_path / "a")], preset=PRESET)
-    assert [j.name for j in jobs] == ["t0", "t1", "t2", "t0_2"]
+    # the two t0 tables are named by their paths below the tables' common folder
+    root = Path(os.path.commonpath([inputs.resolve(), (tmp_path / "a").resolve()]))
+    other = "_".join((tmp_path / "a").resolve().relative_to(root).parts) + "_t0"
+    mine = "_".join(inputs.resolve().relative_to(root).parts) + "_t0"
+    assert [j.name for j in jobs] == [mine, "t1", "t2", other]
+    again = jobs_from_inputs([str(tmp_path / "a"), str(inputs / "t*.csv"),
+                              str(inputs / "t0.csv")], preset=PRESET)   # t0 named twice
+    assert {j.name: j.path for j in again} == {j.name: j.path for j in jobs}
     (tmp_path / "a" / "t0.toml").write_text('fabric = "velvet"\nfree = ["kd1"]\n')
     (job,) = jobs_from_inputs([str(tmp_path / "a" / "t0.csv")], preset=PRESET,
                               free=("kd1", "gamma_s1"))
     assert job.preset == "velvet" and job.param_spec().free == ("kd1",)
+
+
+def test_table_names_are_safe_distinct_and_stable_under_reordering():
+    d = Path("/data")
+    tables = [(d / "a" / "x.csv", None), (d / "b" / "x.csv", None), (d / "b" / "x.exr", None),
+              (d / "c" / "X.csv", None), (d / "c" / "...exr", None), (d / "c" / "....exr", None),
+              (d / "a_x.csv", None), (d / "cu" / "abrdf.dat", 7), (d / "e" / "cu" / "abrdf.dat", 7),
+              (d / "c" / "y.csv", None)]
+    want = dict(zip(tables, table_names(tables)))
+    for n in want.values():
+        assert name_problem(n) is None and n not in (".", "..")
+    assert len({n.casefold() for n in want.values()}) == len(tables)
+    assert want[(d / "c" / "y.csv", None)] == "y"                  # unique stems stay
+    assert want[(d / "cu" / "abrdf.dat", 7)] == "cu_07"
+    assert want[(d / "e" / "cu" / "abrdf.dat", 7)] == "e_cu_07"
+    assert want[(d / "b" / "x.csv", None)] == "b_x_csv"            # b/x.exr beside it
+    rng = random.Random(0)
+    for _ in range(40):
+        order = rng.sample(range(len(tables)), len(tables))
+        got = table_names([tables[i] for i in order])
+        assert got == [want[tables[i]] for i in order]
+
+
+def test_a_dotted_stem_never_names_a_folder_outside(tmp_path, inputs):
+    (tmp_path / "...csv").write_bytes((inputs / "t0.csv").read_bytes())
+    (job,) = jobs_from_inputs([str(tmp_path / "...csv")], preset=PRESET)
+    out = tmp_path / "out"
+    assert name_problem(job.name) is None and (out / job.name).resolve().parent == out.resolve()
+    for bad in ("..", "../x", "/abs", ".hidden"):
+        with pytest.raises(ValueError, match="job name.*refused"):
+            run_batch([BatchJob(bad, str(inputs / "t0.csv"), preset=PRESET)], out)
+    assert not out.exists()
 
 
 def test_job_key_follows_its_inputs(tmp_path, inputs):

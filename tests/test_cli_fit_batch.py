@@ -219,3 +219,36 @@ def test_report_batch_cli_refuses_names_and_planted_links_in_one_line(tmp_path):
     r = microcyl("report", "--batch", good)
     assert r.returncode == 0, r.stderr
     assert 'src="good/corner.png"' in (good / "index.html").read_text()
+
+
+def test_fit_batch_names_same_stem_tables_by_path_whatever_their_order(tables, tmp_path):
+    """Two tables x.csv in two folders and a table ``...csv`` (stem ``..``): the folders are
+    named from the paths, so the same command with the inputs in another order resumes each
+    fit in its own folder (no "another configuration"), and nothing is written beside -o."""
+    src = tmp_path / "in"
+    for sub, table in (("a", "silk0.csv"), ("b", "silk1.csv"), ("c", "silk1.csv")):
+        (src / sub).mkdir(parents=True)
+    shutil.copy(tables / "silk0.csv", src / "a" / "x.csv")
+    shutil.copy(tables / "silk1.csv", src / "b" / "x.csv")
+    shutil.copy(tables / "silk1.csv", src / "c" / "...csv")
+    out = tmp_path / "site" / "out"
+    opts = [*FIT, "--max-steps", "20", "--no-plots", "--workers", "1", "--no-progress",
+            "-o", out]
+    first = microcyl("fit-batch", src / "a", src / "b", src / "c" / "...csv", *opts)
+    assert first.returncode == 0, first.stderr + first.stdout
+    rows = {r["name"]: r for r in json.loads((out / "summary.json").read_text())["tables"]}
+    dotted = [n for n in rows if n.startswith("_-")]
+    assert set(rows) == {"a_x", "b_x"} | set(dotted) and len(dotted) == 1
+    assert rows["a_x"]["path"].endswith(os.path.join("a", "x.csv"))
+    assert rows["b_x"]["path"].endswith(os.path.join("b", "x.csv"))
+    assert sorted(p.name for p in (tmp_path / "site").iterdir()) == ["out"]
+    assert (out / dotted[0] / "results.json").is_file()
+    second = microcyl("fit-batch", src / "c" / "...csv", src / "b", src / "a", *opts)
+    assert second.returncode == 0, second.stderr + second.stdout
+    assert "another configuration" not in second.stdout + second.stderr
+    again = {r["name"]: r for r in json.loads((out / "summary.json").read_text())["tables"]}
+    assert set(again) == set(rows)
+    for name, r in again.items():
+        assert r["status"] == "not_converged" and r["path"] == rows[name]["path"]
+        assert r["resumed_from"] > 0                           # resumed in its own folder
+    assert sorted(p.name for p in (tmp_path / "site").iterdir()) == ["out"]

@@ -272,3 +272,9 @@ def test_fit_measured_refuses_a_damaged_summary_before_any_fit(tmp_path, shared_
     with pytest.raises(ValueError, match=r"measured\.json: "):
         fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, plots=None,
                      progress=False, workers=1)
+
+
+def test_dataset_names_differing_only_in_case_are_refused():
+    from analysis.measuredjson import check_measured_doc
+    with pytest.raises(ValueError, match="m.json: datasets: 'Felt' and 'felt' differ only in"):
+        check_measured_doc({"datasets": {"felt": {}, "Felt": {}}}, "m.json")

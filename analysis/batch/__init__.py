@@ -6,7 +6,8 @@ task. The parts:
 1. :mod:`~analysis.batch.jobs` -- what to fit: :class:`BatchJob` (a table, its preset, its free
    parameters and fit options; plain data, sent to the workers) and :func:`jobs_from_inputs`
    (files, globs, folders and CUReT samples; a ``NAME.toml`` beside a table overrides the
-   batch's spec for it).
+   batch's spec for it) and :func:`~analysis.batch.jobs.table_names` (each table's folder
+   name, a safe file name, from the set of tables, not their order).
 2. :mod:`~analysis.batch.worker` -- :func:`run_job`, what a worker runs: read the table there,
    fit it into its folder (resuming from its checkpoint), return one summary row; a failure
    becomes a row with its one-line error.

@@ -26,6 +26,7 @@ from analysis.batch.worker import error_row, estimate_job, run_job
 from analysis.budget import format_seconds
 from analysis.folderlock import output_lock
 from gonio.progress import progress_bar
+from gonio.safenames import check_component
 
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3      # glibc's mallopt parameters
 
@@ -191,13 +192,16 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
     BatchInterrupted
         On Ctrl-C, after writing the summaries (every fit resumable from its checkpoint).
     ValueError
-        Duplicate job names or a bad ``workers``.
+        Duplicate job names (case ignored), a name that is not a safe file name
+        (:func:`gonio.safenames.check_component`) or a bad ``workers``.
     FolderBusy
         Another batch holds ``out_dir``'s lock (:func:`analysis.folderlock.output_lock`).
     """
     names = [j.name for j in jobs]
-    if len(set(names)) != len(names):
-        raise ValueError("job names must be unique in a batch")
+    for n in names:                     # each names its folder: DIR/<name>
+        check_component(n, source="run_batch", entry="job name")
+    if len(set(n.casefold() for n in names)) != len(names):
+        raise ValueError("job names must be unique in a batch (case ignored)")
     if workers is not None and workers < 1:
         raise ValueError(f"workers must be >= 1; got {workers}")
     out = Path(out_dir).resolve()

@@ -3,9 +3,17 @@
 Inputs are table files, globs or folders (the files directly inside a folder whose names
 :func:`gonio.read` knows), and CUReT's ``abrdf.dat`` with a sample selection (each sample a
 table). Every input is checked here, before any fit starts: a missing file, an unknown suffix
-or a CUReT file without samples is refused by name. A file ``NAME.toml`` beside a table (NAME
-the table's name in the batch) replaces the batch's ``--spec``/``--free``/``--tie`` for it,
-and its ``fabric`` key the batch's preset.
+or a CUReT file without samples is refused by name. A file ``STEM.toml`` beside a table (STEM
+the table's stem; for CUReT ``FOLDER_SS``, the folder's name and the sample) replaces the
+batch's ``--spec``/``--free``/``--tie`` for it, and its ``fabric`` key the batch's preset.
+
+Each table's folder in the batch's output is named by :func:`table_names` from the set of
+tables alone, never from their order, so the same inputs in another order name the same
+folders: the stem (``FOLDER_SS`` for CUReT), made a safe file name
+(:func:`gonio.safenames.safe_component`: a table ``...exr``, whose stem is ``..``, gets
+``_-<digest>``); where stems collide (case ignored), the path relative to the tables' common
+folder (``a/x.csv`` and ``b/x.csv`` give ``a_x`` and ``b_x``), then with its suffix
+(``x_csv``, ``x_exr``), then with a digest of that path. A table named twice is fitted once.
 """
 
 from __future__ import annotations
@@ -14,6 +22,7 @@ import dataclasses
 import glob
 import hashlib
 import json
+import os
 import tomllib
 from pathlib import Path
 from typing import Callable
@@ -23,8 +32,9 @@ import gonio
 from gonio.io import READ_SUFFIXES
 from analysis.fit.workflow import fit_spec
 from gonio.curet import N_SAMPLES
+from gonio.safenames import digest, safe_component
 
-__all__ = ["BatchJob", "jobs_from_inputs", "read_job_table", "parse_samples"]
+__all__ = ["BatchJob", "jobs_from_inputs", "read_job_table", "parse_samples", "table_names"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -161,17 +171,67 @@ def _expand(item: str) -> list[Path]:
     return [path]
 
 
-def _unique(name: str, taken: set) -> str:
-    out, k = name, 2
-    while out in taken:
-        out, k = f"{name}_{k}", k + 1
-    taken.add(out)
-    return out
+def _candidates(path: Path, sample: int | None, root: Path) -> list[str]:
+    """The names a table may get, most readable first (see the module's docstring); the last
+    is unique to the table's path and sample."""
+    rel = path.relative_to(root)
+    if sample is None:
+        base, label = path.stem, "_".join(rel.with_suffix("").parts)
+        full = "_".join(rel.parent.parts + (rel.name.replace(".", "_"),))
+    else:
+        base = f"{path.parent.name}_{sample:02d}"
+        label = "_".join(rel.parent.parts + (f"{sample:02d}",)) if rel.parent.parts else base
+        full = "_".join(rel.parts).replace(".", "_") + f"_{sample:02d}"
+    key = f"{rel.as_posix()}#{sample}"
+    return [safe_component(base), safe_component(label), safe_component(full),
+            f"{safe_component(label)[:80]}-{digest(key)}"]
 
 
-def _override(job: BatchJob, folder: Path) -> BatchJob:
-    """The job with ``NAME.toml`` beside its table, when there is one, as its spec."""
-    toml = folder / f"{job.name}.toml"
+def table_names(tables) -> list[str]:
+    """The folder names of a batch's tables, one each, from the set of tables alone.
+
+    Parameters
+    ----------
+    tables : sequence of (path, sample)
+        Distinct table files (resolved, absolute) with their CUReT sample or None.
+
+    Returns
+    -------
+    list of str
+        Safe file names, distinct even where case is ignored, in the order of ``tables``; the
+        same tables in another order get the same names.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> table_names([(Path("/d/b/x.csv"), None), (Path("/d/a/x.csv"), None),
+    ...              (Path("/d/a/y.csv"), None), (Path("/d/a/...csv"), None)])
+    ['b_x', 'a_x', 'y', '_-5ec1f7e7']
+    """
+    tables = [(Path(p), s) for p, s in tables]
+    if not tables:
+        return []
+    root = Path(os.path.commonpath([str(p.parent) for p, _ in tables]))
+    cands = [_candidates(p, s, root) for p, s in tables]
+    level = [0] * len(tables)
+    while True:
+        names = [c[k] for c, k in zip(cands, level)]
+        groups: dict[str, list[int]] = {}
+        for i, n in enumerate(names):
+            groups.setdefault(n.casefold(), []).append(i)
+        clash = [i for g in groups.values() if len(g) > 1 for i in g]
+        if not clash:
+            return names
+        if all(level[i] == len(cands[i]) - 1 for i in clash):
+            raise ValueError(f"tables {', '.join(str(tables[i][0]) for i in clash)} cannot "
+                             f"be given distinct folder names")
+        for i in clash:
+            level[i] = min(level[i] + 1, len(cands[i]) - 1)
+
+
+def _override(job: BatchJob, folder: Path, stem: str) -> BatchJob:
+    """The job with ``STEM.toml`` beside its table, when there is one, as its spec."""
+    toml = folder / f"{stem}.toml"
     if not toml.is_file():
         return job
     try:
@@ -205,7 +265,8 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
     Returns
     -------
     list of BatchJob
-        In input order (files of a folder or glob sorted), names unique.
+        In input order (files of a folder or glob sorted; a table named twice once), named
+        by :func:`table_names`.
 
     Raises
     ------
@@ -220,19 +281,23 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
                 ties=None if ties is None else tuple(ties), spec=spec, fit=dict(fit or {}),
                 fabric_options=dict(fabric_options or {}),
                 read_options=dict(read_options or {}), plots=plots)
-    jobs, taken = [], set()
+    found: dict[tuple[Path, int | None], Path] = {}      # (resolved, sample) -> as given
     for item in inputs:
         for path in _expand(str(item)):
             if path.name.lower() == "abrdf.dat":
                 if sample_list is None:
                     raise ValueError(f"input {str(path)!r} is CUReT's abrdf.dat: name the "
                                      f"samples with --sample all or --sample 1,2,7")
-                named = [(f"{path.resolve().parent.name}_{s:02d}", s) for s in sample_list]
+                samples_of = sample_list
             else:
-                named = [(path.stem, None)]
-            for name, s in named:
-                job = BatchJob(_unique(name, taken), str(path), s, **base)
-                jobs.append(_override(job, path.parent))
+                samples_of = (None,)
+            for s in samples_of:
+                found.setdefault((path.resolve(), s), path)
+    names = table_names(list(found))
+    jobs = []
+    for ((real, s), path), name in zip(found.items(), names):
+        stem = path.stem if s is None else f"{real.parent.name}_{s:02d}"
+        jobs.append(_override(BatchJob(name, str(path), s, **base), path.parent, stem))
     if not jobs:
         raise ValueError("no tables to fit: name at least one input")
     for job in jobs:

@@ -48,7 +48,7 @@ from analysis.fit.results import read_results
 from analysis.measuredjson import load_measured_json
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
-from gonio import atomic_write
+from gonio import atomic_write, plain
 from gonio.curet import read_curet
 from gonio.io import read
 from gonio.rgl import load_rgl
@@ -267,7 +267,8 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     for n in names:
         doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
     with atomic_write(spath, "w") as fh:
-        fh.write(json.dumps(doc, indent=2) + "\n")
+        # strict JSON: a non-finite number is written null (the schema refuses NaN)
+        fh.write(json.dumps(plain(doc, nonfinite="null"), indent=2) + "\n")
     return doc
 
 

@@ -9,12 +9,12 @@ predictive lobes over the data points, the residual map, the corner and the trac
 
 from __future__ import annotations
 
-import html
 import json
 import shutil
 from pathlib import Path
 
 from analysis.fit.results import read_results
+from reports.safehtml import Markup, html, join, table, url
 
 __all__ = ["read_measured", "measured_page", "PLOTS"]
 
@@ -64,6 +64,8 @@ def read_measured(folder) -> dict:
 
 
 def _f(v, fmt=".4g") -> str:
+    """A number as text (``-`` for None); anything else as its text, escaped where it is
+    put on the page."""
     if v is None:
         return "-"
     try:
@@ -72,14 +74,7 @@ def _f(v, fmt=".4g") -> str:
         return str(v)
 
 
-def _table(header, rows) -> str:
-    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
-                   for row in rows)
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-
-
-def overview_table(measured: dict) -> str:
+def overview_table(measured: dict) -> Markup:
     """One row per dataset: preset, size, verdict, residuals, colour difference."""
     rows = []
     for name, e in measured.items():
@@ -88,11 +83,11 @@ def overview_table(measured: dict) -> str:
                      "yes" if e.get("converged") else "NO", e.get("steps", "-"),
                      _f(q.get("rms_residual"), ".3f"), _f(q.get("rms_normalized"), ".2f"),
                      _f(e.get("albedo_delta_e2000"), ".1f")])
-    return _table(["dataset", "start preset", "values", "converged", "steps",
-                   "residual rms", "normalized rms", "albedo ΔE2000"], rows)
+    return table(["dataset", "start preset", "values", "converged", "steps",
+                  "residual rms", "normalized rms", "albedo ΔE2000"], rows)
 
 
-def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple[str, dict]:
+def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple[Markup, dict]:
     """Write the figures of every fit under ``root/folder/NAME/`` and return the page body
     and its summary (JSON-ready).
 
@@ -103,13 +98,14 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
     measured : dict
         From :func:`read_measured`.
     """
-    body = ['<p>The model fitted to measured fabrics with <code>microcyl fit-measured</code> '
-            '(each from its closest preset; the free parameters are shared by both threads). '
-            'The residual rms is taken in the likelihood\'s space, log(1 + f_r cos θ<sub>i</sub>); '
-            'the normalized rms is in units of the noise the fit found (near 1 when the model '
-            'explains the data to within it). ΔE2000 compares the albedo colours of the data and '
-            'of the posterior-median model over the same directions (for grey tables, the grey '
-            'levels).</p>', overview_table(measured)]
+    body = [Markup(
+        '<p>The model fitted to measured fabrics with <code>microcyl fit-measured</code> '
+        '(each from its closest preset; the free parameters are shared by both threads). '
+        'The residual rms is taken in the likelihood\'s space, log(1 + f_r cos θ<sub>i</sub>); '
+        'the normalized rms is in units of the noise the fit found (near 1 when the model '
+        'explains the data to within it). ΔE2000 compares the albedo colours of the data and '
+        'of the posterior-median model over the same directions (for grey tables, the grey '
+        'levels).</p>'), overview_table(measured)]
     summary = {}
     for name, e in measured.items():
         doc = e["results"]
@@ -132,32 +128,41 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
                 continue
             shutil.copyfile(src, dest / src.name)
             rel = f"{folder}/{name}/{src.name}"
-            figs.append(f'<figure><img src="{html.escape(rel)}" alt="{html.escape(key)}">'
-                        f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+            figs.append(html('<figure><img src="{}" alt="{}"><figcaption>{}</figcaption>'
+                             "</figure>", url(rel), key, caption))
         for data in ("results.json", "results.csv"):
             if (Path(e["folder"]) / data).is_file():
                 shutil.copyfile(Path(e["folder"]) / data, dest / data)
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
-        body.append(
-            f'<section id="{html.escape(name)}" class="measured"><h2>{html.escape(name)}: '
-            f"{html.escape(e.get('title', ''))}</h2>"
-            f"<p>Table: {html.escape(str(e.get('source', '')))}; {e.get('pairs', '-')} pairs, "
-            f"{e.get('values_used', '-')} values used. Start preset "
-            f"<b>{html.escape(str(e.get('preset', '')))}</b>; ties: "
-            f"{html.escape(', '.join(e.get('ties', [])))}.</p>"
-            f"<p><b>{verdict}</b>: {html.escape(str(e.get('reason', '')))}</p>"
-            f"<p>Residual rms {_f(q.get('rms_residual'), '.4f')} (normalized "
-            f"{_f(q.get('rms_normalized'), '.2f')}); albedo ΔE2000 "
-            f"{_f(e.get('albedo_delta_e2000'), '.2f')}. Data: "
-            f'<a href="{folder}/{html.escape(name)}/results.json">results.json</a>, '
-            f'<a href="{folder}/{html.escape(name)}/results.csv">results.csv</a>.</p>'
-            + _table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows)
-            + "".join(figs) + "</section>")
+        body.append(_section(folder, name, e, verdict, rows, figs))
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
                          "parameters": {k: {f: res[k].get(f) for f in
                                             ("median", "lo68", "hi68", "lo95", "hi95", "tau",
                                              "rhat", "ess")} for k in params},
                          "figures": len(figs)}
-    return "".join(body), summary
+    return join(body), summary
+
+
+def _section(folder: str, name: str, e: dict, verdict: str, rows, figs) -> Markup:
+    """One dataset's ``<section>``: what was fitted, the verdict, the fit's quality, its
+    posterior table and figures; every value from measured.json through the template."""
+    q = e.get("quality", {})
+    ties = e.get("ties", [])
+    return html(
+        '<section id="{name}" class="measured"><h2>{name}: {title}</h2>'
+        "<p>Table: {source}; {pairs} pairs, {values} values used. Start preset "
+        "<b>{preset}</b>; ties: {ties}.</p><p><b>{verdict}</b>: {reason}</p>"
+        "<p>Residual rms {rms} (normalized {rms_n}); albedo ΔE2000 {de}. Data: "
+        '<a href="{data}/results.json">results.json</a>, '
+        '<a href="{data}/results.csv">results.csv</a>.</p>{table}{figs}</section>',
+        name=name, title=e.get("title", ""), source=e.get("source", ""),
+        pairs=e.get("pairs", "-"), values=e.get("values_used", "-"),
+        preset=e.get("preset", ""),
+        ties=", ".join(map(str, ties)) if isinstance(ties, (list, tuple)) else ties,
+        verdict=verdict, reason=e.get("reason", ""), rms=_f(q.get("rms_residual"), ".4f"),
+        rms_n=_f(q.get("rms_normalized"), ".2f"), de=_f(e.get("albedo_delta_e2000"), ".2f"),
+        data=url(f"{folder}/{name}"),
+        table=table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows),
+        figs=join(figs))

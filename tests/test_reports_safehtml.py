@@ -102,12 +102,15 @@ def read(path: Path) -> str:
     return path.read_bytes().decode("utf-8")
 
 
-def hostile_results(path: Path, value=P) -> Path:
-    """A results.json whose every string and number field is ``value``."""
-    doc = {"schema": "microcyl-fit", "schema_version": 2, "converged": value, "reason": value,
-           "parameters": {value: {c: value for c in _COLUMNS} | {"unit": value}},
-           "fit": {"steps": value, "chains": value}, "quality": {"rms_residual": value},
-           "plots": {value: value, "corner": value}}
+def hostile_results(path: Path, value=P, numbers=None) -> Path:
+    """A results.json whose every string field is ``value``, and every number field too
+    (``numbers`` None) or ``numbers``: a file a schema check would pass."""
+    n = value if numbers is None else numbers
+    doc = {"schema": "microcyl-fit", "schema_version": 2,
+           "converged": value if numbers is None else False, "reason": value,
+           "parameters": {value: {c: n for c in _COLUMNS} | {"unit": value}},
+           "fit": {"steps": n if numbers is None else 100},
+           "quality": {"rms_residual": n}, "plots": {value: value} if numbers is None else {}}
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(doc), encoding="utf-8")
     return path
@@ -124,39 +127,65 @@ class HostileFabric(Lambert):
         self.options = {value: value}
 
 
-def measured_entry(folder: Path, value=P) -> dict:
-    """An entry of measured.json with every string and number field ``value``."""
-    return {"title": value, "source": value, "pairs": value, "values_used": value,
-            "preset": value, "ties": [value], "converged": value, "reason": value,
-            "steps": value, "quality": {"rms_residual": value, "rms_normalized": value},
-            "albedo_delta_e2000": value, "results": "ds/results.json"}
+def measured_entry(value=P, numbers=None, results="ds/results.json") -> dict:
+    """An entry of measured.json with every string field ``value``, and every number field
+    too (``numbers`` None) or ``numbers``."""
+    n = value if numbers is None else numbers
+    return {"title": value, "source": value, "pairs": n, "values_used": n, "preset": value,
+            "ties": [value], "converged": value if numbers is None else False,
+            "reason": value, "steps": n,
+            "quality": {"rms_residual": n, "rms_normalized": n}, "albedo_delta_e2000": n,
+            "results": results}
+
+
+def _build(tmp: Path, kind: str, fabrics, numbers=None, **kw) -> tuple[Path | None, str]:
+    """A report of ``kind`` (its own folder under ``tmp``) from hostile files: the output
+    folder, or None and the reader's refusal (which must be one line)."""
+    d = tmp / f"{kind}-{numbers}"
+    if kind == "fit":
+        kw["fit_results"] = {n: hostile_results(d / n.replace("/", "_") / "results.json",
+                                                numbers=numbers) for n in fabrics}
+    if kind == "measured":
+        m = d / "measured"
+        for ds in ("ds", "ds2"):
+            hostile_results(m / ds / "results.json", numbers=0.5 if numbers is None else numbers)
+        (m / "measured.json").write_text(json.dumps({"datasets": {
+            ds: measured_entry(numbers=numbers, results=f"{ds}/results.json")
+            for ds in ("ds", "ds2")}}))
+        kw["measured"] = m
+    try:
+        index = build_report(fabrics, d / "report", sections=["parameters", "fit"],
+                             progress=False, quality="fast", title=P, **kw)
+    except ValueError as exc:
+        assert "\n" not in str(exc) and "Traceback" not in str(exc)
+        return None, str(exc)
+    return index.parent, ""
 
 
 # -- every page kind from hostile files ---------------------------------------------------------
 
+NAME = "<script>alert(1)<\\script>"       # a page's name cannot hold "/"
+
+
 @pytest.fixture(scope="module")
 def hostile_report(tmp_path_factory):
-    """The report (fabric pages, fit sections, overview, measured.html) built from hostile
-    files: a user's BRDF named with markup, a preset and that BRDF with hostile results.json,
-    a measured folder whose measured.json holds markup in every field."""
-    d = tmp_path_factory.mktemp("hostile")
-    measured = d / "measured"
-    hostile_results(measured / "ds" / "results.json")
-    (measured / "measured.json").write_text(json.dumps(
-        {"datasets": {P: measured_entry(measured), "ok": measured_entry(measured)}}))
-    name = "<script>alert(1)<\\script>"          # a page name cannot hold "/"
-    fits = {"velvet": hostile_results(d / "f1" / "results.json"),
-            name: hostile_results(d / "f2" / "results.json")}
-    try:
-        index = build_report({"velvet": None, name: HostileFabric()}, d / "report",
-                             sections=["parameters", "fit"], progress=False, quality="fast",
-                             fit_results=fits, measured=measured, title=P)
-    except ValueError as exc:                   # a reader refused the hostile measured.json
-        assert "\n" not in str(exc)
-        index = build_report({"velvet": None, name: HostileFabric()}, d / "report",
-                             sections=["parameters", "fit"], progress=False, quality="fast",
-                             fit_results=fits, title=P)
-    return index.parent, name
+    """Every page kind of the report built from hostile data: fabric pages and overview (a
+    user's BRDF named with markup, its thread fields and options text), the fit sections
+    (results.json with markup in every field) and measured.html (measured.json likewise).
+    A file a reader refuses is built again with numbers where numbers belong (markup in every
+    text field), which a reader must accept. Kind -> output folder; and the refusals."""
+    tmp = tmp_path_factory.mktemp("hostile")
+    fabrics = {"velvet": None, NAME: HostileFabric()}
+    out, refused = {}, {}
+    out["pages"], _ = _build(tmp, "pages", fabrics)
+    for kind in ("fit", "measured"):
+        out[kind], refused[kind] = _build(tmp, kind, fabrics if kind == "fit" else
+                                          {"velvet": None})
+        if out[kind] is None:
+            out[kind], again = _build(tmp, kind, fabrics if kind == "fit" else
+                                      {"velvet": None}, numbers=1)
+            assert out[kind] is not None, again
+    return out, refused
 
 
 def test_a_fabric_name_with_a_slash_is_refused_cleanly(tmp_path):
@@ -164,36 +193,44 @@ def test_a_fabric_name_with_a_slash_is_refused_cleanly(tmp_path):
         build_report({P: Lambert()}, tmp_path / "r", sections=["parameters"], progress=False)
 
 
-def test_report_pages_from_hostile_files_hold_no_markup_from_them(hostile_report):
-    root, name = hostile_report
-    pages = written_pages(root)
-    names = {p.name for p in pages}
-    assert {"index.html", "velvet.html", f"{name}.html"} <= names
-    for p in pages:
+@pytest.mark.parametrize("kind", ["pages", "fit", "measured"])
+def test_report_pages_from_hostile_files_hold_no_markup_from_them(hostile_report, kind):
+    root = hostile_report[0][kind]
+    pages = {p.name: p for p in written_pages(root)}
+    assert {"index.html", "velvet.html"} <= set(pages)
+    for p in pages.values():
         seen = assert_inert(read(p), p.name)
         assert any(P in t for t in seen.texts), f"{p.name} does not show the text"
-    fabric = read(root / f"{name}.html")
-    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in fabric     # options, fit, title
-    index = read(root / "index.html")
-    assert f'href="{safehtml.url(name)}.html"' in index
+    if kind != "measured":
+        fabric = read(pages[f"{NAME}.html"])
+        assert "&lt;script&gt;alert(1)&lt;\\script&gt;" in fabric     # its name
+        assert "&lt;script&gt;alert(1)&lt;/script&gt;" in fabric       # options or fit
+        assert f'href="{safehtml.url(NAME)}.html"' in read(pages["index.html"])
+
+
+def test_fit_section_shows_hostile_results_as_text(hostile_report):
+    velvet = read(hostile_report[0]["fit"] / "velvet.html")
+    fit = velvet.split('<section id="fit"')[1]
+    # the parameter's name and unit and the fit's reason, as text in the table
+    assert fit.count("&lt;script&gt;alert(1)&lt;/script&gt;") >= 2
 
 
 def test_measured_page_from_a_hostile_measured_json(hostile_report):
-    root, _ = hostile_report
-    page_ = root / "measured.html"
-    if not page_.exists():
-        pytest.skip("the hostile measured.json was refused by its reader (a clean refusal)")
-    doc = read(page_)
+    doc = read(hostile_report[0]["measured"] / "measured.html")
     assert_inert(doc, "measured.html")
-    # pairs, values_used, the residuals and ΔE2000 (issue 24) reach the page as text
-    assert doc.count("&lt;script&gt;alert(1)&lt;/script&gt; pairs") == 2
-    assert "Residual rms &lt;script&gt;" in doc and "ΔE2000 &lt;script&gt;" in doc
+    esc = "&lt;script&gt;alert(1)&lt;/script&gt;"
+    assert doc.count(f"Table: {esc}") == 2 and doc.count(f"Start preset <b>{esc}</b>") == 2
+    if not hostile_report[1]["measured"]:
+        # pairs, values_used, the residuals and ΔE2000 (issue 24) reach the page as text
+        assert doc.count(f"{esc} pairs, {esc} values used") == 2
+        assert f"Residual rms {esc}" in doc and f"ΔE2000 {esc}" in doc
 
 
 def test_measured_page_builder_escapes_every_field(tmp_path):
     for value in PAYLOADS:
-        entry = measured_entry(tmp_path, value) | {"results": json.loads(
-            hostile_results(tmp_path / "r.json", value).read_text()), "folder": tmp_path}
+        entry = measured_entry(value) | {"results": json.loads(
+            hostile_results(tmp_path / "r.json", value).read_text()), "folder": tmp_path,
+            "plot_files": {}, "data_files": []}
         measured = {value: entry}
         body, summary = measured_page(tmp_path / "root", measured)
         seen = assert_inert(page("t", nav([], None, True), body), value)
@@ -228,7 +265,8 @@ def test_batch_page_from_a_hostile_summary(tmp_path, value):
     try:
         page_ = write_batch_page(out)
     except ValueError as exc:                    # a schema check refused the summary
-        assert "\n" not in str(exc) and "summary.json" in str(exc)
+        assert "\n" not in str(exc) and ("summary.json" in str(exc)
+                                         or "results.json" in str(exc))
         return
     doc = read(page_)
     seen = assert_inert(doc)
@@ -251,7 +289,7 @@ def test_report_batch_as_a_user_runs_it(tmp_path):
         assert_inert(read(out / "index.html"))
     else:
         assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
-        assert "summary.json" in r.stderr, r.stderr
+        assert "summary.json" in r.stderr or "results.json" in r.stderr, r.stderr
 
 
 # -- fuzz ---------------------------------------------------------------------------------------
@@ -274,7 +312,8 @@ def _shows(seen: _Inert, value) -> bool:
          st.sampled_from(["rms_residual", "rms_normalized"]), values), unit=texts)
 def test_fuzz_measured_page(tmp_path, name, fields, quality, unit):
     results = {"parameters": {"p": {c: 1.0 for c in _COLUMNS} | {"unit": unit}}, "plots": {}}
-    entry = fields | {"quality": quality, "results": results, "folder": tmp_path}
+    entry = fields | {"quality": quality, "results": results, "folder": tmp_path,
+                      "plot_files": {}, "data_files": []}
     try:
         body, _ = measured_page(tmp_path / "root", {name: entry})
     except (ValueError, OSError) as exc:          # a name that cannot name a folder

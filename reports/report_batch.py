@@ -2,30 +2,30 @@
 
 One table row per fit (status, error, steps, wall time, the median and 95% interval of every
 free parameter), and for each fit its plots (corner, posterior predictive, ...) as linked
-thumbnails; every link is relative, so the folder can be moved or served as it is.
+thumbnails; every link is relative, so the folder can be moved or served as it is. Every value
+read from summary.json or a results.json reaches the page through :mod:`reports.safehtml`.
 """
 
 from __future__ import annotations
 
-import html
-import json
 from pathlib import Path
 
 from analysis.batch.summary import SUMMARY_CSV, SUMMARY_JSON, BatchSummary
 from analysis.fit.results import read_results
 from gonio import atomic_write
 from gonio.safenames import check_component, check_inside
+from reports.safehtml import Markup, html, join, json_script, text, url
 
 __all__ = ["write_batch_page", "PAGE", "CAPTIONS"]
 
 PAGE = "index.html"
 
-_CSS = """body{font-family:system-ui,sans-serif;margin:2em;max-width:1400px}
+_CSS = Markup("""body{font-family:system-ui,sans-serif;margin:2em;max-width:1400px}
 table{border-collapse:collapse;font-size:14px}td,th{border:1px solid #ccc;padding:3px 7px}
 th{background:#f0f0f0}td.num{text-align:right;font-variant-numeric:tabular-nums}
 .converged{color:#176}.not_converged{color:#a60}.error{color:#b00}
 .plots{display:grid;grid-template-columns:repeat(auto-fill,minmax(260px,1fr));gap:10px}
-.plots img{width:100%;border:1px solid #ddd}figure{margin:0}figcaption{font-size:13px}"""
+.plots img{width:100%;border:1px solid #ddd}figure{margin:0}figcaption{font-size:13px}""")
 
 
 #: Captions of the fit plots (reports.fitplots) by name.
@@ -42,41 +42,39 @@ def _params(rows) -> list[str]:
     return out
 
 
-def _cell(row, name) -> str:
+def _cell(row, name) -> Markup:
     if any(row.get(f"{name}_{k}") is None for k in ("median", "lo95", "hi95")):
-        return "<td></td>"
+        return Markup("<td></td>")
     m, lo, hi = (row[f"{name}_{k}"] for k in ("median", "lo95", "hi95"))
-    return f'<td class="num">{m:.4g} <small>[{lo:.4g}, {hi:.4g}]</small></td>'
+    return html('<td class="num">{:.4g} <small>[{:.4g}, {:.4g}]</small></td>', m, lo, hi)
 
 
-def _table(rows, names) -> str:
-    head = "".join(f"<th>{html.escape(n)}</th>" for n in
-                   ["table", "status", "steps", "wall (s)"] + [f"{p} median [95%]"
-                                                                for p in names])
+def _table(rows, names) -> Markup:
+    head = join(html("<th>{}</th>", n) for n in
+                ["table", "status", "steps", "wall (s)"] + [f"{p} median [95%]" for p in names])
     body = []
     for r in rows:
-        name = html.escape(r["name"])
-        link = (f'<a href="#{name}">{name}</a>' if r["status"] != "error" else name)
-        status = html.escape(r["status"]) + (f"<br><small>{html.escape(r['error'])}</small>"
-                                             if r.get("error") else "")
-        body.append(f'<tr><td>{link}</td><td class="{html.escape(r["status"])}">{status}</td>'
-                    f'<td class="num">{r.get("steps", "")}</td><td class="num">'
-                    f'{float(r.get("wall_s") or 0):.0f}</td>'
-                    + "".join(_cell(r, p) for p in names) + "</tr>")
-    return f"<table><tr>{head}</tr>{''.join(body)}</table>"
+        name, status = r["name"], r["status"]
+        link = html('<a href="#{}">{}</a>', url(name), name) if status != "error" else text(name)
+        error = html("<br><small>{}</small>", r["error"]) if r.get("error") else Markup("")
+        body.append(html('<tr><td>{}</td><td class="{}">{}{}</td><td class="num">{}</td>'
+                         '<td class="num">{:.0f}</td>{}</tr>', link, status, status, error,
+                         r.get("steps", ""), r.get("wall_s") or 0,
+                         join(_cell(r, p) for p in names)))
+    return html("<table><tr>{}</tr>{}</table>", head, join(body))
 
 
-def _fit_section(out: Path, row) -> str:
+def _fit_section(out: Path, row) -> Markup:
     """One fit: its verdict and its plots, linked. The row's folder and the plots of its
     results.json are safe names inside ``out`` (links resolved), else a ValueError."""
     source = out / SUMMARY_JSON
     folder = check_inside(out / row["folder"], out, source=source,
                           entry=f"the folder of {row['name']}")
-    name = html.escape(row["name"])
+    name = row["name"]
     try:
         doc = read_results(folder / "results.json")
     except ValueError as exc:
-        return f'<h3 id="{name}">{name}</h3><p>{html.escape(str(exc))}</p>'
+        return html('<h3 id="{}">{}</h3><p>{}</p>', name, name, exc)
     plots = doc.get("plots", {})
     if not isinstance(plots, dict):
         raise ValueError(f"{folder / 'results.json'}: plots must be an object; got "
@@ -87,13 +85,15 @@ def _fit_section(out: Path, row) -> str:
         rel = f"{row['folder']}/{file}"
         if check_inside(out / rel, folder, source=folder / "results.json",
                         entry=f"plots.{what}").exists():
-            figs.append(f'<figure><a href="{html.escape(rel)}"><img src="{html.escape(rel)}" '
-                        f'alt="{html.escape(what)} of {name}" loading="lazy"></a>'
-                        f"<figcaption>{html.escape(CAPTIONS.get(what, what))}</figcaption></figure>")
-    plots = f'<div class="plots">{"".join(figs)}</div>' if figs else "<p>no plots</p>"
-    return (f'<h3 id="{name}">{name}</h3><p>{html.escape(doc.get("reason", ""))} &middot; '
-            f'<a href="{html.escape(row["folder"])}/results.json">results.json</a> &middot; '
-            f'<code>{html.escape(str(row.get("path", "")))}</code></p>{plots}')
+            figs.append(html('<figure><a href="{rel}"><img src="{rel}" alt="{what} of {name}" '
+                             'loading="lazy"></a><figcaption>{caption}</figcaption></figure>',
+                             rel=url(rel), what=what, name=name,
+                             caption=CAPTIONS.get(what, what)))
+    plots = (html('<div class="plots">{}</div>', join(figs)) if figs
+             else Markup("<p>no plots</p>"))
+    return html('<h3 id="{}">{}</h3><p>{} &middot; <a href="{}">results.json</a> &middot; '
+                "<code>{}</code></p>{}", name, name, doc.get("reason", ""),
+                url(f"{row['folder']}/results.json"), row.get("path", ""), plots)
 
 
 def write_batch_page(out_dir) -> Path:
@@ -110,16 +110,18 @@ def write_batch_page(out_dir) -> Path:
                          f"fit-batch -o {out} first)")
     summary = BatchSummary(out)
     rows = summary.ordered()
-    counts = ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in sorted(summary.counts().items()))
-    sections = "".join(_fit_section(out, r) for r in rows if r["status"] != "error")
-    doc = (f"<!doctype html><html><head><meta charset='utf-8'><meta name='viewport' "
-           f"content='width=device-width, initial-scale=1'><title>microcyl batch: "
-           f"{html.escape(out.name)}</title><style>{_CSS}</style></head><body>"
-           f"<h1>Batch fit: {html.escape(out.name)}</h1><p>{len(rows)} tables: {counts}. "
-           f"Data: <a href='{SUMMARY_CSV}'>{SUMMARY_CSV}</a>, <a href='{SUMMARY_JSON}'>"
-           f"{SUMMARY_JSON}</a>.</p>{_table(rows, _params(rows))}<h2>Fits</h2>{sections}"
-           f"<script type='application/json' id='summary'>"
-           f"{html.escape(json.dumps(summary.counts()))}</script></body></html>")
+    counts = ", ".join(f"{v} {str(k).replace('_', ' ')}"
+                       for k, v in sorted(summary.counts().items(), key=lambda kv: str(kv[0])))
+    sections = join(_fit_section(out, r) for r in rows if r["status"] != "error")
+    doc = html("<!doctype html><html><head><meta charset='utf-8'><meta name='viewport' "
+               "content='width=device-width, initial-scale=1'><title>microcyl batch: "
+               "{name}</title><style>{css}</style></head><body>"
+               "<h1>Batch fit: {name}</h1><p>{n} tables: {counts}. "
+               "Data: <a href='{csv}'>{csv}</a>, <a href='{json}'>{json}</a>.</p>{table}"
+               "<h2>Fits</h2>{sections}{data}</body></html>", name=out.name, css=_CSS,
+               n=len(rows), counts=counts, csv=SUMMARY_CSV, json=SUMMARY_JSON,
+               table=_table(rows, _params(rows)), sections=sections,
+               data=json_script(summary.counts(), "summary"))
     with atomic_write(out / PAGE, "w") as f:
-        f.write(doc)
+        f.write(str(doc))
     return out / PAGE

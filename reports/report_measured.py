@@ -9,13 +9,13 @@ predictive lobes over the data points, the residual map, the corner and the trac
 
 from __future__ import annotations
 
-import html
 import shutil
 from pathlib import Path
 
 from analysis.fit.results import read_results
 from analysis.measuredjson import load_measured_json, results_path
 from gonio.safenames import check_component, check_inside
+from reports.safehtml import Markup, html, join, table, url
 
 __all__ = ["read_measured", "measured_page", "PLOTS"]
 
@@ -25,6 +25,9 @@ PLOTS = {
              "incidence, over the table's points in that plane.",
     "residuals": "Normalized residuals (data minus posterior-median model over the noise "
                  "scale) on the half-vector disk.",
+    "adequacy": "Standardized residuals per point against angle (N(0, 1) where the model "
+                "fits; forward and back scatter in two colours), the adequacy verdict and the "
+                "warnings.",
     "corner": "Posterior marginals and pairs (corner).",
     "traces": "Traces of some walkers of every ensemble (after burn-in).",
 }
@@ -83,6 +86,8 @@ def _plot_files(doc: dict, rpath: Path) -> dict:
 
 
 def _f(v, fmt=".4g") -> str:
+    """A number as text (``-`` for None); anything else as its text, escaped where it is
+    put on the page."""
     if v is None:
         return "-"
     try:
@@ -91,27 +96,34 @@ def _f(v, fmt=".4g") -> str:
         return str(v)
 
 
-def _table(header, rows) -> str:
-    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
-                   for row in rows)
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-
-
-def overview_table(measured: dict) -> str:
-    """One row per dataset: preset, size, verdict, residuals, colour difference."""
+def overview_table(measured: dict) -> Markup:
+    """One row per dataset: preset, size, verdicts, warnings, residuals, colour difference."""
     rows = []
     for name, e in measured.items():
         q = e.get("quality", {})
+        doc = e.get("results") or {}
+        kinds = sorted({str(w.get("kind")) for w in doc.get("warnings") or []
+                        if isinstance(w, dict)})
         rows.append([name, e.get("preset", "-"), e.get("values_used", "-"),
                      "yes" if e.get("converged") else "NO", e.get("steps", "-"),
+                     {True: "yes", False: "NO"}.get(doc.get("adequate"), "-"),
+                     ", ".join(kinds) or "-",
                      _f(q.get("rms_residual"), ".3f"), _f(q.get("rms_normalized"), ".2f"),
                      _f(e.get("albedo_delta_e2000"), ".1f")])
-    return _table(["dataset", "start preset", "values", "converged", "steps",
-                   "residual rms", "normalized rms", "albedo ΔE2000"], rows)
+    return table(["dataset", "start preset", "values", "converged", "steps", "adequate",
+                  "warnings", "residual rms", "normalized rms", "albedo ΔE2000"], rows)
 
 
-def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple[str, dict]:
+def _trust(doc: dict) -> Markup:
+    """A fit's adequacy verdict and its warnings, escaped."""
+    head = {True: "adequate", False: "NOT adequate"}.get(doc.get("adequate"), "adequacy unknown")
+    items = join(html("<li>{}: {}</li>", w.get("kind"), w.get("message"))
+                 for w in doc.get("warnings") or [] if isinstance(w, dict))
+    return (html("<p><b>{}</b>: {}</p>", head, doc.get("adequate_reason", "not checked"))
+            + (html("<ul>{}</ul>", items) if items else Markup("<p>No warnings.</p>")))
+
+
+def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple[Markup, dict]:
     """Write the figures of every fit under ``root/folder/NAME/`` and return the page body
     and its summary (JSON-ready).
 
@@ -122,13 +134,17 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
     measured : dict
         From :func:`read_measured`.
     """
-    body = ['<p>The model fitted to measured fabrics with <code>microcyl fit-measured</code> '
-            '(each from its closest preset; the free parameters are shared by both threads). '
-            'The residual rms is taken in the likelihood\'s space, log(1 + f_r cos θ<sub>i</sub>); '
-            'the normalized rms is in units of the noise the fit found (near 1 when the model '
-            'explains the data to within it). ΔE2000 compares the albedo colours of the data and '
-            'of the posterior-median model over the same directions (for grey tables, the grey '
-            'levels).</p>', overview_table(measured)]
+    body = [Markup(
+        '<p>The model fitted to measured fabrics with <code>microcyl fit-measured</code> '
+        '(each from its closest preset; the free parameters are shared by both threads). '
+        'The residual rms is taken in the likelihood\'s space, log(1 + f_r cos θ<sub>i</sub>); '
+        'the normalized rms is in units of the noise the fit found (near 1 when the model '
+        'explains the data to within it). ΔE2000 compares the albedo colours of the data and '
+        'of the posterior-median model over the same directions (none for grey tables: '
+        'they hold no colour). <i>Adequate</i> says whether the model describes the data '
+        'to within its noise (posterior predictive tests of the residuals); the warnings '
+        'say which answers the data do not support (parameters at a bound, not informed, '
+        'correlated).</p>'), overview_table(measured)]
     summary = {}
     for name, e in measured.items():
         doc = e["results"]
@@ -147,31 +163,42 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
                 continue
             shutil.copyfile(src, check_inside(dest / src.name, root))
             rel = f"{folder}/{name}/{src.name}"
-            figs.append(f'<figure><img src="{html.escape(rel)}" alt="{html.escape(key)}">'
-                        f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+            figs.append(html('<figure><img src="{}" alt="{}"><figcaption>{}</figcaption>'
+                             "</figure>", url(rel), key, caption))
         for src in e["data_files"]:
             shutil.copyfile(src, check_inside(dest / src.name, root))
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
-        body.append(
-            f'<section id="{html.escape(name)}" class="measured"><h2>{html.escape(name)}: '
-            f"{html.escape(e.get('title', ''))}</h2>"
-            f"<p>Table: {html.escape(str(e.get('source', '')))}; {e.get('pairs', '-')} pairs, "
-            f"{e.get('values_used', '-')} values used. Start preset "
-            f"<b>{html.escape(str(e.get('preset', '')))}</b>; ties: "
-            f"{html.escape(', '.join(e.get('ties', [])))}.</p>"
-            f"<p><b>{verdict}</b>: {html.escape(str(e.get('reason', '')))}</p>"
-            f"<p>Residual rms {_f(q.get('rms_residual'), '.4f')} (normalized "
-            f"{_f(q.get('rms_normalized'), '.2f')}); albedo ΔE2000 "
-            f"{_f(e.get('albedo_delta_e2000'), '.2f')}. Data: "
-            f'<a href="{folder}/{html.escape(name)}/results.json">results.json</a>, '
-            f'<a href="{folder}/{html.escape(name)}/results.csv">results.csv</a>.</p>'
-            + _table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows)
-            + "".join(figs) + "</section>")
+        body.append(_section(folder, name, e, verdict, rows, figs, _trust(doc)))
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
+                         "adequate": doc.get("adequate"), "warnings": doc.get("warnings", []),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
                          "parameters": {k: {f: res[k].get(f) for f in
                                             ("median", "lo68", "hi68", "lo95", "hi95", "tau",
                                              "rhat", "ess")} for k in params},
                          "figures": len(figs)}
-    return "".join(body), summary
+    return join(body), summary
+
+
+def _section(folder: str, name: str, e: dict, verdict: str, rows, figs, trust) -> Markup:
+    """One dataset's ``<section>``: what was fitted, the verdicts (``trust``: adequacy and
+    warnings), the fit's quality, its posterior table and figures; every value from
+    measured.json through the template."""
+    q = e.get("quality", {})
+    ties = e.get("ties", [])
+    return html(
+        '<section id="{name}" class="measured"><h2>{name}: {title}</h2>'
+        "<p>Table: {source}; {pairs} pairs, {values} values used. Start preset "
+        "<b>{preset}</b>; ties: {ties}.</p><p><b>{verdict}</b>: {reason}</p>{trust}"
+        "<p>Residual rms {rms} (normalized {rms_n}); albedo ΔE2000 {de}. Data: "
+        '<a href="{data}/results.json">results.json</a>, '
+        '<a href="{data}/results.csv">results.csv</a>.</p>{table}{figs}</section>',
+        name=name, title=e.get("title", ""), source=e.get("source", ""),
+        pairs=e.get("pairs", "-"), values=e.get("values_used", "-"),
+        preset=e.get("preset", ""),
+        ties=", ".join(map(str, ties)) if isinstance(ties, (list, tuple)) else ties,
+        verdict=verdict, reason=e.get("reason", ""), trust=trust, rms=_f(q.get("rms_residual"), ".4f"),
+        rms_n=_f(q.get("rms_normalized"), ".2f"), de=_f(e.get("albedo_delta_e2000"), ".2f"),
+        data=url(f"{folder}/{name}"),
+        table=table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows),
+        figs=join(figs))

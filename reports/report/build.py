@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import html
 import json
 import os
 import shutil
@@ -15,7 +14,7 @@ from analysis.folderlock import output_lock
 from gonio.atomic import file_mode
 from gonio.progress import progress_bar
 from reports.report.folder import MARKER, check_output_dir, swap_into_place, write_file
-from reports.report.markup import nav, now, page, plain_json, swatch
+from reports.report.markup import Markup, html, join, nav, now, page, plain_json, swatch, url
 from reports.report.overview import overview
 from reports.report.page import Page
 from reports.report.sec_renders import check_engine
@@ -93,28 +92,28 @@ def _fabric_page(tmp: Path, name: str, given, sections, q, fit_results, bar) -> 
     return rep
 
 
-def _fabric_html(rep: FabricReport) -> str:
-    return (f"<p>{swatch(rep.fabric)}Fabric <b>{html.escape(rep.name)}</b>.</p>"
-            + "".join(r.html(rep.name) for r in rep.runs))
+def _fabric_html(rep: FabricReport) -> Markup:
+    return (html("<p>{}Fabric <b>{}</b>.</p>", swatch(rep.fabric), rep.name)
+            + join(r.html(rep.name) for r in rep.runs))
 
 
-def _index_fabrics(reports: list[FabricReport]) -> str:
-    return "".join(
-        f'<section class="fabric" id="fabric-{html.escape(r.name)}"><h2>{swatch(r.fabric)}'
-        f'<a href="{html.escape(r.name)}.html">{html.escape(r.name)}</a></h2><ul>'
-        + "".join(f"<li>{html.escape(TITLES[s.name])}: {html.escape(s.status)}</li>"
-                  for s in r.runs)
-        + "</ul></section>" for r in reports)
+def _index_fabrics(reports: list[FabricReport]) -> Markup:
+    return join(
+        html('<section class="fabric" id="fabric-{name}"><h2>{swatch}<a href="{href}">{name}'
+             "</a></h2><ul>{items}</ul></section>", name=r.name, swatch=swatch(r.fabric),
+             href=url(f"{r.name}.html"),
+             items=join(html("<li>{}: {}</li>", TITLES[s.name], s.status) for s in r.runs))
+        for r in reports)
 
 
-def _measured(tmp: Path, title: str, names, measured_fits) -> tuple[str, dict]:
+def _measured(tmp: Path, title: str, names, measured_fits) -> tuple[Markup, dict]:
     """Write measured.html; return the overview's section on it and the summary's entry."""
     mbody, summary = measured_page(tmp, measured_fits)
     write_file(tmp / "measured.html", page(f"{title}: fits to measured data",
                                            nav(names, "measured", True), mbody))
-    return ('<section id="measured-fits"><h2>Fits to measured data</h2>'
-            + overview_table(measured_fits)
-            + '<p>Details: <a href="measured.html">measured.html</a>.</p></section>'), summary
+    return html('<section id="measured-fits"><h2>Fits to measured data</h2>{}'
+                '<p>Details: <a href="measured.html">measured.html</a>.</p></section>',
+                overview_table(measured_fits)), summary
 
 
 def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,

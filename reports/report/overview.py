@@ -3,7 +3,6 @@ reciprocity and sanity compared."""
 
 from __future__ import annotations
 
-import html
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +11,7 @@ from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
 from reports.plot_lobes import plot_lobe_comparison
 from reports.plot_masking import plot_masking_terms
-from reports.report.markup import fmt, swatch, table
+from reports.report.markup import Markup, fmt, html, join, swatch, table, url
 from reports.report.page import Page, new_figure
 from reports.report.sec_energy import EnergyData
 from reports.report.sec_parameters import THREAD_FIELDS, THREAD_HEADER, parameters_of
@@ -23,7 +22,7 @@ from reports.report.sections import FabricReport
 __all__ = ["overview"]
 
 
-def _fabrics(reports: list[FabricReport]) -> str:
+def _fabrics(reports: list[FabricReport]) -> Markup:
     rows = []
     for r in reports:
         params = parameters_of(r.fabric)
@@ -32,31 +31,30 @@ def _fabrics(reports: list[FabricReport]) -> str:
                         [fmt(t[f]) for f in THREAD_FIELDS])
         if not params["threads"]:
             rows.append([r.name, "n/a"] + [""] * len(THREAD_FIELDS))
-    links = "".join(f'<li>{swatch(r.fabric)}<a href="{html.escape(r.name)}.html">'
-                    f'{html.escape(r.name)}</a></li>' for r in reports)
-    return ('<section id="overview"><h2>Fabrics</h2>'
-            + table(["fabric", "thread", *THREAD_HEADER], rows)
-            + f"<ul>{links}</ul></section>")
+    links = join(html('<li>{}<a href="{}">{}</a></li>', swatch(r.fabric), url(f"{r.name}.html"),
+                      r.name) for r in reports)
+    return html('<section id="overview"><h2>Fabrics</h2>{}<ul>{}</ul></section>',
+                table(["fabric", "thread", *THREAD_HEADER], rows), links)
 
 
-def _lobes(p: Page, reports: list[FabricReport]) -> str:
+def _lobes(p: Page, reports: list[FabricReport]) -> Markup:
     fabrics = {r.name: r.fabric for r in reports}
-    out = ['<section id="combined-lobes"><h2>Lobes compared</h2>']
+    out = [Markup('<section id="combined-lobes"><h2>Lobes compared</h2>')]
     for ti, phi in ((30.0, 0.0), (60.0, 0.0), (60.0, 90.0)):
         fig, ax = plot_lobe_comparison(fabrics, ti, phi, resolution=p.q["lobe"])
         out.append(p.figure(fig, f"lobes_ti{ti:g}_phi{phi:g}.png",
                             f"Luminance f_r (1/sr, log) of every fabric, θi = {ti:g}°, plane "
                             f"φ = {phi:g}°; each fabric in its own colour and line style."))
-    return "".join(out) + "</section>"
+    return join(out) + Markup("</section>")
 
 
-def _albedo(p: Page, reports: list[FabricReport]) -> str:
+def _albedo(p: Page, reports: list[FabricReport]) -> Markup:
     have = {r.name: e for r in reports if (e := r.data(EnergyData)) is not None}
-    out = ['<section id="albedo-comparison"><h2>Albedo compared</h2>']
+    out = [Markup('<section id="albedo-comparison"><h2>Albedo compared</h2>')]
     if not have:
-        out.append('<p class="na">Not available: no fabric has energy results (the energy '
-                   'section was not requested).</p></section>')
-        return "".join(out)
+        out.append(Markup('<p class="na">Not available: no fabric has energy results (the '
+                          'energy section was not requested).</p></section>'))
+        return join(out)
     fig, axes = new_figure(2, 1, figsize=(11.0, 4.2))
     styles = series_styles(have)
     for j, (ax, phi) in enumerate(zip(axes, (0.0, 90.0))):
@@ -77,43 +75,42 @@ def _albedo(p: Page, reports: list[FabricReport]) -> str:
             for n, e in have.items()]
     out.append(table(["fabric", "max albedo", "error", "θ (deg)", "φ (deg)", "channel",
                       "exceeds 1"], rows))
-    return "".join(out) + "</section>"
+    return join(out) + Markup("</section>")
 
 
-def _masking(p: Page) -> str:
+def _masking(p: Page) -> Markup:
     fig, ax = plot_masking_terms(resolution=max(p.q["lobe"], 61))
-    return ('<section id="masking"><h2>Shadowing, masking and reweighting terms</h2>'
-            + p.figure(fig, "masking_terms.png", "M(φ) = max(cos φ, 0) (and P(ψ), the same "
-                       "form), the blend u with σu = 20°, and the paired weight M(wi, wo) "
-                       "against φo for φi = 0°, 30°, 60° (MODEL.md).")
-            + "</section>")
+    return html('<section id="masking"><h2>Shadowing, masking and reweighting terms</h2>'
+                "{}</section>",
+                p.figure(fig, "masking_terms.png", "M(φ) = max(cos φ, 0) (and P(ψ), the same "
+                         "form), the blend u with σu = 20°, and the paired weight M(wi, wo) "
+                         "against φo for φi = 0°, 30°, 60° (MODEL.md)."))
 
 
-def _reciprocity(reports: list[FabricReport]) -> str:
+def _reciprocity(reports: list[FabricReport]) -> Markup:
     recs = {r.name: d.maps for r in reports if (d := r.data(ReciprocityData)) is not None}
     if not recs:
-        return ""
-    return ('<section id="reciprocity-comparison"><h2>Reciprocity compared</h2>'
-            + table(["fabric", "warp plane median", "warp plane max", "weft plane median",
-                     "weft plane max"],
-                    [[n, f"{r['warp']['median']:.3g}", f"{r['warp']['max']:.3g}",
-                      f"{r['weft']['median']:.3g}", f"{r['weft']['max']:.3g}"]
-                     for n, r in recs.items()])
-            + "</section>")
+        return Markup("")
+    return html('<section id="reciprocity-comparison"><h2>Reciprocity compared</h2>'
+                "{}</section>",
+                table(["fabric", "warp plane median", "warp plane max", "weft plane median",
+                       "weft plane max"],
+                      [[n, f"{r['warp']['median']:.3g}", f"{r['warp']['max']:.3g}",
+                        f"{r['weft']['median']:.3g}", f"{r['weft']['max']:.3g}"]
+                       for n, r in recs.items()]))
 
 
-def _sanity(reports: list[FabricReport]) -> str:
+def _sanity(reports: list[FabricReport]) -> Markup:
     have = {r.name: d for r in reports if (d := r.data(SanityData)) is not None}
     if not have:
-        return ""
+        return Markup("")
     rows = [[n, len(d.result.checks), sum(c["n"] for c in d.result.checks), d.n_failing,
              "yes" if d.result.ok else "no"] for n, d in have.items()]
-    return ('<section id="sanity-comparison"><h2>Sanity compared</h2>'
-            + table(["fabric", "checks", "evaluations", "failing", "all pass"], rows)
-            + "</section>")
+    return html('<section id="sanity-comparison"><h2>Sanity compared</h2>{}</section>',
+                table(["fabric", "checks", "evaluations", "failing", "all pass"], rows))
 
 
-def overview(root: Path, reports: list[FabricReport], sections, q: dict) -> str:
+def overview(root: Path, reports: list[FabricReport], sections, q: dict) -> Markup:
     """The body of index.html; its figures go to ``root/overview``.
 
     Parameters
@@ -130,5 +127,5 @@ def overview(root: Path, reports: list[FabricReport], sections, q: dict) -> str:
     p = Page(root, "overview", None, q)
     return (_fabrics(reports) + _lobes(p, reports) + _albedo(p, reports) + _masking(p)
             + _reciprocity(reports) + _sanity(reports)
-            + f"<p>Sections per fabric: {html.escape(', '.join(sections))}. "
-            f'Data: <a href="summary.json">summary.json</a>.</p>')
+            + html('<p>Sections per fabric: {}. Data: <a href="summary.json">summary.json</a>.'
+                   "</p>", ", ".join(sections)))

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import html
 import io
 import json
 from pathlib import Path
@@ -16,7 +15,7 @@ from matplotlib.figure import Figure
 
 from reports._plotting import save_figure
 from reports.report.folder import write_file
-from reports.report.markup import plain_json
+from reports.report.markup import Markup, html, plain_json, url
 
 __all__ = ["Page", "new_figure", "replace_3d", "figure_html"]
 
@@ -58,7 +57,7 @@ class Page:
         """``filename``'s link relative to the report folder."""
         return f"{self.folder}/{filename}"
 
-    def figure(self, fig, filename: str, caption: str) -> str:
+    def figure(self, fig, filename: str, caption: str) -> Markup:
         """Save ``fig`` atomically beside the page, close it, return its <figure> HTML (a
         cell of the page's grid; the image links to itself at full size)."""
         try:
@@ -67,12 +66,16 @@ class Page:
             _close(fig)
         return figure_html(self.rel(filename), caption)
 
-    def json(self, filename: str, data) -> str:
+    def json(self, filename: str, data) -> Markup:
         """Write ``data`` as strict JSON beside the page, return a link to it."""
         write_file(self.path(filename), json.dumps(plain_json(data), indent=1))
-        return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
+        return self.link(filename)
 
-    def csv(self, filename: str, header: list[str], rows) -> str:
+    def link(self, filename: str) -> Markup:
+        """A link to ``filename`` in the page's folder, named by the file's name."""
+        return html('<a href="{}">{}</a>', url(self.rel(filename)), filename)
+
+    def csv(self, filename: str, header: list[str], rows) -> Markup:
         """Write ``rows`` as CSV (floats to 9 digits) beside the page, return a link to it."""
         buf = io.StringIO()
         w = csv.writer(buf)
@@ -80,21 +83,20 @@ class Page:
         for row in rows:
             w.writerow([f"{v:.9g}" if isinstance(v, (float, np.floating)) else v for v in row])
         write_file(self.path(filename), buf.getvalue())
-        return f'<a href="{html.escape(self.rel(filename))}">{html.escape(filename)}</a>'
+        return self.link(filename)
 
 
-def figure_html(src: str, caption: str) -> str:
+def figure_html(src: str, caption: str) -> Markup:
     """A ``<figure>`` of the grid: the image, a link to it at full size, its caption.
 
     Examples
     --------
-    >>> figure_html("a/b.png", "x").split("<img")[0]
+    >>> str(figure_html("a/b.png", "x")).split("<img")[0]
     '<figure><a href="a/b.png" title="x (click for full size)">'
     """
-    src, text = html.escape(src), html.escape(caption)
-    return (f'<figure><a href="{src}" title="{text} (click for full size)">'
-            f'<img src="{src}" alt="{text}" loading="lazy"></a>'
-            f'<figcaption>{text}</figcaption></figure>')
+    return html('<figure><a href="{src}" title="{text} (click for full size)">'
+                '<img src="{src}" alt="{text}" loading="lazy"></a>'
+                "<figcaption>{text}</figcaption></figure>", src=url(src), text=caption)
 
 
 def _close(fig):

@@ -11,6 +11,7 @@ import numpy as np
 from analysis import albedo_curve, energy_report
 from reports.colour import line_colour
 from reports.plot_albedo import plot_albedo
+from reports.report.markup import html, join
 from reports.report.page import Page, new_figure
 from reports.report.settings import Section
 
@@ -123,6 +124,6 @@ def section_energy(p: Page) -> Section:
     link = p.csv("albedo.csv", ["theta_deg", "phi_deg", "albedo_r", "albedo_g", "albedo_b",
                                 "error_r", "error_g", "error_b"], rows)
     th, ph, ch = e.max_where
-    out.append(f"<p>Largest albedo {e.max:.4f} ± {e.max_error:.1e} ({ch} channel, "
-               f"θ = {th:g}°, φ = {ph:g}°): it {_verdict(e)}. Data: {link}</p>")
-    return Section("".join(out), e)
+    out.append(html("<p>Largest albedo {:.4f} ± {:.1e} ({} channel, θ = {:g}°, φ = {:g}°): "
+                    "it {}. Data: {}</p>", e.max, e.max_error, ch, th, ph, _verdict(e), link))
+    return Section(join(out), e)

@@ -12,6 +12,7 @@ from reports.plot_lobes import plane_directions, plot_lobe_planes
 from reports.plot_masking import plot_masking_lobes
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)
+from reports.report.markup import Markup, html, join
 from reports.report.page import Page, new_figure, replace_3d
 from reports.report.settings import Section, Unavailable
 
@@ -40,7 +41,7 @@ def can_unmask(fab) -> bool:
     return True
 
 
-def _lobes_csv(p: Page) -> str:
+def _lobes_csv(p: Page) -> Markup:
     """f_r (1/sr) per channel and luminance in every plane and incidence, as lobes.csv."""
     theta_o = np.linspace(-90.0, 90.0, p.q["lobe"])
     cols, header = [theta_o], ["theta_o_deg"]
@@ -74,7 +75,7 @@ def section_lobes(p: Page) -> Section:
     out.append(p.figure(fig, "lobes_rgb.png", "f_r per channel (red, green, blue curves), "
                         "linear, θi = 30° (solid) and 60° (dashed)."))
     link = _lobes_csv(p)
-    return Section("".join(out) + f"<p>Data (f_r in 1/sr, signed θo in degrees): {link}</p>")
+    return Section(join(out) + html("<p>Data (f_r in 1/sr, signed θo in degrees): {}</p>", link))
 
 
 def section_slices(p: Page) -> Section:
@@ -92,10 +93,10 @@ def section_slices(p: Page) -> Section:
     out.append(p.figure(fig, "slice_image.png", "Luminance f_r (1/sr, log) over θh × θd at "
                         "φd = 90°, with the half vector in the warp plane (φh = 0) and the weft "
                         "plane (φh = 90°)."))
-    return Section("".join(out))
+    return Section(join(out))
 
 
-def _colour_and_lobe3d(p: Page) -> str:
+def _colour_and_lobe3d(p: Page) -> Markup:
     """The sRGB colour of f_r(wo) at θi = 45° beside the 3-D lobe."""
     img = hemisphere_image(p.fabric, 45.0, 0.0, p.q["hemi"])
     peak = float(np.nanmax(luminance(img))) if np.any(np.isfinite(img)) else 0.0
@@ -124,7 +125,7 @@ def section_hemisphere(p: Page) -> Section:
                     "black: more than four decades below the peak; grey: f_r = 0 (where the "
                     "colour bar says so).")]
     out.append(_colour_and_lobe3d(p))
-    return Section("".join(out))
+    return Section(join(out))
 
 
 def section_masking(p: Page) -> Section:
@@ -152,6 +153,6 @@ def section_masking(p: Page) -> Section:
         fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=FONT["small"],
                    frameon=False)
         out.append(p.figure(fig, stem, caption))
-    out.append('<p>The terms M, P and u themselves are drawn on the <a href="index.html#masking">'
-               'overview page</a>.</p>')
-    return Section("".join(out))
+    out.append(Markup('<p>The terms M, P and u themselves are drawn on the <a href='
+                      '"index.html#masking">overview page</a>.</p>'))
+    return Section(join(out))

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 from typing import Any
 
 from analysis.fit.results import read_results
-from reports.report.markup import fmt, table
+from reports.report.markup import fmt, html, table
 from reports.report.page import Page
 from reports.report.settings import Section, Unavailable
 
@@ -45,5 +44,5 @@ def section_fit(p: Page) -> Section:
     rows = [[k] + [fmt(v.get(f)) for f in _COLUMNS] for k, v in data["parameters"].items()]
     return Section(table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat",
                           "ESS"], rows)
-                   + f"<p>Converged: {html.escape(fmt(data.get('converged')))}</p>",
+                   + html("<p>Converged: {}</p>", fmt(data.get("converged"))),
                    FitData(data))

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 from typing import Any
 
 from brdf import schema
-from reports.report.markup import fmt, plain_json, table
+from reports.report.markup import fmt, html, plain_json, table
 from reports.report.page import Page
 from reports.report.settings import Section
 from reports.standard import STANDARD_GEOMETRIES, standard_values
@@ -52,7 +51,7 @@ def section_parameters(p: Page) -> Section:
     params = parameters_of(p.fabric)
     link = p.json("parameters.json", params)
     if not params["threads"]:
-        return Section(f"<p>This BRDF exposes no threads.</p><p>Data: {link}</p>",
+        return Section(html("<p>This BRDF exposes no threads.</p><p>Data: {}</p>", link),
                        ParametersData(params, None))
     rows = [[f"T{j + 1}"] + [fmt(t[f]) for f in THREAD_FIELDS]
             for j, t in enumerate(params["threads"])]
@@ -61,6 +60,7 @@ def section_parameters(p: Page) -> Section:
     std = table(["geometry", "θi, φi (deg)", "θo, φo (deg)", "f_r R", "f_r G", "f_r B (1/sr)"],
                 [[g[0], f"{g[1]:g}, {g[2]:g}", f"{g[3]:g}, {g[4]:g}"]
                  + [f"{v:.5g}" for v in values[g[0]]] for g in STANDARD_GEOMETRIES])
-    return Section(f"{table(['thread', *THREAD_HEADER], rows)}<p>Options: {html.escape(opts)}</p>"
-                   f"<h3>f_r at standard geometries</h3>{std}<p>Data: {link}</p>",
+    return Section(html("{}<p>Options: {}</p><h3>f_r at standard geometries</h3>{}"
+                        "<p>Data: {}</p>", table(["thread", *THREAD_HEADER], rows), opts, std,
+                        link),
                    ParametersData(params, values))

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 from typing import Any
 
 import numpy as np
 
 from analysis import reciprocity
 from reports.plot_reciprocity import plot_reciprocity_map, reciprocity_map
-from reports.report.markup import fmt, plain_json, table
+from reports.report.markup import Markup, fmt, html, join, plain_json, table
 from reports.report.page import Page, new_figure
 from reports.report.settings import Section
 
@@ -44,7 +43,7 @@ class ReciprocityData:
                 "reciprocity": self.stats}
 
 
-def _maps(p: Page) -> tuple[dict, str]:
+def _maps(p: Page) -> tuple[dict, Markup]:
     maps = {}
     fig, axes = new_figure(2, 1, figsize=(10.0, 4.0))
     for ax, (pi, po, label) in zip(axes, MAP_PLANES):
@@ -64,7 +63,8 @@ def section_reciprocity(p: Page) -> Section:
     rows = [[k, f"{v['median']:.3g}", f"{v['max']:.3g}"] for k, v in maps.items()]
     res = reciprocity(p.fabric)
     stats = {k: plain_json(getattr(res, k)) for k in _STATS}
-    out = [fig, table(["plane", "median error", "max error"], rows), f"<p>Data: {link}</p>",
-           "<p>Over random pairs (analysis.reciprocity): "
-           + html.escape(", ".join(f"{k} {fmt(v)}" for k, v in stats.items())) + "</p>"]
-    return Section("".join(out), ReciprocityData(maps, stats))
+    out = [fig, table(["plane", "median error", "max error"], rows),
+           html("<p>Data: {}</p>", link),
+           html("<p>Over random pairs (analysis.reciprocity): {}</p>",
+                ", ".join(f"{k} {fmt(v)}" for k, v in stats.items()))]
+    return Section(join(out), ReciprocityData(maps, stats))

@@ -24,6 +24,7 @@ from reports.colour import luminance, to_srgb
 from reports.mitsuba_render import render_mitsuba
 from reports.render import render
 from reports.report.folder import write_file
+from reports.report.markup import join
 from reports.report.page import Page, figure_html
 from reports.report.sec_figures import can_unmask
 from reports.report.settings import Section
@@ -144,4 +145,4 @@ def section_renders(p: Page) -> Section:
                        "width": width, "height": height,
                        "spp": spp, "exposure": exposure,
                        "mean_luminance": float(luminance(img).mean())}
-    return Section("".join(out), RendersData(ref, stats))
+    return Section(join(out), RendersData(ref, stats))

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 from typing import Any
 
 import brdf
 from analysis import SanityResult, sanity_scan
-from reports.report.markup import table
+from reports.report.markup import Markup, html, join, table
 from reports.report.page import Page
 from reports.report.settings import Section
 
@@ -70,7 +69,7 @@ class SanityData:
                            "n_failing": self.n_failing}}
 
 
-def _matrix(checks: list) -> str:
+def _matrix(checks: list) -> Markup:
     """Parameter sets (rows) by direction sets (columns): "ok" or what failed."""
     dirs = list(dict.fromkeys(c["directions"] for c in checks if c["directions"] is not None))
     rows: dict[str, list] = {}
@@ -92,12 +91,11 @@ def section_sanity(p: Page) -> Section:
     n_eval = sum(c["n"] for c in res.checks)
     verdict = ("every check passes" if res.ok else
                f"{data.n_failing} of {len(res.checks)} checks find a violation")
-    legend = "".join(f"<li><b>{html.escape(k)}</b>: {html.escape(v)}</li>"
-                     for k, v in DIRECTION_SETS.items())
-    return Section(
-        f"<p>f_r evaluated {n_eval} times on {len(res.checks)} (parameter set, direction set) "
-        f"checks built for the edges of the domain (analysis.sanity_scan, as "
-        f"<code>microcyl sanity</code>): a NaN, infinite or negative value, a RuntimeWarning, "
-        f"or a non-zero value below the horizon is a violation. Result: "
-        f"<b>{html.escape(verdict)}</b>.</p>{_matrix(res.checks)}"
-        f"<p>Direction sets:</p><ul>{legend}</ul><p>Data: {link}</p>", data)
+    legend = join(html("<li><b>{}</b>: {}</li>", k, v) for k, v in DIRECTION_SETS.items())
+    return Section(html(
+        "<p>f_r evaluated {} times on {} (parameter set, direction set) "
+        "checks built for the edges of the domain (analysis.sanity_scan, as "
+        "<code>microcyl sanity</code>): a NaN, infinite or negative value, a RuntimeWarning, "
+        "or a non-zero value below the horizon is a violation. Result: "
+        "<b>{}</b>.</p>{}<p>Direction sets:</p><ul>{}</ul><p>Data: {}</p>",
+        n_eval, len(res.checks), verdict, _matrix(res.checks), legend, link), data)

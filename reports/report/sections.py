@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 import time
 from typing import Any, Callable, TypeVar
 
-from reports.report.markup import not_available
+from reports.report.markup import Markup, html, not_available
 from reports.report.page import Page
 from reports.report.sec_energy import section_energy
 from reports.report.sec_figures import (section_hemisphere, section_lobes, section_masking,
@@ -42,11 +41,11 @@ class SectionRun:
     seconds: float
     section: Section
 
-    def html(self, fabric_name: str) -> str:
+    def html(self, fabric_name: str) -> Markup:
         """The section's ``<section>`` element on the fabric's page."""
-        return (f'<section id="{self.name}" class="report-section" data-fabric='
-                f'"{html.escape(fabric_name)}"><h2>{html.escape(TITLES[self.name])}</h2>'
-                f"{self.section.html}</section>")
+        return html('<section id="{}" class="report-section" data-fabric="{}"><h2>{}</h2>'
+                    "{}</section>", self.name, fabric_name, TITLES[self.name],
+                    self.section.html)
 
 
 @dataclasses.dataclass

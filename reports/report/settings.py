@@ -8,6 +8,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from reports.safehtml import Markup, text
+
 __all__ = ["SECTIONS", "TITLES", "QUALITIES", "Section", "SectionData", "Unavailable"]
 
 #: Per-fabric sections in page order.
@@ -62,11 +64,19 @@ class SectionData(Protocol):
 class Section:
     """What a section builder returns: its HTML fragment and its data (None: figures only).
 
+    ``html`` is Markup (:mod:`reports.safehtml`); a plain ``str`` is taken as text and
+    escaped, so a section can never put unescaped text on its page.
+
     Examples
     --------
-    >>> Section("<p>hi</p>").data is None
+    >>> Section(Markup("<p>hi</p>")).data is None
     True
+    >>> Section("<p>hi</p>").html
+    Markup('&lt;p&gt;hi&lt;/p&gt;')
     """
 
-    html: str
+    html: Markup
     data: SectionData | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "html", text(self.html))

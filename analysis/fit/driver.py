@@ -26,7 +26,8 @@ from analysis.fit.sampler import FitSampler
 from analysis.likelihood import Likelihood
 from analysis.params import INTERNAL_LIMIT, ParamSpec
 
-__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time", "estimate_fit_time"]
+__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time", "estimate_fit_time",
+           "with_nuisance"]
 
 #: A fit that may take this many seconds or more says so before it starts (``notify``).
 ESTIMATE_MIN_S = 10.0
@@ -105,7 +106,7 @@ class FitOptions:
                 **({"extra": dict(extra)} if extra else {})}
 
 
-def _with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
+def with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
     """``spec`` plus ``log_noise`` when the table has no sigma and ``scale`` for relative
     data, unless already free."""
     extra = []
@@ -287,7 +288,7 @@ def _checked(table, spec: ParamSpec, model, opts: FitOptions):
     """The checks before any work: (likelihood, spec with its nuisance parameters, resolved
     options, log-posterior), or the ValueError of the first that fails."""
     lik = Likelihood(table, kind=opts.likelihood, nu=opts.nu)
-    spec = _with_nuisance(spec, lik)
+    spec = with_nuisance(spec, lik)
     _check_points(lik, spec.ndim)
     opts = opts.resolve(spec.ndim)
     _check_memory(opts, spec.ndim, lik.n_used)

@@ -294,8 +294,10 @@ def plot_table_models(table, models, theta_i_deg, phi_deg=0.0, *, light_deg=None
     if legend:
         legend_outside(ax, "right")
     what = "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
-    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, light at φi = "
-                          f"{pts['light'] % 360:g}°, {what}", fontsize=FONT["title"])
+    where = ("at the normal" if pts["theta_i"] <= tol_deg
+             else f"at φi = {pts['light'] % 360:g}°")
+    ax.set_title(title or f"θi = {float(theta_i_deg):g}°, light {where}, {what}",
+                 fontsize=FONT["title"])
     return finish(fig, ax, filename)
 
 

@@ -130,9 +130,12 @@ def format_information(report, ties, table_name) -> str:
         lines.append("confounded (|correlation| > 0.95): none")
     not_told = [n for n in report.names if report.verdict(n) == "not informed"]
     if not_told:
-        lines.append("not informed (fix them at the preset's values): " + ", ".join(not_told))
+        lines.append("not informed with every candidate free: " + ", ".join(not_told))
+    left = [n for n in report.names if n not in report.suggested]
     if report.suggested:
         tie = ("" if not ties else " --tie " + ",".join(f"{t}={s}" for t, s in ties.items()))
+        lines.append("with " + (f"{', '.join(left)} fixed at the start, " if left else "")
+                     + "these are each informed and no two confounded:")
         lines.append(f"suggested: --free {','.join(report.suggested)}{tie}")
     else:
         lines.append("suggested: none of the candidates is informed by this table")

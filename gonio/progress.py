@@ -38,7 +38,8 @@ def progress_line(text: str, stream=None) -> None:
     print(text, file=stream, flush=True)
 
 
-def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = True, initial: int = 0):
+def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = True,
+                 initial: int = 0):
     """A tqdm bar (``tqdm.auto``: a widget in notebooks) on stderr that vanishes when closed.
 
     Parameters

@@ -57,7 +57,8 @@ def plane_points(table, phi_deg=0.0, tol_deg=2.0):
 
 def plane_lights(table, phi_deg=0.0, tol_deg=2.0) -> np.ndarray:
     """The light's azimuth (degrees: ``phi_deg`` or ``phi_deg + 180``, the latter for a
-    light within the tolerance of the pole) of each row :func:`plane_points` returns, in its order."""
+    light within the tolerance of the pole) of each row :func:`plane_points` returns, in
+    its order."""
     _, _, _, flip = _plane_rows(table, phi_deg, tol_deg)
     return np.where(flip, float(phi_deg), float(phi_deg) + 180.0)
 

@@ -64,8 +64,12 @@ def check_line(diag, total: int, max_steps: int, converged: bool = False) -> str
     >>> from analysis.fit.convergence import Diagnosis
     >>> d = Diagnosis(step=100, burn=20, chains=None, log_prob=None, taus=None,
     ...               tau=np.array([4.0, 10.0]), rhat=np.array([1.2, 1.1]))
-    >>> check_line(d, 650, 20000)
-    'emcee: step 100, tau 10.0 steps (largest), N/tau 8.0 (smallest), expected total 650 of at most 20000 steps'
+    >>> for part in check_line(d, 650, 20000).split(", "):
+    ...     print(part)
+    emcee: step 100
+    tau 10.0 steps (largest)
+    N/tau 8.0 (smallest)
+    expected total 650 of at most 20000 steps
     """
     end = ("converged" if converged
            else f"expected total {total} of at most {max_steps} steps")

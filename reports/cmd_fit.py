@@ -14,10 +14,11 @@ import sys
 from pathlib import Path
 
 import brdf
-from analysis.fit import fit_fabric, fit_spec
+from analysis.fit import FabricModel, fit_fabric, fit_spec
+from analysis.fit.fisher import suggest_free
 from reports import cliutil
 
-__all__ = ["register", "run", "read_table", "format_summary"]
+__all__ = ["register", "run", "read_table", "format_summary", "format_information"]
 
 
 def read_table(path, sample=None):
@@ -41,7 +42,14 @@ def register(sub):
                    help="CUReT sample number (for abrdf.dat)")
     p.add_argument("--no-plots", action="store_true", help="skip the plots")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--suggest", action="store_true",
+                   help="sample nothing: print what the table can tell of each candidate "
+                        "parameter (the --free given, else the default set plus albedo1 and "
+                        "albedo2 on an RGB table) from the Fisher information at the start "
+                        "point (Cramér-Rao sd against the prior's, confounded pairs) and a "
+                        "suggested --free list, then exit; -o is not needed")
+    p.add_argument("-o", "--output", default=None, metavar="DIR",
+                   help="output folder (required unless --suggest)")
     cliutil.add_fabric_options(p)
     p.set_defaults(func=run)
 
@@ -56,6 +64,10 @@ def run(args) -> int:
         raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
                          f"{', '.join(brdf.PRESETS)}")
     fit_kw = cliutil.fit_kwargs(args)
+    if args.suggest:
+        return _suggest(args, fit_kw)
+    if args.output is None:
+        raise ValueError("-o/--output DIR is required (unless --suggest)")
     fab = cliutil.fabric_from_args(args.fabric, args)
     spec = _spec_from_args(args, fab)
     cliutil.reader_options(args.table, sample=args.sample)
@@ -77,6 +89,57 @@ def run(args) -> int:
           f"{q['albedo_delta_e2000']:.2f}" + ("" if args.no_plots else f"; plots in {out}"))
     print(f"results: {out / 'results.json'}")
     return 0
+
+
+def _suggest(args, fit_kw) -> int:
+    """``--suggest``: the Fisher information of the table at the start, printed; no
+    sampling, nothing written."""
+    fab = cliutil.fabric_from_args(args.fabric, args)
+    ties = cliutil.split_ties(args.tie)
+    if args.free is not None or args.spec is not None:
+        _spec_from_args(args, fab)              # a bad --free, --tie or --spec: before reading
+    cliutil.reader_options(args.table, sample=args.sample)
+    table = read_table(args.table, args.sample)
+    report, kept = suggest_free(table, fab, FabricModel(fab, table.wi, table.wo), args.free,
+                                ties, args.spec, likelihood=fit_kw["likelihood"],
+                                nu=fit_kw["nu"])
+    print(format_information(report, kept, args.table))
+    return 0
+
+
+def format_information(report, ties, table_name) -> str:
+    """``--suggest``'s text: a row per candidate (start, Cramér-Rao sd, prior sd, ratio,
+    verdict), the confounded pairs and the suggested ``--free`` (with its ties)."""
+    lines = [f"what {table_name} can tell of each candidate parameter: Fisher information "
+             f"at the start ({report.n_used} values)",
+             f"{'parameter':12s} {'start':>10s} {'+- (unit)':>16s} {'CR sd':>9s} "
+             f"{'prior sd':>9s} {'ratio':>7s}  verdict"]
+    for n, sd, prior, nat in zip(report.names, report.cr_sd, report.prior_sd,
+                                 report.natural_sd):
+        unit = report.units[n]
+        lines.append(f"{n:12s} {report.start[n]:10.4g} {nat:9.2g} {unit[:6]:6s} {sd:9.3g} "
+                     f"{prior:9.3g} {sd / prior:7.3f}  {report.verdict(n)}")
+    lines.append(f"(CR sd and prior sd in the fit's internal logit coordinates, where the flat "
+                 f"prior has sd {report.prior_sd[0]:.3g}; +- the CR sd in the parameter's "
+                 f"unit at the start; informed: ratio < {report.informed_ratio:g}, well "
+                 f"informed: < {0.2 * report.informed_ratio:g})")
+    if report.confounded:
+        lines.append("confounded (|correlation| > 0.95): " + "; ".join(
+            f"{a} ~ {b} ({c:+.3f})" for a, b, c in report.confounded))
+    else:
+        lines.append("confounded (|correlation| > 0.95): none")
+    not_told = [n for n in report.names if report.verdict(n) == "not informed"]
+    if not_told:
+        lines.append("not informed with every candidate free: " + ", ".join(not_told))
+    left = [n for n in report.names if n not in report.suggested]
+    if report.suggested:
+        tie = ("" if not ties else " --tie " + ",".join(f"{t}={s}" for t, s in ties.items()))
+        lines.append("with " + (f"{', '.join(left)} fixed at the start, " if left else "")
+                     + "these are each informed and no two confounded:")
+        lines.append(f"suggested: --free {','.join(report.suggested)}{tie}")
+    else:
+        lines.append("suggested: none of the candidates is informed by this table")
+    return "\n".join(lines)
 
 
 def format_summary(result) -> str:

@@ -10,6 +10,7 @@ FILE (PNG at ``--dpi``, PDF and SVG as vector graphics).
 from __future__ import annotations
 
 import argparse
+import csv
 import math
 from pathlib import Path
 
@@ -20,7 +21,8 @@ import gonio
 from analysis.fit.medians import median_fabric
 from reports import cliutil
 
-__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes"]
+__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes",
+           "write_table_data", "DATA_COLUMNS"]
 
 #: The views of ``microcyl plot``.
 VIEWS = ("lobes", "slices", "hemisphere", "masking", "albedo", "reciprocity", "table")
@@ -62,6 +64,11 @@ def register(sub):
     p.add_argument("--preset", action="append", default=None, metavar="NAME",
                    help="table: a preset drawn as a model (repeatable); also the fitted preset "
                         "when the fit does not say")
+    p.add_argument("--data", default=None, metavar="FILE.csv",
+                   help="table: also write what was drawn at the measured points, one row "
+                        "per point and curve: curve,theta_i,phi_i,theta_o,phi_o,f_r (curve "
+                        "'measured' or a model's label; angles in degrees, f_r in 1/sr; each "
+                        "model at every measured point's own angles)")
     cliutil.add_fabric_options(p)
     p.set_defaults(func=run_plot)
 
@@ -132,6 +139,12 @@ def _check(args) -> None:
     if args.view == "table" and not (args.sources[1:] or args.preset or args.fit):
         raise ValueError("table: give a preset (SOURCE or --preset) or --fit DIR to compare "
                          "the table with")
+    if args.data is not None and args.view != "table":
+        raise ValueError("--data applies to the 'table' view only")
+    if args.data is not None and Path(args.data).suffix.lower() != ".csv":
+        raise ValueError(f"--data must end in .csv; got {args.data!r}")
+    if args.data is not None and not Path(args.data).resolve().parent.is_dir():
+        raise ValueError(f"--data: no such folder {str(Path(args.data).resolve().parent)!r}")
     if args.view == "table" and args.channel == "rgb":
         raise ValueError("--channel for 'table' must be luminance, r, g or b; got 'rgb'")
     out = Path(args.output).resolve().parent
@@ -196,7 +209,11 @@ def run_plot(args):
             models[label] = model
         table = gonio.read(args.sources[0])
         _check_incidences(table, args)
-        fig = plot_views.table_view(table, models, **opts)
+        fig = plot_views.table_view(table, models, source=Path(args.sources[0]).name, **opts)
+        if args.data is not None:
+            rows = plot_views.table_view_data(table, models, channel=args.channel,
+                                              theta_i=args.theta_i, planes=args.plane)
+            write_table_data(args.data, rows)
     else:
         fabrics = {n: cliutil.fabric_from_args(n, args) for n in args.sources}
         fig = plot_views.VIEW_FUNCTIONS[args.view](fabrics, **opts)
@@ -204,4 +221,20 @@ def run_plot(args):
         fig.set_size_inches(*args.size)
     path = save_figure(fig, args.output, dpi=args.dpi)
     print(f"wrote {path} ({args.view}, {len(fig.axes)} axes)")
+    if args.data is not None:
+        print(f"wrote {args.data} (the points drawn)")
     return 0
+
+
+#: The columns of ``plot table --data``.
+DATA_COLUMNS = ("curve", "theta_i", "phi_i", "theta_o", "phi_o", "f_r")
+
+
+def write_table_data(path, rows) -> None:
+    """Write the rows of :func:`reports.plot_views.table_view_data` as CSV (a header of
+    :data:`DATA_COLUMNS`; numbers with 17 significant digits), atomically."""
+    with gonio.atomic_write(Path(path), "w") as fh:
+        out = csv.writer(fh, lineterminator="\n")
+        out.writerow(DATA_COLUMNS)
+        for name, *numbers in rows:
+            out.writerow([name, *(repr(float(v)) for v in numbers)])

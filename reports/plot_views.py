@@ -12,13 +12,15 @@ comparison of its own (masking).
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
 from analysis import albedo_curve
 from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
-from reports.plot_fit import plane_incidences, plot_table_models
+from reports.plot_fit import plot_table_models, table_panels, table_points
 from reports.plot_hemisphere import plot_hemisphere
 from reports.plot_lobes import lobe_peak, plane_name, plot_lobe_comparison, plot_lobe_planes
 from reports.plot_masking import plot_masking_lobes
@@ -27,7 +29,7 @@ from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slic
                                  plot_slice_theta_o)
 
 __all__ = ["VIEW_FUNCTIONS", "lobes_view", "slices_view", "hemisphere_view", "masking_view",
-           "albedo_view", "reciprocity_view", "table_view"]
+           "albedo_view", "reciprocity_view", "table_view", "table_view_data", "MAX_WIDTH_IN"]
 
 
 def _grid(nrows, ncols, panel, polar=False):
@@ -188,23 +190,71 @@ def reciprocity_view(fabrics, *, channel=None, theta_i=None, planes=None, scale=
     return fig
 
 
+#: The widest a figure of ``plot`` grows by itself: panels wrap into rows beyond this many
+#: inches (3,000 pixels at the default 200 dpi, room left for the margins).
+MAX_WIDTH_IN = 14.0
+_TABLE_PANEL = (4.4, 3.4)
+
+
 def table_view(table, models, *, channel=None, theta_i=None, planes=None, scale="log",
-               resolution=None):
-    """A measured table against models: a panel per incidence (default: the table's first
-    three in the plane), the first plane, points with error bars and a curve per model."""
+               resolution=None, source=None):
+    """A measured table against models in the first plane: a panel per incidence (default:
+    the table's first three in the plane) and per side the light was measured from, each
+    model evaluated with the light there (:func:`reports.plot_fit.table_points`); points
+    with error bars and a curve per model. Panels wrap into rows so that the figure is at
+    most :data:`MAX_WIDTH_IN` wide. ``source`` names the table in the title (default its
+    ``meta["source"]`` when that is a short text)."""
     phi = (planes or (0.0,))[0]
-    theta_i = theta_i or tuple(plane_incidences(table, phi)[:3])
-    fig, axes = _grid(1, len(theta_i), (4.4, 3.4))
-    for ax, ti in zip(axes[0], theta_i):
-        plot_table_models(table, models, ti, phi, quantity=channel or "luminance",
+    quantity = channel or "luminance"
+    panels = table_panels(table, theta_i, phi)
+    ncols = max(1, min(len(panels), int(MAX_WIDTH_IN // _TABLE_PANEL[0])))
+    nrows = -(-len(panels) // ncols)
+    fig = Figure(figsize=(_TABLE_PANEL[0] * ncols, _TABLE_PANEL[1] * nrows),
+                 layout="constrained")
+    axes = [fig.add_subplot(nrows, ncols, k + 1) for k in range(len(panels))]
+    for k, (ax, (ti, light)) in enumerate(zip(axes, panels)):
+        plot_table_models(table, models, ti, phi, light_deg=light, quantity=quantity,
                           log=scale == "log", resolution=resolution or 181, legend=False,
                           ax=ax)
-    for ax in axes[0][1:]:
-        ax.set_ylabel("")
-    _figure_legend(fig, axes[0][0])
-    source = table.meta.get("source", "table") if hasattr(table, "meta") else "table"
-    fig.suptitle(f"{source}: measured and models", fontsize=FONT["title"])
+        if k % ncols:
+            ax.set_ylabel("")
+        if k < len(panels) - ncols:
+            ax.set_xlabel("")
+    _figure_legend(fig, axes[0])
+    what = "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
+    fig.suptitle("\n".join(textwrap.wrap(
+        f"{_table_name(table, source)}: measured f_r ({what}) and models in the plane "
+        f"φ = {phi:g}° ({plane_name(phi)})", width=int(13 * _TABLE_PANEL[0] * ncols))),
+        fontsize=FONT["title"])
     return fig
+
+
+def _table_name(table, source) -> str:
+    """What the title calls a table: ``source``, else its meta's source when that is a
+    short text, else "table"."""
+    if source:
+        return str(source)
+    meta = getattr(table, "meta", None) or {}
+    name = meta.get("source") if isinstance(meta, dict) else None
+    return name if isinstance(name, str) and 0 < len(name) <= 60 else "table"
+
+
+def table_view_data(table, models, *, channel=None, theta_i=None, planes=None) -> list:
+    """What :func:`table_view` draws at the measured points, one row per point and curve:
+    ``(curve, theta_i, phi_i, theta_o, phi_o, f_r)``, curve ``"measured"`` or a model's
+    label, the angles of the measured point in degrees (phi in (-180, 180]), f_r in 1/sr
+    (the measured value, or the model's at that point's own directions)."""
+    phi = (planes or (0.0,))[0]
+    quantity = channel or "luminance"
+    angles = np.degrees(np.asarray(table.angles))
+    out = []
+    for ti, light in table_panels(table, theta_i, phi):
+        pts = table_points(table, models, ti, phi, light, quantity=quantity)
+        curves = {"measured": pts["measured"], **pts["models"]}
+        for name, values in curves.items():
+            for row, value in zip(pts["rows"], values):
+                out.append((name, *angles[row].tolist(), float(value)))
+    return out
 
 
 #: View name -> figure builder (``table`` takes a table and models instead of fabrics).

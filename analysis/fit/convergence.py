@@ -15,7 +15,7 @@ import numpy as np
 
 from analysis import diagnostics
 
-__all__ = ["Criteria", "Diagnosis", "diagnose", "finite_min", "finite_max"]
+__all__ = ["Criteria", "Diagnosis", "diagnose", "finite_min", "finite_max", "expected_steps"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -112,3 +112,40 @@ def diagnose(chains, burn_fraction: float, last_refit: int = 0) -> Diagnosis:
     taus = np.stack([diagnostics.autocorr_time(c) for c in x])
     return Diagnosis(step=n, burn=burn, chains=x, log_prob=lp, taus=taus,
                      tau=taus.mean(axis=0), rhat=diagnostics.split_rhat(x))
+
+
+def expected_steps(diag: Diagnosis, c: Criteria, check_every: int, max_steps: int,
+                   converged: bool = False) -> int:
+    """The step count at which the fit is expected to converge, from the tau of this check
+    (this check's step when ``converged``):
+    the first check (a multiple of ``check_every``) where N - burn > ``min_ratio`` x the
+    largest tau, the burn-in being ``burn_fraction`` N or, while it is longer, this check's;
+    at least the next check when this one has not converged; at most ``max_steps``
+    (also without a finite tau).
+
+    Notes
+    -----
+    N/tau > r needs N (1 - b) > r tau with a burn-in of b N, or N > burn + r tau with the
+    refit's burn-in, so N = max(r tau / (1 - b), burn + r tau); tau is re-estimated at each
+    check (it usually grows as the chains lengthen), and so is this total.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> d = Diagnosis(step=100, burn=20, chains=None, log_prob=None, taus=None,
+    ...               tau=np.array([4.0, 10.0]), rhat=np.array([1.2, 1.1]))
+    >>> expected_steps(d, Criteria(), 50, 20000)      # 50 x 10 / 0.8 = 625 -> 650
+    650
+    >>> expected_steps(d, Criteria(), 50, 600)
+    600
+    """
+    if converged:
+        return int(diag.step)
+    tau = np.asarray(diag.tau, dtype=np.float64)
+    if tau.size == 0 or not np.all(np.isfinite(tau)):
+        return int(max_steps)
+    need = c.min_ratio * float(tau.max())
+    n = max(need / (1.0 - c.burn_fraction), diag.burn + need, diag.step + 1)
+    every = max(int(check_every), 1)
+    n = int((np.floor(n / every) + 1) * every)     # the rule is N/tau > r, strictly
+    return int(min(max(n, diag.step), max_steps))

@@ -7,7 +7,6 @@ the EM fits) fights them for the cores.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import os
 import time
@@ -21,13 +20,14 @@ from analysis.fit.checkpoint import FitFolder, table_digest
 from analysis.fit.convergence import Criteria
 from analysis.fit.optimize import optimize_start
 from analysis.fit.posterior import LogPosterior
+from analysis.fit.progress import fit_progress
 from analysis.fit.results import FitResult, summarize
 from analysis.fit.sampler import FitSampler
 from analysis.likelihood import Likelihood
 from analysis.params import INTERNAL_LIMIT, ParamSpec
-from gonio.progress import progress_bar
 
-__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time", "estimate_fit_time"]
+__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time", "estimate_fit_time",
+           "with_nuisance"]
 
 #: A fit that may take this many seconds or more says so before it starts (``notify``).
 ESTIMATE_MIN_S = 10.0
@@ -106,7 +106,7 @@ class FitOptions:
                 **({"extra": dict(extra)} if extra else {})}
 
 
-def _with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
+def with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
     """``spec`` plus ``log_noise`` when the table has no sigma and ``scale`` for relative
     data, unless already free."""
     extra = []
@@ -129,27 +129,6 @@ def _check_points(lik: Likelihood, ndim: int):
             f"table has {lik.n_used} valid values for {ndim} free parameters (need more than "
             f"{ndim}); masked: {c['invalid_value']} NaN/negative, {c['below_horizon']} below "
             f"the horizon, {c['bad_sigma']} with bad sigma, {c['zero_value']} zero")
-
-
-@contextlib.contextmanager
-def _progress(progress, total: int, initial: int):
-    """(tick, postfix) callables for the sampler: a tqdm bar when ``progress`` is True, the
-    caller's ``progress(steps)`` when it is callable, nothing when False."""
-    if callable(progress):
-        yield progress, None
-        return
-    if not progress:
-        yield None, None
-        return
-    bar = progress_bar(total, desc="emcee", unit="step", initial=initial)
-
-    def tick(steps):
-        bar.n = steps
-        bar.refresh()
-    try:
-        yield tick, (lambda d: bar.set_postfix(d, refresh=True))
-    finally:
-        bar.close()
 
 
 def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian",
@@ -197,7 +176,10 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     time_limit : float, optional
         Seconds after which sampling stops (checked at each convergence check).
     progress : bool or callable
-        A tqdm bar (True), none (False), or ``progress(steps)`` called about every 0.25 s.
+        A tqdm bar (True) whose total is the step count expected at convergence, re-estimated
+        at each check (one line a check instead on a pipe or a file:
+        :mod:`analysis.fit.progress`), none (False), or ``progress(steps)`` called about
+        every 0.25 s.
     config_extra : mapping, optional
         Also recorded in (and matched against) the stored configuration.
     notify : callable, optional
@@ -306,7 +288,7 @@ def _checked(table, spec: ParamSpec, model, opts: FitOptions):
     """The checks before any work: (likelihood, spec with its nuisance parameters, resolved
     options, log-posterior), or the ValueError of the first that fails."""
     lik = Likelihood(table, kind=opts.likelihood, nu=opts.nu)
-    spec = _with_nuisance(spec, lik)
+    spec = with_nuisance(spec, lik)
     _check_points(lik, spec.ndim)
     opts = opts.resolve(spec.ndim)
     _check_memory(opts, spec.ndim, lik.n_used)
@@ -366,7 +348,7 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
         if start is None and folder is not None:    # only a start the walkers could use
             folder.write_start(config, best, best_logp, cov)
         resumed = sampler.steps if ckpt is not None else 0
-        with _progress(progress, opts.max_steps, sampler.steps) as (tick, postfix):
+        with fit_progress(progress, opts, sampler.steps) as (tick, postfix):
             out = sampler.run(folder, tick, t0, postfix)
     return _result(spec, lik, logpost, opts, sampler, out, best, best_logp,
                    {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt,

@@ -177,7 +177,8 @@ class FitSampler:
     def run(self, folder, tick=None, t0: float | None = None, postfix=None) -> Outcome:
         """Sample until converged, ``max_steps`` or ``time_limit`` (seconds since ``t0``).
 
-        ``tick(steps)`` reports progress; ``postfix(dict)`` the figures of each check.
+        ``tick(steps)`` reports progress; ``postfix(figures, diagnosis, converged)`` each
+        check (its figures as texts, its :class:`Diagnosis` and verdict).
         """
         o, c = self.opts, self.opts.criteria
         t0 = time.perf_counter() if t0 is None else t0
@@ -199,7 +200,8 @@ class FitSampler:
                 self.tau_prev = diag.tau
                 if postfix is not None:
                     postfix({"min N/tau": f"{finite_min(diag.ratio):.1f}",
-                             "dtau": f"{dtau:.3f}", "max R-hat": f"{finite_max(diag.rhat):.3f}"})
+                             "dtau": f"{dtau:.3f}", "max R-hat": f"{finite_max(diag.rhat):.3f}"},
+                            diag, ok)
                 if ok:
                     break
                 if diag.step >= o.max_steps:

@@ -45,6 +45,7 @@ import numpy as np
 
 from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
+from analysis.folderlock import output_lock
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write
@@ -256,15 +257,15 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     out = Path(out_dir)
     jobs = [_job(n, root, rgl_step, plots, {"seed": seed, "max_steps": max_steps,
                                             "time_limit": time_limit}) for n in names]
-    summary = run_batch(jobs, out, workers=workers, scheduler=scheduler, progress=progress,
-                        echo=echo)
-    spath = out / SUMMARY_FILE
-    # read just before writing: another fit-measured run may have added its datasets
-    doc = _read_summary(spath)
-    for n in names:
-        doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
-    with atomic_write(spath, "w") as fh:
-        fh.write(json.dumps(doc, indent=2) + "\n")
+    with output_lock(out, "fit-measured"):       # the batch's lock, measured.json included
+        summary = run_batch(jobs, out, workers=workers, scheduler=scheduler,
+                            progress=progress, echo=echo, locked=True)
+        spath = out / SUMMARY_FILE
+        doc = _read_summary(spath)               # the datasets of earlier runs, kept
+        for n in names:
+            doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
+        with atomic_write(spath, "w") as fh:
+            fh.write(json.dumps(doc, indent=2) + "\n")
     return doc
 
 

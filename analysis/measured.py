@@ -247,6 +247,9 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
         An unknown dataset name (before any fit).
     FileNotFoundError
         A missing data file (before any fit).
+    analysis.folderlock.FolderBusy
+        Another run holds ``out_dir``'s lock; this run holds it from the first fit to the
+        last write of ``measured.json``.
     """
     names = list(names) if names else list(MEASURED)
     bad = [n for n in names if n not in MEASURED]

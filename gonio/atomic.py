@@ -106,9 +106,10 @@ def atomic_write(path, mode: str = "wb"):
 
     The temporary file (``.microcyl-NAME.XXXXXXXXXXXX.tmp``, :func:`open_temporary`: created
     new, never through a link) lives in the destination folder (so ``os.replace`` is atomic
-    on the same file system; a link at ``path`` is replaced, its target untouched), is flushed and fsync-ed, then renamed over ``path``. If the body raises
-    anything, KeyboardInterrupt included, the temporary file is removed and ``path`` is left
-    as it was.
+    on the same file system; a link at ``path`` is replaced, its target untouched), is
+    flushed and fsync-ed, then renamed over ``path``. If the body raises anything,
+    KeyboardInterrupt included, the temporary file is removed and ``path`` is left as it
+    was.
 
     Parameters
     ----------

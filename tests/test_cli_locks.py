@@ -2,9 +2,11 @@
 report and convert as a user runs them (subprocesses, real folders), against folders that hold
 another kind of output, a planted symbolic link, or a user's own ``.tmp`` files."""
 
+import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -99,6 +101,11 @@ def test_a_report_refuses_a_report_folder_a_fit_was_written_into(tmp_path):
     with pytest.raises(ValueError, match=r"holds a fit \(checkpoint.h5, fit_config.json\)"):
         small_report(out)
     assert listing(out) == before
+    marker = json.loads((out / ".microcyl-report").read_text())    # a marker that lies
+    marker["files"] += ["fit_config.json", "checkpoint.h5"]
+    (out / ".microcyl-report").write_text(json.dumps(marker))
+    with pytest.raises(ValueError, match=r"holds a fit \(checkpoint.h5, fit_config.json\)"):
+        small_report(out)
 
 
 def test_a_report_refuses_a_batch_and_unknown_files(tmp_path):
@@ -200,3 +207,38 @@ def test_a_fit_keeps_a_users_tmp_files_and_removes_its_own(table_csv, tmp_path):
     assert (out / ".checkpoint.h5.abcdefgh.tmp").exists()
     assert not stale.exists()
     assert (out / "results.json").is_file()
+
+
+def test_the_batch_page_takes_the_batch_folders_lock(tmp_path):
+    out = tmp_path / "B"
+    with output_lock(out, "batch"):
+        r = microcyl("report", "--batch", out)
+    assert r.returncode == 1
+    assert last_line(r) == (f"microcyl report: error: another batch is running in {out} "
+                            f"(pid {os.getpid()}); wait for it to end or use another output")
+    assert list(out.iterdir()) == []
+
+
+def test_a_killed_report_leaves_what_the_next_report_removes(tmp_path):
+    """SIGKILL mid-build: the lock and the build folder stay behind; the next report takes
+    the lock over, removes the build folder and writes its own."""
+    out = tmp_path / "R"
+    proc = subprocess.Popen([sys.executable, "-m", "reports", "report", "--fabric", "velvet",
+                             "--quality", "fast", "--render-engine", "builtin", "--quiet",
+                             "-o", str(out)], cwd=REPO, env=ENV, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and not any(
+                p.name.startswith(".microcyl-R.") and any(p.iterdir())
+                for p in tmp_path.iterdir() if p.is_dir()):
+            time.sleep(0.05)
+    finally:
+        proc.kill()
+        proc.wait(timeout=60)
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert len(left) == 2 and left[0].startswith(".microcyl-R.") and left[1] == "R"
+    assert [p.name for p in out.iterdir()] == [".microcyl.lock"]
+    small_report(out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["R"]
+    assert (out / "a.html").is_file() and not (out / ".microcyl.lock").exists()

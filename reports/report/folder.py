@@ -83,11 +83,11 @@ def _listed(folder: Path) -> set | None:
         fd = os.open(folder / MARKER, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError:
         return None
-    with os.fdopen(fd, "rb") as fh:
-        data = fh.read(_MARKER_MAX + 1)
     try:
+        with os.fdopen(fd, "rb") as fh:
+            data = fh.read(_MARKER_MAX + 1)
         doc = json.loads(data) if len(data) <= _MARKER_MAX else None
-    except ValueError:
+    except (OSError, ValueError, RecursionError):
         return None
     files = doc.get("files") if isinstance(doc, dict) and doc.get("kind") == _KIND else None
     if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
@@ -138,7 +138,8 @@ def _unlisted(out: Path) -> set:
     if listed is None:
         return files & (set(FIT_FILES) | set(BATCH_FILES))
     kept = {p.as_posix() for f in listed for p in Path(f).parents}
-    extra = (files - listed) | (folders - kept)
+    never = set(FIT_FILES) | (set(BATCH_FILES) - {"summary.json"})     # no report writes these
+    extra = (files - listed) | (folders - kept) | (files & never)
     return {f for f in extra if not any(p.as_posix() in extra for p in Path(f).parents)}
 
 

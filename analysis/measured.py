@@ -45,6 +45,7 @@ import numpy as np
 
 from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
+from analysis.folderlock import output_lock
 from analysis.measuredjson import load_measured_json
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
@@ -248,6 +249,9 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
         A ``measured.json`` in ``out_dir`` that is out of its schema (before any fit).
     FileNotFoundError
         A missing data file (before any fit).
+    analysis.folderlock.FolderBusy
+        Another run holds ``out_dir``'s lock; this run holds it from the first fit to the
+        last write of ``measured.json``.
     """
     names = list(names) if names else list(MEASURED)
     bad = [n for n in names if n not in MEASURED]
@@ -260,15 +264,16 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     _read_summary(spath)                # a damaged summary is refused before any fit
     jobs = [_job(n, root, rgl_step, plots, {"seed": seed, "max_steps": max_steps,
                                             "time_limit": time_limit}) for n in names]
-    summary = run_batch(jobs, out, workers=workers, scheduler=scheduler, progress=progress,
-                        echo=echo)
-    # read just before writing: another fit-measured run may have added its datasets
-    doc = _read_summary(spath)
-    for n in names:
-        doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
-    with atomic_write(spath, "w") as fh:
-        # strict JSON: a non-finite number is written null (the schema refuses NaN)
-        fh.write(json.dumps(plain(doc, nonfinite="null"), indent=2) + "\n")
+    with output_lock(out, "fit-measured"):       # the batch's lock, measured.json included
+        summary = run_batch(jobs, out, workers=workers, scheduler=scheduler,
+                            progress=progress, echo=echo, locked=True)
+        # read just before writing: another fit-measured run may have added its datasets
+        doc = _read_summary(spath)
+        for n in names:
+            doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
+        with atomic_write(spath, "w") as fh:
+            # strict JSON: a non-finite number is written null (the schema refuses NaN)
+            fh.write(json.dumps(plain(doc, nonfinite="null"), indent=2) + "\n")
     return doc
 
 

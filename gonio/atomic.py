@@ -1,14 +1,96 @@
-"""Atomic file writes: a file is either written whole or not at all."""
+"""Atomic file writes: a file is either written whole or not at all; and the names of
+microcyl's temporaries.
+
+Every temporary file or folder microcyl writes is named ``.microcyl-NAME.XXXXXXXXXXXX.tmp``
+(NAME the file or folder it becomes, X a random hex digit) and created new: ``O_CREAT |
+O_EXCL | O_NOFOLLOW`` for a file, ``mkdir`` for a folder, so an existing file or a planted
+link is never opened. :func:`is_temporary` recognises those names and no others: a clean-up
+of a killed run's leftovers removes nothing a user named ``.notes.tmp``.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import hashlib
 import os
-import tempfile
+import re
+import secrets
 from pathlib import Path
 
-__all__ = ["atomic_write", "file_mode"]
+__all__ = ["atomic_write", "file_mode", "TEMP_PREFIX", "temporary_stem", "is_temporary",
+           "open_temporary", "make_temporary_folder"]
+
+#: The start of the name of every temporary file or folder microcyl writes.
+TEMP_PREFIX = ".microcyl-"
+_TOKEN = r"[0-9a-f]{12}"          # secrets.token_hex(6)
+_STEM_MAX = 100                   # bytes of NAME kept whole in a temporary's name
+_ANY_TEMP = re.compile(re.escape(TEMP_PREFIX) + r".+\." + _TOKEN + r"\.tmp", re.S)
+
+
+def temporary_stem(name: str) -> str:
+    """The NAME part of the temporaries of ``name``: ``name`` itself, or when longer than 100
+    bytes its start and a digest of the whole (a file name holds at most 255 bytes).
+
+    Examples
+    --------
+    >>> temporary_stem("checkpoint.h5")
+    'checkpoint.h5'
+    >>> len(temporary_stem("x" * 250).encode())
+    77
+    """
+    if len(name.encode("utf-8", "surrogateescape")) <= _STEM_MAX:
+        return name
+    digest = hashlib.sha256(name.encode("utf-8", "surrogateescape")).hexdigest()[:16]
+    return name[:60] + "-" + digest
+
+
+def _temporary_name(name: str) -> str:
+    return f"{TEMP_PREFIX}{temporary_stem(name)}.{secrets.token_hex(6)}.tmp"
+
+
+def is_temporary(entry: str, name: str | None = None) -> bool:
+    """Whether ``entry`` (a file name) is a microcyl temporary: of the output ``name``, or of
+    any output when ``name`` is None.
+
+    Examples
+    --------
+    >>> is_temporary(".microcyl-results.json.0123456789ab.tmp", "results.json")
+    True
+    >>> is_temporary(".microcyl-rep.v2.0123456789ab.tmp", "rep")
+    False
+    >>> is_temporary(".notes.tmp"), is_temporary(".mydata.tmp")
+    (False, False)
+    """
+    if name is None:
+        return _ANY_TEMP.fullmatch(entry) is not None
+    return re.fullmatch(re.escape(f"{TEMP_PREFIX}{temporary_stem(name)}.") + _TOKEN
+                        + r"\.tmp", entry) is not None
+
+
+def open_temporary(folder, name: str) -> tuple[int, Path]:
+    """Create a new temporary file for ``name`` in ``folder``: a descriptor open for reading
+    and writing (mode 0600) and its path. Opened ``O_CREAT | O_EXCL | O_NOFOLLOW``: never an
+    existing file, never through a link."""
+    flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | getattr(os, "O_CLOEXEC", 0)
+    while True:
+        tmp = Path(folder) / _temporary_name(name)
+        try:
+            return os.open(tmp, flags, 0o600), tmp
+        except FileExistsError:
+            continue
+
+
+def make_temporary_folder(folder, name: str) -> Path:
+    """Create a new, empty temporary folder for ``name`` in ``folder`` (mode 0700); its
+    path. ``mkdir`` creates it new: never an existing folder or a link."""
+    while True:
+        tmp = Path(folder) / _temporary_name(name)
+        try:
+            os.mkdir(tmp, 0o700)
+            return tmp
+        except FileExistsError:
+            continue
 
 
 def file_mode(base: int = 0o666) -> int:
@@ -22,10 +104,12 @@ def file_mode(base: int = 0o666) -> int:
 def atomic_write(path, mode: str = "wb"):
     """Open a temporary file beside ``path``; on success move it onto ``path``.
 
-    The temporary file lives in the destination folder (so ``os.replace`` is atomic on the
-    same file system), is flushed and fsync-ed, then renamed over ``path``. If the body raises
-    anything, KeyboardInterrupt included, the temporary file is removed and ``path`` is left
-    as it was.
+    The temporary file (``.microcyl-NAME.XXXXXXXXXXXX.tmp``, :func:`open_temporary`: created
+    new, never through a link) lives in the destination folder (so ``os.replace`` is atomic
+    on the same file system; a link at ``path`` is replaced, its target untouched), is
+    flushed and fsync-ed, then renamed over ``path``. If the body raises anything,
+    KeyboardInterrupt included, the temporary file is removed and ``path`` is left as it
+    was.
 
     Parameters
     ----------
@@ -69,10 +153,9 @@ def atomic_write(path, mode: str = "wb"):
         raise IsADirectoryError(errno.EISDIR, "Is a directory, not a file to write", str(path))
     folder = path.parent if str(path.parent) else Path(".")
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+        fd, tmp = open_temporary(folder, path.name)
     except OSError as exc:
         raise _named(exc, path) from None
-    tmp = Path(tmp)
     in_body = False
     try:
         kwargs = {} if mode == "wb" else {"encoding": "utf-8", "newline": "\n"}

@@ -165,7 +165,7 @@ def run(args) -> int:
                     progress=not args.no_progress)
     if "name" not in table.meta["source"]:
         table.meta["source"]["name"] = args.fabric
-    with output_lock(out, "measure", inside=False):   # removes a killed run's .OUT.*.tmp
+    with output_lock(out, "measure", inside=False):   # removes a killed run's temporaries
         gonio.write(table, out)
     bad = int((~table.valid).any(axis=1).sum())
     note = f", {bad} with a negative or missing value" if bad else ""

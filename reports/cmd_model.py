@@ -10,6 +10,7 @@ import numpy as np
 
 import brdf
 import gonio
+from analysis.folderlock import output_lock
 from reports import cliutil
 from reports.report_batch import write_batch_page
 from reports.standard import STANDARD_GEOMETRIES, standard_values
@@ -128,7 +129,8 @@ def run_report(args):
     from reports.report import build_report
 
     if args.batch is not None:
-        log.info(f"wrote the batch page {write_batch_page(args.batch)}")
+        with output_lock(Path(args.batch), "report"):    # the batch folder's own lock
+            log.info(f"wrote the batch page {write_batch_page(args.batch)}")
         return 0
     names = tuple(dict.fromkeys(args.fabric)) if args.fabric else brdf.PRESETS
     fits = {}

@@ -56,7 +56,7 @@ def run_convert(args):
         options["param"] = args.alta_param
     table = _read(args, args.input)
     with output_lock(Path(args.output), "convert", inside=False):  # removes a killed run's
-        gonio.write(table, args.output, **options)                 # .OUT.*.tmp
+        gonio.write(table, args.output, **options)                 # .microcyl-OUT.*.tmp
     log.info(f"wrote {len(table)} rows to {args.output}")
     return 0
 

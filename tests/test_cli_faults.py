@@ -6,7 +6,6 @@ import os
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import pytest
 import brdf
 import gonio
 from analysis.folderlock import FolderBusy, output_lock
+from gonio.atomic import make_temporary_folder
 from _signals import default_sigint
 
 REPO = Path(__file__).resolve().parents[1]
@@ -93,7 +93,7 @@ def test_a_lock_of_a_killed_process_is_taken_over(tmp_path):
     subprocess.run([sys.executable, "-c", code, str(tmp_path)], env=ENV, cwd=REPO)
     assert (tmp_path / ".microcyl.lock").exists()    # left behind, its holder dead
     with output_lock(tmp_path, "fit"):
-        assert (tmp_path / ".microcyl.lock").read_text().strip() == str(os.getpid())
+        assert (tmp_path / ".microcyl.lock").read_text() == f"{os.getpid()} fit\n"
         with pytest.raises(FolderBusy, match=f"another fit is running in {tmp_path} "
                                              rf"\(pid {os.getpid()}\)"):
             with output_lock(tmp_path, "fit"):
@@ -131,7 +131,8 @@ def _killed_mid_write(path):
             "with atomic_write(sys.argv[1]) as f:\n"
             "    f.write(b'half'); f.flush(); os.kill(os.getpid(), signal.SIGKILL)\n")
     subprocess.run([sys.executable, "-c", code, str(path)], env=ENV, cwd=REPO)
-    return [p for p in path.parent.iterdir() if p.name.endswith(".tmp")]
+    return [p for p in path.parent.iterdir() if p.name.startswith(f".microcyl-{path.name}.")
+            and p.name.endswith(".tmp")]
 
 
 def test_convert_removes_what_a_killed_convert_left(table_csv, tmp_path):
@@ -149,14 +150,14 @@ def test_a_fit_folder_and_a_report_folder_lose_their_stale_temporaries(tmp_path)
     fit_dir.mkdir()
     stale = _killed_mid_write(fit_dir / "checkpoint.h5")
     assert stale
-    report_tmp = Path(tempfile.mkdtemp(prefix=".report.tmp-", dir=tmp_path))
+    report_tmp = make_temporary_folder(tmp_path, "report")  # a killed build's
     (report_tmp / "index.html").write_text("half")
     with output_lock(fit_dir, "fit"):
         assert not any(p.exists() for p in stale)
-    with output_lock(tmp_path / "report", "report", inside=False):
+    with output_lock(tmp_path / "report", "report"):
         assert not report_tmp.exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["fit"]
-    assert list(fit_dir.iterdir()) == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fit", "report"]
+    assert list(fit_dir.iterdir()) == [] and list((tmp_path / "report").iterdir()) == []
 
 
 def test_a_second_report_into_the_same_folder_is_refused(tmp_path):
@@ -164,7 +165,7 @@ def test_a_second_report_into_the_same_folder_is_refused(tmp_path):
     the first's pid; the first writes its report whole."""
     out = tmp_path / "rep"
     args = ("report", "--fabric", "velvet", "--quality", "fast", "-o", out)
-    lock = tmp_path / ".rep.lock"
+    lock = out / ".microcyl.lock"
     first = _cli(*args)
     try:
         assert _wait_for(lambda: lock.exists() and lock.read_text().strip(), timeout=120)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import gonio
-from gonio.atomic import atomic_write
+from gonio.atomic import atomic_write, is_temporary
 from tests._gonio_helpers import random_table
 
 
@@ -91,3 +91,23 @@ def test_errors_name_the_users_path_not_the_temporary_file(tmp_path, monkeypatch
             open(tmp_path / "other.bin", "rb")
     assert info.value.filename == str(tmp_path / "other.bin")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.csv"]
+
+
+def test_temporaries_are_microcyl_named_and_never_open_an_existing_name(tmp_path, monkeypatch):
+    """A planted link at the next temporary's name is skipped, not written through; the
+    temporary that is used carries the microcyl prefix and is gone after the rename."""
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    tokens = iter(["0123456789ab", "0123456789ab", "ba9876543210"])
+    monkeypatch.setattr("gonio.atomic.secrets.token_hex", lambda n: next(tokens))
+    planted = tmp_path / ".microcyl-t.bin.0123456789ab.tmp"
+    planted.symlink_to(victim)
+    seen = []
+    with atomic_write(tmp_path / "t.bin") as f:
+        seen.append(f.tmp_path.name)
+        f.write(b"data")
+    assert seen == [".microcyl-t.bin.ba9876543210.tmp"]
+    assert victim.read_text() == "precious" and planted.is_symlink()
+    assert (tmp_path / "t.bin").read_bytes() == b"data"
+    assert is_temporary(seen[0], "t.bin") and is_temporary(seen[0])
+    assert not is_temporary(".t.bin.abcdefgh.tmp") and not is_temporary(".notes.tmp")

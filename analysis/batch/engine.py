@@ -160,7 +160,8 @@ def estimate_batch(todo: list[BatchJob], workers: int | None = None,
 def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
               echo: Callable[[str], None] | None = print,
-              notify: Callable[[str], None] | None = None) -> BatchSummary:
+              notify: Callable[[str], None] | None = None,
+              locked: bool = False) -> BatchSummary:
     """Fit every job on Dask into ``out_dir/<name>``, keeping the summaries up to date.
 
     Jobs that converged before with the same inputs (:meth:`BatchSummary.done`) are not
@@ -182,6 +183,9 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
         Receives one line per table as it ends (None: silent).
     notify : callable, optional
         Receives the batch's estimated time (:func:`estimate_batch`) before it starts.
+    locked : bool
+        The caller holds ``out_dir``'s lock already (:func:`analysis.fit_measured`, which
+        writes measured.json under the same lock); else the batch takes it.
 
     Returns
     -------
@@ -195,7 +199,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
         Duplicate job names (case ignored), a name that is not a safe file name
         (:func:`gonio.safenames.check_component`) or a bad ``workers``.
     FolderBusy
-        Another batch holds ``out_dir``'s lock (:func:`analysis.folderlock.output_lock`).
+        Another run (batch, fit, report) holds ``out_dir``'s lock
+        (:func:`analysis.folderlock.output_lock`).
     """
     names = [j.name for j in jobs]
     for n in names:                     # each names its folder: DIR/<name>
@@ -204,8 +209,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
         raise ValueError("job names must be unique in a batch (case ignored)")
     if workers is not None and workers < 1:
         raise ValueError(f"workers must be >= 1; got {workers}")
-    out = Path(out_dir).resolve()
-    with output_lock(out, "batch"):
+    out = Path(os.path.abspath(out_dir))           # a link there is refused, not followed
+    with contextlib.nullcontext() if locked else output_lock(out, "batch"):
         summary = BatchSummary(out)
         todo = [j for j in jobs if not summary.done(j)]
         line = estimate_batch(todo, workers, scheduler) if notify and todo else None

@@ -61,9 +61,10 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     """Fit ``fabric``'s free parameters to ``table`` and write the results into ``out_dir``.
 
     The fit (:func:`analysis.fit.fit`) checkpoints into ``out_dir`` and resumes there; the
-    folder is locked meanwhile (:func:`analysis.folderlock.output_lock`: a second fit into it
-    is refused, ``another fit is running in DIR (pid N)``), and temporaries a killed fit left
-    in it are removed. Then the
+    folder is locked meanwhile (:func:`analysis.folderlock.output_lock`, the lock a batch or a
+    report there takes too: a second run into it is refused, ``another fit is running in DIR
+    (pid N)``; a folder holding a report is refused), and temporaries a killed fit left in it
+    are removed. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
     colours and their CIEDE2000 difference), the plots drawn when ``plots`` is given, and
     ``results.json`` / ``results.csv`` written, once, atomically.

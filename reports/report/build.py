@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -13,7 +12,8 @@ import brdf
 from analysis.folderlock import output_lock
 from gonio.atomic import file_mode
 from gonio.progress import progress_bar
-from reports.report.folder import MARKER, check_output_dir, swap_into_place, write_file
+from reports.report.folder import (check_output_dir, check_report_folder, make_build_folder,
+                                   swap_into_place, write_file, write_marker)
 from reports.report.markup import Markup, html, join, nav, now, page, plain_json, swatch, url
 from reports.report.overview import overview
 from reports.report.page import Page
@@ -147,7 +147,7 @@ def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,
     if measured_summary is not None:
         doc["measured"] = measured_summary
     write_file(tmp / "summary.json", json.dumps(plain_json(doc), indent=1))
-    write_file(tmp / MARKER, "microcyl report folder: replaced whole by the next run\n")
+    write_marker(tmp)
 
 
 def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True,
@@ -198,9 +198,11 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     -----
     Built in a temporary folder beside ``out_dir`` and renamed into place at the end; a
     failure or interrupt removes the temporary folder and leaves ``out_dir`` as it was. The
-    build holds the lock ``.NAME.lock`` beside ``out_dir`` (a second report into it is
-    refused: ``another report is running in DIR (pid N)``) and first removes the temporary
-    folders a killed build left.
+    build holds ``out_dir``'s lock, the one a fit or a batch there takes
+    (:func:`analysis.folderlock.output_lock`: a second run into it is refused, ``another
+    report is running in DIR (pid N)``), and first removes the temporary folders a killed
+    build left. A folder holding anything but an earlier report (a fit, a batch, other
+    files) is refused, naming what is there (:func:`reports.report.folder.check_report_folder`).
     """
     if quality not in QUALITIES:
         raise ValueError(f"quality must be one of {', '.join(QUALITIES)}; got {quality!r}")
@@ -210,12 +212,9 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     measured_fits = read_measured(measured) if measured is not None else None
     out = check_output_dir(out_dir)
     fits = {str(k): v for k, v in dict(fit_results or {}).items()}
-    with output_lock(out, "report", inside=False):    # removes a killed build's .tmp-*
-        try:
-            tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
-        except OSError as exc:
-            raise OSError(f"output folder {out.parent} is not writable: "
-                          f"{exc.strerror or exc}") from None
+    with output_lock(out, "report"):     # removes a killed build's temporaries
+        check_report_folder(out)         # again, under the lock: nothing written meanwhile
+        tmp = make_build_folder(out)
         try:
             os.chmod(tmp, file_mode(0o777))
             _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress,

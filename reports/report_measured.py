@@ -3,8 +3,9 @@
 One section per dataset: what was fitted (table, start preset, free parameters), the verdict
 on convergence, the posterior table (median, 68% and 95% intervals, tau, R-hat, ESS), how well
 the model explains the data (residual rms in the likelihood's space and in units of the noise,
-CIEDE2000 between measured and predicted albedo colours) and the fit's figures: posterior-
-predictive lobes over the data points, the residual map, the corner and the trace plots.
+CIEDE2000 between measured and predicted albedo colours, the PSIS-LOO elpd and the LOO-PIT
+uniformity test) and the fit's figures: posterior-predictive lobes over the data points, the
+residual map, the LOO-PIT histogram, the corner and the trace plots.
 """
 
 from __future__ import annotations
@@ -24,6 +25,9 @@ PLOTS = {
              "incidence, over the table's points in that plane.",
     "residuals": "Normalized residuals (data minus posterior-median model over the noise "
                  "scale) on the half-vector disk.",
+    "pit": "LOO-PIT: each value's leave-one-out predictive CDF at the measured value (uniform "
+           "when the predictive distributions are right; grey: 99% band of a bin under "
+           "uniformity).",
     "corner": "Posterior marginals and pairs (corner).",
     "traces": "Traces of some walkers of every ensemble (after burn-in).",
 }
@@ -79,17 +83,39 @@ def _table(header, rows) -> str:
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
+def _elpd(loo) -> str:
+    """``elpd ± se`` of a ``loo`` entry of results.json, "-" without one."""
+    if not isinstance(loo, dict) or loo.get("elpd") is None:
+        return "-"
+    return f"{_f(loo.get('elpd'), '.1f')} ± {_f(loo.get('se'), '.1f')}"
+
+
 def overview_table(measured: dict) -> str:
-    """One row per dataset: preset, size, verdict, residuals, colour difference."""
+    """One row per dataset: preset, size, verdict, residuals, colour difference, elpd."""
     rows = []
     for name, e in measured.items():
         q = e.get("quality", {})
         rows.append([name, e.get("preset", "-"), e.get("values_used", "-"),
                      "yes" if e.get("converged") else "NO", e.get("steps", "-"),
                      _f(q.get("rms_residual"), ".3f"), _f(q.get("rms_normalized"), ".2f"),
-                     _f(e.get("albedo_delta_e2000"), ".1f")])
+                     _f(e.get("albedo_delta_e2000"), ".1f"), _elpd(e.get("loo"))])
     return _table(["dataset", "start preset", "values", "converged", "steps",
-                   "residual rms", "normalized rms", "albedo ΔE2000"], rows)
+                   "residual rms", "normalized rms", "albedo ΔE2000", "elpd (PSIS-LOO)"],
+                  rows)
+
+
+def _loo_sentence(doc: dict) -> str:
+    """The PSIS-LOO and LOO-PIT of one fit in a sentence (HTML-escaped), or nothing."""
+    loo = doc.get("loo")
+    if not isinstance(loo, dict):
+        return ""
+    text = (f"PSIS-LOO elpd {_elpd(loo)} (p_loo {_f(loo.get('p_loo'), '.1f')}; Pareto k "
+            f"max {_f(loo.get('pareto_k_max'), '.2f')}, {_f(loo.get('n_high_k'), '.0f')} "
+            f"values above 0.7).")
+    pit = doc.get("quality", {}).get("loo_pit")
+    if isinstance(pit, dict):
+        text += f" LOO-PIT uniformity: Kolmogorov-Smirnov p = {_f(pit.get('ks_pvalue'), '.2g')}."
+    return html.escape(text)
 
 
 def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple[str, dict]:
@@ -109,7 +135,10 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             'the normalized rms is in units of the noise the fit found (near 1 when the model '
             'explains the data to within it). ΔE2000 compares the albedo colours of the data and '
             'of the posterior-median model over the same directions (for grey tables, the grey '
-            'levels).</p>', overview_table(measured)]
+            'levels). The elpd is the expected log predictive density of the table\'s values '
+            'had the fit not seen each (PSIS-LOO; higher is better): it compares fits of one '
+            'table, not datasets, and <code>microcyl compare</code> ranks such fits.</p>',
+            overview_table(measured)]
     summary = {}
     for name, e in measured.items():
         doc = e["results"]
@@ -149,13 +178,14 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             f"<p><b>{verdict}</b>: {html.escape(str(e.get('reason', '')))}</p>"
             f"<p>Residual rms {_f(q.get('rms_residual'), '.4f')} (normalized "
             f"{_f(q.get('rms_normalized'), '.2f')}); albedo ΔE2000 "
-            f"{_f(e.get('albedo_delta_e2000'), '.2f')}. Data: "
+            f"{_f(e.get('albedo_delta_e2000'), '.2f')}. {_loo_sentence(doc)} Data: "
             f'<a href="{folder}/{html.escape(name)}/results.json">results.json</a>, '
             f'<a href="{folder}/{html.escape(name)}/results.csv">results.csv</a>.</p>'
             + _table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows)
             + "".join(figs) + "</section>")
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
+                         "loo": doc.get("loo"),
                          "parameters": {k: {f: res[k].get(f) for f in
                                             ("median", "lo68", "hi68", "lo95", "hi95", "tau",
                                              "rhat", "ess")} for k in params},

@@ -2,9 +2,10 @@ r"""PSIS-LOO of a fit (ArviZ): the expected log predictive density of each value
 had the fit not seen it, its Pareto-k diagnostic, and the LOO-PIT of each value.
 
 One observation is one value the likelihood uses (a channel of a direction pair; a pair of a
-grey table). Over S posterior draws thinned evenly from the fit's chains (at most
-:data:`MAX_DRAWS`; fewer for large tables, so that S x values stays under
-:data:`CELL_BUDGET`), the log-likelihood of each value, log p(y_i | theta_s), is evaluated
+grey table). Over S posterior draws thinned evenly from the fit's chains (:data:`MAX_DRAWS`;
+fewer for tables of more than :data:`CELL_BUDGET` / :data:`MAX_DRAWS` values, down to
+:data:`MIN_DRAWS`, and fewer still when memory is short: 12 bytes a draw and value), the
+log-likelihood of each value, log p(y_i | theta_s), is evaluated
 (:meth:`analysis.fit.posterior.LogPosterior.pointwise`) and carried to the density of the
 table's value f_r by the residual space's Jacobian (:attr:`analysis.likelihood.Likelihood.
 log_jacobian`), so that fits of one table under different ``--likelihood`` compare. Then, as
@@ -40,10 +41,11 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
+from analysis.budget import memory_limit
 from gonio import atomic_write
 
-__all__ = ["Loo", "psis_loo", "psis_pointwise", "thin_draws", "load_loo", "import_arviz",
-           "LOO_FILE", "MAX_DRAWS", "HIGH_K"]
+__all__ = ["Loo", "psis_loo", "psis_pointwise", "thin_draws", "draws_for", "load_loo",
+           "import_arviz", "LOO_FILE", "MAX_DRAWS", "MIN_DRAWS", "CELL_BUDGET", "HIGH_K"]
 
 # ArviZ announces its refactor with a FutureWarning on import, once a day: not ours to show
 warnings.filterwarnings("ignore", message=r"\s*ArviZ is undergoing a major refactor",
@@ -53,10 +55,13 @@ warnings.filterwarnings("ignore", message=r"\s*ArviZ is undergoing a major refac
 LOO_FILE = "loo.npz"
 #: Posterior draws the log-likelihood is evaluated at, at most.
 MAX_DRAWS = 400
-#: ... and at least (unless the chains hold fewer).
-MIN_DRAWS = 100
-#: Draws x values held at once (a float64 log-likelihood and a float32 CDF each): 192 MB.
-CELL_BUDGET = 16_000_000
+#: ... and at least (unless the chains or the memory hold fewer): with fewer, the Pareto k
+#: of each value rests on a tail of fewer than 40 draws (S / 5).
+MIN_DRAWS = 200
+#: Draws x values held at once (a float64 log-likelihood and a float32 CDF each): 288 MB.
+CELL_BUDGET = 24_000_000
+#: Draws at the least, whatever the memory.
+_FLOOR_DRAWS = 50
 #: Pareto k above which a value's elpd is unreliable (Vehtari et al. 2017).
 HIGH_K = 0.7
 #: Values per block of the PSIS (arviz.psislw's temporaries) and of the model evaluation.
@@ -255,6 +260,22 @@ def _logsumexp_rows(x) -> np.ndarray:
     return np.log(np.sum(np.exp(x - m), axis=-1)) + m[..., 0]
 
 
+def draws_for(n_values: int, max_draws: int = MAX_DRAWS) -> int:
+    """The draws :func:`psis_loo` evaluates for a table of ``n_values`` used values: up to
+    ``max_draws``, fewer past :data:`CELL_BUDGET` cells (not under :data:`MIN_DRAWS`), and
+    within half of the memory available (:func:`analysis.budget.memory_limit`; never under 50).
+
+    Examples
+    --------
+    >>> draws_for(1000), draws_for(10**6) >= 50
+    (400, True)
+    """
+    n = max(int(n_values), 1)
+    draws = min(int(max_draws), max(MIN_DRAWS, CELL_BUDGET // n))
+    by_memory = memory_limit()[0] // 2 // (12 * n)
+    return int(max(min(draws, by_memory), min(_FLOOR_DRAWS, int(max_draws))))
+
+
 def psis_loo(result, table_digest: str = "", max_draws: int = MAX_DRAWS) -> Loo:
     """The PSIS-LOO of a :class:`~analysis.fit.results.FitResult` (see the module notes).
 
@@ -273,8 +294,7 @@ def psis_loo(result, table_digest: str = "", max_draws: int = MAX_DRAWS) -> Loo:
     """
     lik = result.logpost.lik
     n = lik.n_used
-    budget = max(MIN_DRAWS, CELL_BUDGET // max(n, 1))
-    theta = thin_draws(result, min(max_draws, budget))
+    theta = thin_draws(result, draws_for(n, max_draws))
     s = theta.shape[0]
     ll = np.empty((s, n))
     cdf = np.empty((s, n), dtype=np.float32)

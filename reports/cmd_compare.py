@@ -28,8 +28,9 @@ def register(sub):
         description="Rank two or more fits of the same table (other presets, variants, free "
                     "sets or likelihoods) by their expected log predictive density under "
                     "leave-one-out cross-validation (PSIS-LOO, stored by `microcyl fit` in "
-                    "DIR/loo.npz), with the difference to the best fit and its standard error. "
-                    "Fits of different tables are refused.")
+                    "DIR/loo.npz), with the difference to the best fit (d_elpd: the best's "
+                    "elpd minus each fit's) and its standard error (d_se, from the paired "
+                    "pointwise values). Fits of different tables are refused.")
     p.add_argument("fits", nargs="+", metavar="DIR", help="output folders of `microcyl fit`")
     p.add_argument("--json", action="store_true",
                    help="print a JSON list, best first, of {fit, elpd, se, d_elpd, d_se}")

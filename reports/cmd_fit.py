@@ -89,7 +89,8 @@ def format_loo(loo: dict, pit: dict | None = None) -> str:
     --------
     >>> print(format_loo({"elpd": 812.34, "se": 20.1, "p_loo": 3.2, "pareto_k_max": 0.41,
     ...                   "n_high_k": 0}, {"ks_pvalue": 0.31, "values": 450}))
-    PSIS-LOO: elpd 812.3 ± 20.1 (p_loo 3.2; Pareto k max 0.41, 0 values above 0.7); LOO-PIT uniformity over 450 values: KS p = 0.31
+    PSIS-LOO: elpd 812.3 ± 20.1 (p_loo 3.2; Pareto k max 0.41, 0 values above 0.7);
+    LOO-PIT uniformity over 450 values: KS p = 0.31
     """
     line = (f"PSIS-LOO: elpd {loo['elpd']:.1f} ± {loo['se']:.1f} (p_loo {loo['p_loo']:.1f}; "
             f"Pareto k max {loo['pareto_k_max']:.2f}, {loo['n_high_k']} values above {HIGH_K})")

@@ -11,6 +11,10 @@ and the log-likelihood is sum over valid (point, channel) of
 (the noise term only when ``log_noise`` is a parameter; it is the whole of s when the table has
 no sigma).
 
+:meth:`Likelihood.pointwise` gives the same terms one used value at a time (and, on request,
+each value's predictive CDF), which PSIS-LOO and LOO-PIT need (:mod:`analysis.fit.loo`);
+:attr:`Likelihood.log_jacobian` carries a density of the residual space back to f_r.
+
 ``"relative"``: Gaussian on log(f_r) residuals (errors proportional to the value), with
 sigma_y = sigma / f_r; points with f_r = 0 are masked as well.
 
@@ -30,6 +34,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import stats
 from scipy.special import gammaln
 
 from brdf.scratch import Scratch
@@ -89,6 +94,10 @@ class Likelihood:
         ``bad_sigma``, ``below_horizon``, ``zero_value`` (relative only).
     has_sigma : bool
         Whether the table gave sigma (otherwise a ``log_noise`` parameter is needed).
+    log_jacobian : ndarray (n_used,)
+        log |dy/df| at each used value (y the residual space, f the table's value): added to
+        a log density of y it gives the log density of f (per 1/sr), the same space for every
+        ``kind``.
 
     Raises
     ------
@@ -152,9 +161,13 @@ class Likelihood:
         if kind == "relative":
             self.y = np.log(f)
             sy = None if sigma is None else sigma[self.pt, self.ch] / f
+            with np.errstate(divide="ignore"):
+                self.log_jacobian = -np.log(f)
         else:
             self.y = np.log1p(f * c)
             sy = None if sigma is None else c * sigma[self.pt, self.ch] / (1.0 + f * c)
+            with np.errstate(divide="ignore"):
+                self.log_jacobian = np.log(c) - np.log1p(f * c)
         self.sigma_y2 = None if sy is None else sy * sy
         if self.sigma_y2 is not None:
             self._inv_s2 = 1.0 / self.sigma_y2
@@ -241,6 +254,50 @@ class Likelihood:
             s2 = self.sigma_y2 + np.exp(2.0 * np.asarray(log_noise, dtype=np.float64))[..., None]
             out = -0.5 * (r * r / s2 + np.log(s2) + _LOG_2PI).sum(axis=-1)
         return np.where(np.isfinite(out), out, -np.inf)
+
+    def pointwise(self, model_values, scale=None, log_noise=None, cdf: bool = False):
+        """The log-likelihood of each used value, and optionally its predictive CDF.
+
+        Parameters
+        ----------
+        model_values, scale, log_noise
+            As :meth:`__call__`.
+        cdf : bool
+            Also return the CDF of each value's predictive distribution (given the
+            parameters) at the measured value: the probability integral transform.
+
+        Returns
+        -------
+        ndarray, shape (B..., n_used)
+            The terms whose sum is :meth:`__call__` (-inf where the prediction is not finite),
+            in the residual space (add :attr:`log_jacobian` for the density of f_r); and,
+            with ``cdf``, an array of the same shape in [0, 1].
+
+        Raises
+        ------
+        ValueError
+            When the table has no sigma and no ``log_noise`` is given.
+        """
+        if log_noise is None and self.sigma_y2 is None:
+            raise ValueError("the table has no sigma: a log_noise parameter is needed")
+        m = self._at(model_values)
+        r = self.y - self._mu(m, scale, out=None)
+        if log_noise is None:
+            s2 = np.broadcast_to(self.sigma_y2, r.shape)
+        else:
+            noise2 = np.exp(2.0 * np.asarray(log_noise, dtype=np.float64))[..., None]
+            s2 = noise2 + (0.0 if self.sigma_y2 is None else self.sigma_y2)
+        z = r / np.sqrt(s2)
+        if self.kind == "student-t":
+            ll = (self._t_const - 0.5 * (self.nu + 1) * np.log1p(z * z / self.nu)
+                  - 0.5 * np.log(s2))
+        else:
+            ll = -0.5 * (z * z + np.log(s2) + _LOG_2PI)
+        ll = np.where(np.isfinite(ll), ll, -np.inf)
+        if not cdf:
+            return ll
+        dist = stats.t(self.nu) if self.kind == "student-t" else stats.norm
+        return ll, dist.cdf(z)
 
     def _student_t(self, r, log_noise):
         if log_noise is None:

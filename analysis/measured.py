@@ -297,13 +297,13 @@ def _entry(n: str, table, row: dict, out: Path) -> dict:
              "results": f"{n}/results.json"}
     if row["status"] == "error":
         return dict(entry, error=row["error"], values_used=0, quality={},
-                    albedo_delta_e2000=None)
+                    albedo_delta_e2000=None, loo=None)
     res = read_results(out / n / "results.json")
     quality = res.get("quality", {})
     return dict(entry, converged=bool(res["converged"]), reason=res["reason"],
                 values_used=res.get("fit", {}).get("points", {}).get("used"),
                 free=list(res["parameters"]), quality=quality,
-                albedo_delta_e2000=quality.get("albedo_delta_e2000"))
+                albedo_delta_e2000=quality.get("albedo_delta_e2000"), loo=res.get("loo"))
 
 
 def _read_summary(path: Path) -> dict:

@@ -26,6 +26,7 @@ COMMAND_MODULES = (
     "reports.cmd_render",
     "reports.cmd_physics",
     "reports.cmd_fit",
+    "reports.cmd_compare",
     "reports.cmd_measured",
     "reports.cmd_batch",
     "reports.cmd_plot",

@@ -16,9 +16,11 @@ from pathlib import Path
 import brdf
 from analysis.fit import FabricModel, fit_fabric, fit_spec
 from analysis.fit.fisher import suggest_free
+from analysis.fit.loo import HIGH_K
 from reports import cliutil
 
-__all__ = ["register", "run", "read_table", "format_summary", "format_information"]
+__all__ = ["register", "run", "read_table", "format_summary", "format_information",
+           "format_loo"]
 
 
 def read_table(path, sample=None):
@@ -87,6 +89,8 @@ def run(args) -> int:
           f"likelihood's space, {q['rms_normalized']:.2f} in units of the noise")
     print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "
           f"{q['albedo_delta_e2000']:.2f}" + ("" if args.no_plots else f"; plots in {out}"))
+    if result.loo is not None:
+        print(format_loo(result.loo.summary(), q.get("loo_pit")))
     print(f"results: {out / 'results.json'}")
     return 0
 
@@ -140,6 +144,24 @@ def format_information(report, ties, table_name) -> str:
     else:
         lines.append("suggested: none of the candidates is informed by this table")
     return "\n".join(lines)
+
+
+def format_loo(loo: dict, pit: dict | None = None) -> str:
+    """One line: the PSIS-LOO of a fit (``results.json``'s ``loo``) and its LOO-PIT test.
+
+    Examples
+    --------
+    >>> print(format_loo({"elpd": 812.34, "se": 20.1, "p_loo": 3.2, "pareto_k_max": 0.41,
+    ...                   "n_high_k": 0}, {"ks_pvalue": 0.31, "values": 450}))
+    PSIS-LOO: elpd 812.3 ± 20.1 (p_loo 3.2; Pareto k max 0.41, 0 values above 0.7);
+    LOO-PIT uniformity over 450 values: KS p = 0.31
+    """
+    line = (f"PSIS-LOO: elpd {loo['elpd']:.1f} ± {loo['se']:.1f} (p_loo {loo['p_loo']:.1f}; "
+            f"Pareto k max {loo['pareto_k_max']:.2f}, {loo['n_high_k']} values above {HIGH_K})")
+    if pit:
+        line += (f"; LOO-PIT uniformity over {pit['values']} values: KS p = "
+                 f"{pit['ks_pvalue']:.2g}")
+    return line
 
 
 def format_summary(result) -> str:

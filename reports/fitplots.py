@@ -17,6 +17,7 @@ from matplotlib.ticker import MaxNLocator
 
 from analysis.fit import LogPosterior
 from gonio import atomic_write
+from reports.plot_pit import pit_histogram
 
 __all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "posterior_draws",
            "write_fit_plots"]
@@ -209,7 +210,8 @@ def residual_map(result, table, prediction, ax=None, filename=None):
 
 
 def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
-    """Write corner.png, traces.png, lobes.png, residuals.png into ``out_dir``.
+    """Write corner.png, traces.png, lobes.png, residuals.png (and pit.png, the LOO-PIT
+    histogram, when the result has its PSIS-LOO) into ``out_dir``.
 
     The signature :func:`analysis.fit.fit_fabric` expects of its ``plots``; returns
     ``{name: path}``.
@@ -226,4 +228,9 @@ def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
         fig, _ = call(out / name)
         plt.close(fig)
         files[name[:-4]] = str(out / name)
+    if getattr(result, "loo", None) is not None:
+        pvalue = result.quality.get("loo_pit", {}).get("ks_pvalue")
+        fig, _ = pit_histogram(result.loo.pit, ks_pvalue=pvalue, filename=out / "pit.png")
+        plt.close(fig)
+        files["pit"] = str(out / "pit.png")
     return files

@@ -31,7 +31,8 @@ th{background:#f0f0f0}td.num{text-align:right;font-variant-numeric:tabular-nums}
 #: Captions of the fit plots (reports.fitplots) by name.
 CAPTIONS = {"corner": "posterior (corner plot)",
             "lobes": "posterior predictive: 5-95% band of f_r cos(theta_o) over the data",
-            "residuals": "residuals at the posterior median", "traces": "chains (traces)"}
+            "residuals": "residuals at the posterior median", "traces": "chains (traces)",
+            "pit": "LOO-PIT histogram (uniform when the predictive distributions are right)"}
 
 
 def _params(rows) -> list[str]:

@@ -3,8 +3,9 @@
 One section per dataset: what was fitted (table, start preset, free parameters), the verdict
 on convergence, the posterior table (median, 68% and 95% intervals, tau, R-hat, ESS), how well
 the model explains the data (residual rms in the likelihood's space and in units of the noise,
-CIEDE2000 between measured and predicted albedo colours) and the fit's figures: posterior-
-predictive lobes over the data points, the residual map, the corner and the trace plots.
+CIEDE2000 between measured and predicted albedo colours, the PSIS-LOO elpd and the LOO-PIT
+uniformity test) and the fit's figures: posterior-predictive lobes over the data points, the
+residual map, the LOO-PIT histogram, the corner and the trace plots.
 """
 
 from __future__ import annotations
@@ -28,6 +29,9 @@ PLOTS = {
     "adequacy": "Standardized residuals per point against angle (N(0, 1) where the model "
                 "fits; forward and back scatter in two colours), the adequacy verdict and the "
                 "warnings.",
+    "pit": "LOO-PIT: each value's leave-one-out predictive CDF at the measured value (uniform "
+           "when the predictive distributions are right; grey: 99% band of a bin under "
+           "uniformity).",
     "corner": "Posterior marginals and pairs (corner).",
     "traces": "Traces of some walkers of every ensemble (after burn-in).",
 }
@@ -96,8 +100,16 @@ def _f(v, fmt=".4g") -> str:
         return str(v)
 
 
+def _elpd(loo) -> str:
+    """``elpd ± se`` of a ``loo`` entry of results.json, "-" without one."""
+    if not isinstance(loo, dict) or loo.get("elpd") is None:
+        return "-"
+    return f"{_f(loo.get('elpd'), '.1f')} ± {_f(loo.get('se'), '.1f')}"
+
+
 def overview_table(measured: dict) -> Markup:
-    """One row per dataset: preset, size, verdicts, warnings, residuals, colour difference."""
+    """One row per dataset: preset, size, verdicts, warnings, residuals, colour difference,
+    elpd."""
     rows = []
     for name, e in measured.items():
         q = e.get("quality", {})
@@ -109,9 +121,24 @@ def overview_table(measured: dict) -> Markup:
                      {True: "yes", False: "NO"}.get(doc.get("adequate"), "-"),
                      ", ".join(kinds) or "-",
                      _f(q.get("rms_residual"), ".3f"), _f(q.get("rms_normalized"), ".2f"),
-                     _f(e.get("albedo_delta_e2000"), ".1f")])
+                     _f(e.get("albedo_delta_e2000"), ".1f"), _elpd(e.get("loo"))])
     return table(["dataset", "start preset", "values", "converged", "steps", "adequate",
-                  "warnings", "residual rms", "normalized rms", "albedo ΔE2000"], rows)
+                  "warnings", "residual rms", "normalized rms", "albedo ΔE2000",
+                  "elpd (PSIS-LOO)"], rows)
+
+
+def _loo_sentence(doc: dict) -> str:
+    """The PSIS-LOO and LOO-PIT of one fit in a sentence (plain text), or nothing."""
+    loo = doc.get("loo")
+    if not isinstance(loo, dict):
+        return ""
+    text = (f"PSIS-LOO elpd {_elpd(loo)} (p_loo {_f(loo.get('p_loo'), '.1f')}; Pareto k "
+            f"max {_f(loo.get('pareto_k_max'), '.2f')}, {_f(loo.get('n_high_k'), '.0f')} "
+            f"values above 0.7).")
+    pit = (doc.get("quality") or {}).get("loo_pit")
+    if isinstance(pit, dict):
+        text += f" LOO-PIT uniformity: Kolmogorov-Smirnov p = {_f(pit.get('ks_pvalue'), '.2g')}."
+    return text
 
 
 def _trust(doc: dict) -> Markup:
@@ -144,7 +171,10 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         'they hold no colour). <i>Adequate</i> says whether the model describes the data '
         'to within its noise (posterior predictive tests of the residuals); the warnings '
         'say which answers the data do not support (parameters at a bound, not informed, '
-        'correlated).</p>'), overview_table(measured)]
+        'correlated). The elpd is the expected log predictive density of the table\'s values '
+        'had the fit not seen each (PSIS-LOO; higher is better): it compares fits of one '
+        'table, not datasets, and <code>microcyl compare</code> ranks such fits.</p>'),
+        overview_table(measured)]
     summary = {}
     for name, e in measured.items():
         doc = e["results"]
@@ -173,6 +203,7 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
                          "adequate": doc.get("adequate"), "warnings": doc.get("warnings", []),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
+                         "loo": doc.get("loo"),
                          "parameters": {k: {f: res[k].get(f) for f in
                                             ("median", "lo68", "hi68", "lo95", "hi95", "tau",
                                              "rhat", "ess")} for k in params},
@@ -190,7 +221,7 @@ def _section(folder: str, name: str, e: dict, verdict: str, rows, figs, trust) -
         '<section id="{name}" class="measured"><h2>{name}: {title}</h2>'
         "<p>Table: {source}; {pairs} pairs, {values} values used. Start preset "
         "<b>{preset}</b>; ties: {ties}.</p><p><b>{verdict}</b>: {reason}</p>{trust}"
-        "<p>Residual rms {rms} (normalized {rms_n}); albedo ΔE2000 {de}. Data: "
+        "<p>Residual rms {rms} (normalized {rms_n}); albedo ΔE2000 {de}. {loo} Data: "
         '<a href="{data}/results.json">results.json</a>, '
         '<a href="{data}/results.csv">results.csv</a>.</p>{table}{figs}</section>',
         name=name, title=e.get("title", ""), source=e.get("source", ""),
@@ -199,6 +230,7 @@ def _section(folder: str, name: str, e: dict, verdict: str, rows, figs, trust) -
         ties=", ".join(map(str, ties)) if isinstance(ties, (list, tuple)) else ties,
         verdict=verdict, reason=e.get("reason", ""), trust=trust, rms=_f(q.get("rms_residual"), ".4f"),
         rms_n=_f(q.get("rms_normalized"), ".2f"), de=_f(e.get("albedo_delta_e2000"), ".2f"),
+        loo=_loo_sentence(e.get("results") or {}),
         data=url(f"{folder}/{name}"),
         table=table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows),
         figs=join(figs))

@@ -111,3 +111,47 @@ def test_grey_table_enters_once_per_point_against_the_channel_mean():
     v = grey.copy()
     v[0, 2] *= 1.01
     assert Likelihood(t.replace(values=v, sigma=0.1 * v)).counts["used"] == 3 * len(t)
+
+
+@pytest.mark.parametrize("kind", ["gaussian", "relative", "student-t"])
+@pytest.mark.parametrize("sigma,noise", [(True, None), (True, -3.0), (False, -2.0)])
+def test_pointwise_terms_sum_to_the_likelihood(kind, sigma, noise):
+    t = _table(sigma=sigma)
+    lik = Likelihood(t, kind, nu=5.0)
+    m = np.stack([t.values * 0.9, t.values * 1.2])
+    ln = None if noise is None else np.array([noise, noise + 0.5])
+    ll, cdf = lik.pointwise(m, scale=np.array([1.0, 0.95]), log_noise=ln, cdf=True)
+    assert ll.shape == cdf.shape == (2, lik.n_used)
+    np.testing.assert_allclose(ll.sum(axis=1), lik(m, scale=np.array([1.0, 0.95]),
+                                                    log_noise=ln), rtol=1e-12)
+    # the CDF by hand: the residual over its scale, through scipy's distribution
+    c = t.wi[:, 2:3]
+    y, mu = ((np.log(t.values), np.log(m[0])) if kind == "relative"
+             else (np.log1p(t.values * c), np.log1p(m[0] * c)))
+    s2 = np.zeros_like(y) if not sigma else (
+        (t.sigma / t.values) ** 2 if kind == "relative" else (c * t.sigma / (1 + t.values * c)) ** 2)
+    if noise is not None:
+        s2 = s2 + np.exp(2 * noise)
+    z = ((y - mu) / np.sqrt(s2)).ravel()
+    ref = stats.t.cdf(z, 5.0) if kind == "student-t" else stats.norm.cdf(z)
+    np.testing.assert_allclose(cdf[0], ref, rtol=1e-10)
+
+
+def test_log_jacobian_is_the_derivative_of_the_residual_space():
+    t = _table()
+    for kind, space in (("gaussian", lambda f, c: np.log1p(f * c)),
+                        ("relative", lambda f, c: np.log(f))):
+        lik = Likelihood(t, kind)
+        f, c = t.values.ravel(), np.repeat(t.wi[:, 2], 3)
+        h = 1e-6 * f
+        dy = (space(f + h, c) - space(f - h, c)) / (2 * h)
+        np.testing.assert_allclose(lik.log_jacobian, np.log(dy), atol=1e-7)
+
+
+def test_pointwise_of_a_grey_table_is_one_term_a_point():
+    t = _table()
+    grey = t.values[:, :1] * np.ones(3)
+    lik = Likelihood(t.replace(values=grey, sigma=0.1 * grey))
+    m = (t.values * 1.3)[None]
+    ll = lik.pointwise(m)
+    assert ll.shape == (1, len(t)) and ll.sum() == pytest.approx(lik(m)[0], rel=1e-12)

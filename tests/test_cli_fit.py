@@ -53,12 +53,14 @@ def test_fit_writes_results_and_plots(table_file, tmp_path, capsys):
         assert np.isfinite(par["kd1"][k])
     assert par["gamma_s1"]["lo95"] < 5.0 < par["gamma_s1"]["hi95"]
     assert doc["quality"]["albedo_delta_e2000"] < 2.0   # same model, 5% noise: barely visible
-    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals"}
-    for name in ("corner", "traces", "lobes", "residuals"):
+    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "pit"}
+    for name in ("corner", "traces", "lobes", "residuals", "pit"):
         assert (out / f"{name}.png").stat().st_size > 1000
-    assert (out / "results.csv").exists()
+    assert (out / "results.csv").exists() and (out / "loo.npz").exists()
+    assert doc["loo"]["elpd"] == pytest.approx(float(np.load(out / "loo.npz")["elpd_i"].sum()))
     text = capsys.readouterr().out
     assert "gamma_s1" in text and "results:" in text
+    assert f"PSIS-LOO: elpd {doc['loo']['elpd']:.1f} ± {doc['loo']['se']:.1f}" in text
     # same command again: resumes (no new optimisation), same folder accepted
     assert main(args[:-2] + ["--no-plots", "-o", str(out)]) == 0
 

@@ -59,8 +59,9 @@ def test_fit_measured_writes_results_and_summary(fitted):
     # the fitted noise explains the residuals: normalized rms near 1, raw rms near exp(noise)
     assert 0.7 < q["rms_normalized"] < 1.3
     assert q["rms_residual"] == pytest.approx(np.exp(res["parameters"]["log_noise"]["median"]), rel=0.3)
-    for name in ("lobes", "residuals", "corner", "traces"):
+    for name in ("lobes", "residuals", "corner", "traces", "pit"):
         assert (out / "curet_44_linen" / f"{name}.png").stat().st_size > 1000
+    assert e["loo"] == res["loo"] and np.isfinite(res["loo"]["elpd"]) and res["loo"]["se"] > 0
 
 
 def test_report_page_of_measured_fits(fitted, tmp_path):
@@ -72,10 +73,13 @@ def test_report_page_of_measured_fits(fitted, tmp_path):
     page = (root / "measured.html").read_text()
     assert '<section id="curet_44_linen"' in page and "NOT converged" in page
     imgs = re.findall(r'<img src="([^"]+)"', page)
-    assert len(imgs) == 4 and all((root / i).stat().st_size > 1000 for i in imgs)
+    assert len(imgs) == 5 and all((root / i).stat().st_size > 1000 for i in imgs)
+    loo = json.loads((out / "curet_44_linen" / "results.json").read_text())["loo"]
+    assert f"PSIS-LOO elpd {loo['elpd']:.1f} ± {loo['se']:.1f}" in page
     assert "measured.html" in index.read_text()
     summary = json.loads((root / "summary.json").read_text())
     assert summary["measured"]["curet_44_linen"]["converged"] is False
+    assert summary["measured"]["curet_44_linen"]["loo"] == loo
     with pytest.raises(ValueError, match="measured.json: not found"):
         build_report(["velvet"], tmp_path / "rep2", sections=["parameters"], progress=False,
                      quality="fast", measured=tmp_path)

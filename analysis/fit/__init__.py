@@ -25,7 +25,10 @@ Pipeline (:func:`fit`, module by module):
 6. :mod:`~analysis.fit.results` and :mod:`~analysis.fit.quality` -- :class:`FitResult`,
    ``results.json`` (versioned schema) and ``results.csv``; residuals and the albedo colour
    difference. :func:`fit_fabric` (:mod:`~analysis.fit.workflow`) is the whole of
-   ``microcyl fit``: fit, quality, plots, files.
+   ``microcyl fit``: fit, quality, PSIS-LOO, plots, files.
+7. :mod:`~analysis.fit.loo` -- PSIS-LOO (ArviZ) over thinned posterior draws: ``loo`` in
+   ``results.json``, the pointwise values in ``loo.npz``, the LOO-PIT;
+   :mod:`~analysis.fit.compare` ranks fits of one table by it (``microcyl compare``).
 
 Threading rule
 --------------
@@ -55,10 +58,12 @@ True
 import numpy as np  # noqa: F401  (the Examples use it)
 
 from analysis.fit.checkpoint import CHECKPOINT_FILE, CONFIG_FILE, FitFolder
+from analysis.fit.compare import compare_fits
 from analysis.fit.convergence import Criteria, Diagnosis
 from analysis.fit.driver import FitOptions, fit
 from analysis.fit.ensemble import Chain, EnsembleRunner
 from analysis.fit.lockstep import LockStep
+from analysis.fit.loo import LOO_FILE, Loo, load_loo, psis_loo
 from analysis.fit.medians import FitModel, MedianFabric, median_fabric
 from analysis.fit.moves import EnsembleMoves
 from analysis.fit.optimize import point_estimate
@@ -74,4 +79,5 @@ __all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInter
            "FabricModel", "LogPosterior", "point_estimate", "LockStep", "Chain",
            "EnsembleRunner", "EnsembleMoves", "LaplaceMove", "Criteria", "Diagnosis",
            "FitFolder", "fit_quality", "albedo_colours", "albedo_delta_e", "CONFIG_FILE",
-           "CHECKPOINT_FILE", "SCHEMA_VERSION", "MedianFabric", "median_fabric", "FitModel"]
+           "CHECKPOINT_FILE", "SCHEMA_VERSION", "MedianFabric", "median_fabric", "FitModel",
+           "Loo", "psis_loo", "load_loo", "LOO_FILE", "compare_fits"]

@@ -127,6 +127,19 @@ class LogPosterior:
             out = out * v["scale"][:, None, None]
         return out
 
+    def pointwise(self, theta, cdf: bool = False):
+        """The log-likelihood of each used value of the table, for internal theta (B, ndim)
+        inside the prior's support: (B, n_used), and with ``cdf`` each value's predictive
+        CDF at the measured value (:meth:`analysis.likelihood.Likelihood.pointwise`).
+        Their sum over values is the log-likelihood part of :meth:`__call__`."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=np.float64))
+        v = self.spec.values(theta)
+        with np.errstate(all="ignore"):
+            pred = self._predict(v, scaled=False)          # the likelihood applies scale
+            return self.lik.pointwise(pred, scale=v["scale"] if self.use_scale else None,
+                                      log_noise=v["log_noise"] if self.use_noise else None,
+                                      cdf=cdf)
+
     def __call__(self, theta) -> np.ndarray:
         theta = np.atleast_2d(np.asarray(theta, dtype=np.float64))
         lp = self.spec.log_prior(theta)

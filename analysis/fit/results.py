@@ -11,7 +11,12 @@
              "map_log_posterior", "points", "ties", "timing", "proposal"},
      "quality": {"rms_residual", "rms_normalized", "values", and with the table:
                  "albedo_measured", "albedo_predicted", "albedo_delta_e2000"},
-     "plots": {"corner": "corner.png", ...}}
+     "plots": {"corner": "corner.png", ...},
+     "loo": {"elpd", "se", "p_loo", "pareto_k_max", "n_high_k"} (or null),
+     "warnings": [{"kind", "parameters", "message"}, ...]}
+
+``loo`` is the PSIS-LOO of the fit (:mod:`analysis.fit.loo`; its pointwise values in
+``loo.npz``), ``quality["loo_pit"]`` the uniformity test of its LOO-PIT.
 
 Intervals are central (68%: 15.9-84.1 percentiles), in each parameter's natural unit.
 """
@@ -71,6 +76,10 @@ class FitResult:
         colours and their CIEDE2000 difference (:mod:`analysis.fit.quality`).
     plots : dict
         Plot names -> file names, when plots were written.
+    loo : analysis.fit.loo.Loo or None
+        The PSIS-LOO, when the workflow computed it.
+    warnings : list of dict
+        ``{"kind", "parameters", "message"}`` each: what the fit cannot be trusted for.
     """
 
     names: tuple
@@ -93,6 +102,8 @@ class FitResult:
     proposal: dict = dataclasses.field(default_factory=dict)
     quality: dict = dataclasses.field(default_factory=dict)
     plots: dict = dataclasses.field(default_factory=dict)
+    loo: object = dataclasses.field(repr=False, default=None)
+    warnings: list = dataclasses.field(default_factory=list)
     spec: object = dataclasses.field(repr=False, default=None)
     logpost: object = dataclasses.field(repr=False, default=None)
 
@@ -127,7 +138,9 @@ class FitResult:
                     "ties": ({k: list(v) for k, v in self.spec.ties.items()}
                              if self.spec is not None else {}),
                     "proposal": self.proposal},
-            "quality": quality, "plots": dict(self.plots)}
+            "quality": quality, "plots": dict(self.plots),
+            "loo": None if self.loo is None else self.loo.summary(),
+            "warnings": [dict(w) for w in self.warnings]}
         return plain(doc)
 
 

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import Callable
 
+from analysis.fit.checkpoint import table_digest
 from analysis.fit.driver import fit
+from analysis.fit.loo import psis_loo
 from analysis.fit.posterior import FabricModel
 from analysis.fit.quality import fit_quality
 from analysis.fit.results import FitResult, write_results
@@ -66,8 +69,11 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     (pid N)``; a folder holding a report is refused), and temporaries a killed fit left in it
     are removed. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
-    colours and their CIEDE2000 difference), the plots drawn when ``plots`` is given, and
-    ``results.json`` / ``results.csv`` written, once, atomically.
+    colours and their CIEDE2000 difference), the PSIS-LOO (:func:`analysis.fit.loo.psis_loo`:
+    ``loo`` in the results, its pointwise values in ``loo.npz``, the LOO-PIT test in
+    ``quality["loo_pit"]``, a ``pareto_k`` warning when values have a high Pareto k), the
+    plots drawn when ``plots`` is given, and ``results.json`` / ``results.csv`` written, once,
+    atomically.
 
     Parameters
     ----------
@@ -87,13 +93,19 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     Returns
     -------
     FitResult
-        With ``quality`` and ``plots`` filled in.
+        With ``quality``, ``loo``, ``warnings`` and ``plots`` filled in.
     """
     out = Path(out_dir)
     with output_lock(out, "fit"):
         result = fit(table, spec, FabricModel(fabric, table.wi, table.wo), out_dir=out,
                      **fit_kw)
         result.quality = fit_quality(result, table)
+        t0 = time.perf_counter()
+        result.loo = psis_loo(result, table_digest(table))
+        result.timing["loo_s"] = time.perf_counter() - t0
+        result.quality["loo_pit"] = result.loo.pit_test()
+        result.warnings = [*result.warnings, *result.loo.warnings()]
+        result.loo.save(out)
         if plots is not None:
             files = plots(result, table, lambda wi, wo: FabricModel(fabric, wi, wo), out)
             result.plots = {k: Path(v).name for k, v in files.items()}

@@ -21,7 +21,8 @@ from gonio.memory import available_memory, check_memory, format_bytes, memory_li
 from gonio.tablesize import RGL_BYTES_PER_PAIR
 
 __all__ = ["available_memory", "memory_limit", "check_memory", "format_bytes",
-           "format_seconds", "spec_pairs", "check_fit_rows", "MEASURE_BYTES_PER_PAIR", "RGL_BYTES_PER_PAIR",
+           "format_seconds", "spec_pairs", "check_fit_rows", "MEASURE_BYTES_PER_PAIR",
+           "RGL_BYTES_PER_PAIR",
            "FIT_BYTES_PER_VALUE"]
 
 #: Peak memory of ``measure`` per direction pair (geometry, values, chunked evaluation),

@@ -33,9 +33,10 @@ def read_pairs_csv(path) -> Geometry:
     OSError
         The file cannot be read.
     ValueError
-        A file too large for the memory, no header, a header without the four angle columns, or a bad row (with its line
-        number and column: not a decimal number, or an angle outside
-        :data:`gonio.csvtable.ANGLE_RANGES`): a :class:`gonio.FormatError` naming the file.
+        A file too large for the memory; no header, a header without the four angle
+        columns, or a bad row (with its line number and column: not a decimal number, or an
+        angle outside :data:`gonio.csvtable.ANGLE_RANGES`): a :class:`gonio.FormatError`
+        naming the file.
     """
     path = Path(path)
     try:

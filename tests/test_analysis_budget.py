@@ -292,6 +292,23 @@ def test_an_rgl_file_is_sized_from_its_header(shared_data):
     assert len(gonio.read(path, step=10)) <= e.rows
 
 
+def test_curet_and_alta_are_sized_from_their_lines(shared_data, monkeypatch):
+    curet = shared_data / "curet" / "abrdf.dat"
+    e = estimate_table(curet, "curet")
+    assert e.rows == 61 + 205                   # abrdf.dat's samples and table.txt's rows
+    assert e.basis == "61 lines of 206 fields and 205 lines of 5 fields"
+    alta = shared_data / "merl-slice" / "pink-felt-1d.alta"
+    lines = alta.read_bytes().splitlines()
+    first = next(ln for ln in lines if ln.strip() and not ln.startswith(b"#"))
+    e = estimate_table(alta, "alta")
+    assert (e.rows, e.basis) == (len(lines), f"{len(lines):,} lines of {len(first.split())} "
+                                             f"fields")
+    monkeypatch.setenv("MICROCYL_MEMORY_LIMIT", "10K")
+    for path, options in ((curet, {"sample": 44}), (alta, {})):
+        with pytest.raises(ValueError, match=rf"^reading {path.name} \(.* lines of"):
+            gonio.read(path, **options)
+
+
 def test_a_pairs_file_too_large_is_refused(tmp_path, monkeypatch):
     p = tmp_path / "p.csv"
     p.write_text("theta_i,phi_i,theta_o,phi_o\n" + "30,0,30,180\n" * 20_000)
@@ -321,8 +338,9 @@ def test_every_layout_is_checked_against_the_memory_limit(monkeypatch):
                         (lambda: gonio.rusinkiewicz(10), "rusinkiewicz"),
                         (lambda: gonio.merl_grid(2), "merl"),
                         (lambda: from_spec("full:10"), "full_grid")):
-        with pytest.raises(memory.MemoryLimitError, match=rf"^{kind}: [0-9,]+ direction pairs would take "
-                                             r"about .*MICROCYL_MEMORY_LIMIT\); use coarser"):
+        with pytest.raises(memory.MemoryLimitError,
+                           match=rf"^{kind}: [0-9,]+ direction pairs would take about "
+                                 r".*MICROCYL_MEMORY_LIMIT\); use coarser"):
             build()
 
 

@@ -6,7 +6,7 @@ of two threads, the paper's six presets, and every variant; importance sampling 
 """
 
 from brdf import directions, frames, sampling, schema, terms
-from brdf.curve import SAMPLING_METHODS, TangentCurve
+from brdf.curve import MAX_TANGENT_SAMPLES, SAMPLING_METHODS, TangentCurve
 from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
 from brdf.presets import PRESETS, fabric, preset_threads
 from brdf.protocols import BRDF, SampledBRDF, ThreadedBRDF
@@ -15,5 +15,5 @@ from brdf.thread import Thread
 __all__ = [
     "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
-    "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
+    "MAX_TANGENT_SAMPLES", "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
 ]

@@ -14,6 +14,10 @@ _OFFSETS, _LENGTHS = schema.THREAD["offsets"], schema.THREAD["lengths"]
 
 #: Names accepted by ``tangent_sampling``.
 SAMPLING_METHODS = ("midpoint", "control_points")
+#: The most tangent samples a curve takes (the default is 32): a fixed cap on the work and
+#: memory of each direction pair, whoever asks (a preset's options, a fabric JSON or TOML,
+#: the command line's --tangent-samples, the API).
+MAX_TANGENT_SAMPLES = 4096
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,7 +96,8 @@ class TangentCurve:
         Parameters
         ----------
         n : int
-            Number of samples N (``tangent_samples``), used by ``"midpoint"``.
+            Number of samples N (``tangent_samples``), used by ``"midpoint"``: an integer in
+            1..:data:`MAX_TANGENT_SAMPLES`.
         method : {"midpoint", "control_points"}
             ``"midpoint"``: N samples at arc-length midpoints
             :math:`s_m = (m + 1/2) / N \sum l`; ``"control_points"``: the K + 1 listed offsets,
@@ -110,7 +115,7 @@ class TangentCurve:
         if method == "control_points":
             alpha = np.asarray(self.offsets)
         else:
-            n = validate.integer("tangent_samples", n, lo=1)
+            n = validate.integer("tangent_samples", n, lo=1, hi=MAX_TANGENT_SAMPLES)
             total = float(np.sum(self.lengths)) if self.lengths else 1.0
             s = (np.arange(n) + 0.5) / n * total
             alpha = self.offset_at(s)

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from brdf import sampling, schema, validate
-from brdf.curve import SAMPLING_METHODS
+from brdf.curve import MAX_TANGENT_SAMPLES, SAMPLING_METHODS
 from brdf.frames import flat_pairs
 from brdf.kernel import thread_geometry
 from brdf.shading import combine_rgb, inverse_denominator, thread_shade
@@ -63,7 +63,7 @@ class Fabric:
     reweighting : bool, default True
         Reweighting by visible length P and the normalization Q; off means P = Q = 1.
     tangent_samples : int, default 32
-        Samples N per tangent curve (arc-length midpoints).
+        Samples N per tangent curve (arc-length midpoints), 1..:data:`MAX_TANGENT_SAMPLES`.
     tangent_sampling : {"midpoint", "control_points"}, default "midpoint"
     transmission : {"half_angle", "longitudinal"}, default "half_angle"
     gap : {"incident", "outgoing"}, default "incident"
@@ -115,7 +115,7 @@ class Fabric:
         opts["masking"] = validate.flag("masking", opts["masking"])
         opts["reweighting"] = validate.flag("reweighting", opts["reweighting"])
         opts["tangent_samples"] = validate.integer("tangent_samples", opts["tangent_samples"],
-                                                   lo=1)
+                                                   lo=1, hi=MAX_TANGENT_SAMPLES)
         validate.choice("tangent_sampling", opts["tangent_sampling"], SAMPLING_METHODS)
         validate.choice("transmission", opts["transmission"], TRANSMISSION_METHODS)
         validate.choice("gap", opts["gap"], GAP_METHODS)

@@ -60,14 +60,22 @@ def flag(name: str, value) -> bool:
     raise ValueError(f"{name} must be True or False (or 'on'/'off'); got {value!r}")
 
 
-def integer(name: str, value, *, lo: int) -> int:
-    """Return ``value`` as an int >= ``lo``; raise ValueError otherwise."""
+def integer(name: str, value, *, lo: int, hi: int | None = None) -> int:
+    """Return ``value`` as an int >= ``lo`` (and <= ``hi`` when given); raise ValueError
+    otherwise.
+
+    Examples
+    --------
+    >>> integer("n", 3, lo=1, hi=4)
+    3
+    """
+    allowed = f"an integer >= {lo}" if hi is None else f"an integer in {lo}..{hi}"
     if isinstance(value, bool) or not isinstance(value, (int,)) and not (
             hasattr(value, "__index__")):
-        raise ValueError(f"{name} must be an integer >= {lo}; got {value!r}")
+        raise ValueError(f"{name} must be {allowed}; got {value!r}")
     v = int(value)
-    if v < lo:
-        raise ValueError(f"{name} must be an integer >= {lo}; got {value!r}")
+    if v < lo or (hi is not None and v > hi):
+        raise ValueError(f"{name} must be {allowed}; got {value!r}")
     return v
 
 

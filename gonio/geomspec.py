@@ -9,9 +9,12 @@ from pathlib import Path
 from gonio.csvtable import ANGLES, parse_columns, read_rows
 from gonio.errors import FormatError
 from gonio.geometry import SPEC_HELP, Geometry
-from gonio.gridsize import full_grid_pairs, merl_pairs, rusinkiewicz_pairs
-from gonio.layouts import PLANE_AZIMUTHS, full_grid, merl, pairs_from_angles, plane, rusinkiewicz
+from gonio.gridsize import full_grid_pairs, merl_pairs, plane_pairs, rusinkiewicz_pairs
+from gonio.layouts import (PLANE_AZIMUTHS, PLANE_THETA_I, full_grid, merl, pairs_from_angles,
+                           plane, rusinkiewicz)
+from gonio.memory import MemoryLimitError
 from gonio.numtext import NUMBER_FORM, parse_number
+from gonio.tablesize import check_table
 
 __all__ = ["from_spec", "spec_pairs", "read_pairs_csv", "SPEC_HELP"]
 
@@ -22,19 +25,22 @@ def read_pairs_csv(path) -> Geometry:
     """Read theta_i,phi_i,theta_o,phi_o (degrees) from a CSV; '#' lines are comments.
 
     The file is split by :func:`gonio.csvtable.read_rows`, the reader of CSV tables; other
-    columns are allowed and ignored.
+    columns are allowed and ignored. Its size is checked against the memory limit before it
+    is parsed (:func:`gonio.tablesize.check_table`).
 
     Raises
     ------
     OSError
         The file cannot be read.
     ValueError
-        No header, a header without the four angle columns, or a bad row (with its line
-        number and column: not a decimal number, or an angle outside
-        :data:`gonio.csvtable.ANGLE_RANGES`): a :class:`gonio.FormatError` naming the file.
+        A file too large for the memory; no header, a header without the four angle
+        columns, or a bad row (with its line number and column: not a decimal number, or an
+        angle outside :data:`gonio.csvtable.ANGLE_RANGES`): a :class:`gonio.FormatError`
+        naming the file.
     """
     path = Path(path)
     try:
+        check_table(path, "csv")
         text = read_rows(path)
     except OSError as exc:
         raise OSError(exc.errno, f"cannot read pairs file: {exc.strerror}", str(path)) from None
@@ -99,9 +105,12 @@ def _parse(spec: str):
 
 
 def _checked(spec, make):
-    """``make()``, its ValueErrors naming the spec (once)."""
+    """``make()``, its ValueErrors naming the spec (once); a refusal for the memory limit
+    passes as it is (it names the file or the layout and what to change)."""
     try:
         return make()
+    except MemoryLimitError:
+        raise
     except ValueError as exc:
         if str(exc).startswith("geometry spec"):
             raise
@@ -128,10 +137,14 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
     return _checked(spec, make)
 
 
+def _plane_pairs(which, step, theta_i=PLANE_THETA_I):
+    return plane_pairs(step, len(theta_i))
+
+
 def spec_pairs(spec: str) -> int | None:
-    """Number of direction pairs the grid ``spec`` places, counted without building it (an
+    """Number of direction pairs the layout ``spec`` places, counted without building it (an
     exact int, however large; ``rus`` and ``merl`` before their below-horizon nodes are
-    dropped); None for ``plane`` and ``pairs``, small by construction.
+    dropped); None for ``pairs``, whose file :func:`read_pairs_csv` sizes before reading.
 
     Raises
     ------
@@ -140,12 +153,12 @@ def spec_pairs(spec: str) -> int | None:
 
     Examples
     --------
-    >>> spec_pairs("full:45:90"), spec_pairs("full:0.5"), spec_pairs("plane:warp:5")
-    (25, 16610312161, None)
+    >>> spec_pairs("full:45:90"), spec_pairs("full:0.5"), spec_pairs("plane:warp:30:0,30")
+    (25, 16610312161, 10)
     """
     def count():
         kind, args, kw = _parse(spec)
         counter = {"full": full_grid_pairs, "rusinkiewicz": rusinkiewicz_pairs,
-                   "merl": merl_pairs}.get(kind)
+                   "merl": merl_pairs, "plane": _plane_pairs}.get(kind)
         return None if counter is None else counter(*args, **kw)
     return _checked(spec, count)

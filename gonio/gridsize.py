@@ -1,8 +1,10 @@
 """Sizes of the grid layouts of :mod:`gonio.layouts`, counted without building them.
 
 The step parsing and the pair counts that the layouts' builders check before allocating
-(:data:`MAX_PAIRS`) and that :func:`gonio.geomspec.spec_pairs` and the memory budgets use.
-Steps are in degrees.
+(:func:`check_pairs`: at most :data:`MAX_PAIRS`, and within the memory limit of
+:func:`gonio.memory.memory_limit`) and that :func:`gonio.geomspec.spec_pairs` and the memory
+budgets use. Every layout's size, from a spec string, a file or the API, passes
+:func:`check_pairs` before its arrays are built. Steps are in degrees.
 """
 
 from __future__ import annotations
@@ -11,11 +13,12 @@ import math
 
 import numpy as np
 
+from gonio.memory import check_memory
 from gonio.numtext import parse_number
 
 __all__ = ["MAX_PAIRS", "full_grid_pairs", "rusinkiewicz_pairs", "merl_pairs", "step_degrees",
            "node_count", "node_range", "side_count", "full_steps", "rus_steps", "merl_stride",
-           "check_pairs"]
+           "check_pairs", "plane_pairs", "GEOMETRY_BYTES_PER_PAIR"]
 
 
 def step_degrees(name, value, upper=90.0) -> float:
@@ -33,6 +36,9 @@ def step_degrees(name, value, upper=90.0) -> float:
 #: The most (wi, wo) pairs a grid layout builds (about 2 GB of float64 arrays): finer steps
 #: are refused before any allocation instead of exhausting memory.
 MAX_PAIRS = 20_000_000
+#: Peak memory of building a layout, bytes a pair (directions, angles, the horizon's
+#: selection and their copies; about 250 measured on full:2, rounded up).
+GEOMETRY_BYTES_PER_PAIR = 300
 
 
 def node_count(step, stop) -> int:
@@ -105,12 +111,38 @@ def merl_pairs(stride: int = 1) -> int:
     return node_count(s, 90.0) ** 2 * node_count(s, 180.0)
 
 
+def plane_pairs(theta_o_step: float = 5.0, n_theta_i: int = 6) -> int:
+    """Number of pairs :func:`plane` places for ``n_theta_i`` incidences: each sweeps
+    theta_o = k step strictly inside (-90, 90).
+
+    Examples
+    --------
+    >>> plane_pairs(30, 2)
+    10
+    """
+    k = node_count(step_degrees("theta_o_step", theta_o_step), 90.0) - 1
+    return int(n_theta_i) * (2 * k + 1)
+
+
 def check_pairs(kind, counts) -> None:
-    """ValueError if the product of ``counts`` exceeds :data:`MAX_PAIRS`."""
+    """ValueError if the product of ``counts`` exceeds :data:`MAX_PAIRS`, or the layout's
+    arrays (:data:`GEOMETRY_BYTES_PER_PAIR` a pair) exceed the memory limit
+    (:func:`gonio.memory.check_memory`).
+
+    Examples
+    --------
+    >>> check_pairs("plane", (6, 1.8e11))
+    Traceback (most recent call last):
+    ...
+    ValueError: plane: the steps give 1,080,000,000,000 direction pairs, more than
+    20,000,000; use coarser steps
+    """
     total = math.prod(int(c) for c in counts)
     if total > MAX_PAIRS:
         raise ValueError(f"{kind}: the steps give {total:,} direction pairs, more than "
                          f"{MAX_PAIRS:,}; use coarser steps")
+    check_memory(f"{kind}: {total:,} direction pairs", total * GEOMETRY_BYTES_PER_PAIR,
+                 "use coarser steps")
 
 
 def node_range(step, stop) -> np.ndarray:

@@ -13,8 +13,9 @@ from gonio.exr import count_missing, from_angles, read_exr, write_exr
 from gonio.merl import read_merl, write_merl
 from gonio.rgl import load_rgl, read_tensor_file
 from gonio.table import Table
+from gonio.tablesize import check_table
 
-__all__ = ["read", "write", "check_read_options", "READ_SUFFIXES", "WRITE_SUFFIXES",
+__all__ = ["read", "write", "check_read_options", "table_kind", "READ_SUFFIXES", "WRITE_SUFFIXES",
            "READ_OPTIONS"]
 
 READ_SUFFIXES = (".exr", ".csv", ".binary", ".alta", ".bsdf", "abrdf.dat")
@@ -36,6 +37,27 @@ def _kind(path: Path, known) -> str:
         raise ValueError(f"{path}: unknown table format {suffix or '(no suffix)'!r}; known: "
                          + ", ".join(known))
     return kinds[suffix]
+
+
+def table_kind(path, quiet: bool = False) -> str | None:
+    """The format of a table to read, from its name (a key of :data:`READ_OPTIONS`).
+
+    Raises
+    ------
+    ValueError
+        An unknown suffix (listing the known ones); with ``quiet``, None instead.
+
+    Examples
+    --------
+    >>> table_kind("t.exr"), table_kind("x/abrdf.dat"), table_kind("t.txt", quiet=True)
+    ('exr', 'curet', None)
+    """
+    try:
+        return _kind(Path(path), READ_SUFFIXES)
+    except ValueError:
+        if quiet:
+            return None
+        raise
 
 
 def check_read_options(path, options, *, as_flags: bool = False) -> None:
@@ -102,6 +124,10 @@ def read(path, **options) -> Table:
         ``sample`` for CUReT; :data:`READ_OPTIONS`); another is refused by name
         (:func:`check_read_options`) before the file is opened.
 
+    The table's size is estimated from the file before it is parsed (its line count, an
+    OpenEXR header, an RGL header: :func:`gonio.tablesize.check_table`), and a table whose
+    reading would exceed the memory limit (:func:`gonio.memory.memory_limit`) is refused.
+
     Returns
     -------
     Table
@@ -110,7 +136,7 @@ def read(path, **options) -> Table:
     ------
     ValueError
         Unknown suffix (the message lists the known ones), an option the format does not
-        take, or a missing option.
+        take, a missing option, or a table too large for the memory.
     FormatError
         The file is not what its name says, truncated or corrupt.
     """
@@ -119,6 +145,7 @@ def read(path, **options) -> Table:
     check_read_options(path, options)
     if not path.exists():
         raise FileNotFoundError(2, "No such file", str(path))
+    check_table(path, kind, **options)
     if kind == "exr":
         return read_exr(path, **options)
     if kind == "csv":

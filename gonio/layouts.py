@@ -20,10 +20,12 @@ from gonio.gridsize import (check_pairs, full_steps, merl_stride, node_count, no
 from gonio.numtext import parse_number
 
 __all__ = ["full_grid", "plane", "rusinkiewicz", "merl", "pairs", "pairs_from_angles",
-           "PLANE_AZIMUTHS"]
+           "PLANE_AZIMUTHS", "PLANE_THETA_I"]
 
 #: Named planes of incidence and their azimuths, degrees.
 PLANE_AZIMUTHS = {"warp": 0.0, "weft": 90.0, "45": 45.0}
+#: The incidence angles of a plane by default, degrees.
+PLANE_THETA_I = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0)
 
 
 def _build(kind, params, wi, wo, coords, rotation) -> Geometry:
@@ -97,7 +99,7 @@ def full_grid(theta_step: float = 10.0, phi_step: float | None = None, *,
 
 
 def plane(azimuth="warp", theta_o_step: float = 5.0,
-          theta_i=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0), *, rotation: float = 0.0) -> Geometry:
+          theta_i=PLANE_THETA_I, *, rotation: float = 0.0) -> Geometry:
     """Measurements in a plane of incidence (phi_o = phi_i + 180 degrees).
 
     Parameters
@@ -147,6 +149,7 @@ def plane(azimuth="warp", theta_o_step: float = 5.0,
         raise ValueError(f"theta_i must be a non-empty list of degrees in (-90, 90); "
                          f"got {theta_i!r}")
     k = node_count(step, 90.0) - 1
+    check_pairs("plane", (ti.size, 2 * k + 1))
     to = step * np.arange(-k, k + 1)
     TI = np.radians(np.repeat(ti, to.size))
     TO = np.radians(np.tile(to, ti.size))
@@ -235,6 +238,7 @@ def merl(stride: int = 1, *, rotation: float = 0.0) -> Geometry:
     [10.336111]
     """
     stride = merl_stride(stride)
+    check_pairs("merl", [node_count(stride, stop) for stop in (90.0, 90.0, 180.0)])
     i = np.arange(0, 90, stride)
     j = np.arange(0, 90, stride)
     k = np.arange(0, 180, stride)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import struct
 from pathlib import Path
@@ -12,11 +13,50 @@ from brdf.frames import flat_pairs
 from brdf.shading import DENOM_MIN
 from gonio.errors import FormatError
 
-__all__ = ["read_tensor_file", "load_rgl", "RGLBRDF"]
+__all__ = ["read_tensor_file", "read_tensor_field", "load_rgl", "RGLBRDF", "HEADER_LIMIT"]
 
 _MAGIC = b"tensor_file\0"
 _DTYPES = {1: "u1", 2: "i1", 3: "<u2", 4: "<i2", 5: "<u4", 6: "<i4", 7: "<u8", 8: "<i8",
            9: "<f2", 10: "<f4", 11: "<f8"}
+
+
+def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
+    """The field table of a tensor file's header: name -> (dtype, shape, offset), each
+    field checked to end within ``file_size`` bytes. ``data`` holds at least the header."""
+    if len(data) < 18 or data[:12] != _MAGIC:
+        raise FormatError(path, f"wrong magic {data[:12]!r}, expected {_MAGIC!r} "
+                                "(not an RGL tensor file)")
+    major, minor = data[12], data[13]
+    if (major, minor) != (1, 0):
+        raise FormatError(path, f"unsupported tensor file version {major}.{minor}, expected 1.0")
+    (count,) = struct.unpack_from("<I", data, 14)
+    pos = 18
+    table = {}
+    try:
+        for _ in range(count):
+            (name_len,) = struct.unpack_from("<H", data, pos)
+            pos += 2
+            name = data[pos:pos + name_len].decode("utf-8")
+            if len(name) != name_len:
+                raise struct.error("name")
+            pos += name_len
+            ndim, code, offset = struct.unpack_from("<HBQ", data, pos)
+            pos += 11
+            shape = struct.unpack_from(f"<{ndim}Q", data, pos)
+            pos += 8 * ndim
+            if code not in _DTYPES:
+                raise FormatError(path, f"field {name!r} has unknown dtype code {code}")
+            dtype = np.dtype(_DTYPES[code])
+            size = math.prod(shape) * dtype.itemsize
+            if offset + size > file_size:
+                raise FormatError(path, f"wrong size: field {name!r} needs bytes "
+                                        f"{offset}..{offset + size}, file has {file_size} "
+                                        "(truncated?)")
+            table[name] = (dtype, shape, offset)
+    except (struct.error, UnicodeDecodeError):
+        raise FormatError(path, f"truncated or corrupt header (field table of {count} fields "
+                                f"ends past byte {pos} of {len(data)})") from None
+    return table
 
 
 def read_tensor_file(path) -> dict[str, np.ndarray]:
@@ -39,41 +79,35 @@ def read_tensor_file(path) -> dict[str, np.ndarray]:
     """
     path = Path(path)
     data = path.read_bytes()
-    if len(data) < 18 or data[:12] != _MAGIC:
-        raise FormatError(path, f"wrong magic {data[:12]!r}, expected {_MAGIC!r} "
-                                "(not an RGL tensor file)")
-    major, minor = data[12], data[13]
-    if (major, minor) != (1, 0):
-        raise FormatError(path, f"unsupported tensor file version {major}.{minor}, expected 1.0")
-    (count,) = struct.unpack_from("<I", data, 14)
-    pos = 18
-    fields = {}
-    try:
-        for _ in range(count):
-            (name_len,) = struct.unpack_from("<H", data, pos)
-            pos += 2
-            name = data[pos:pos + name_len].decode("utf-8")
-            if len(name) != name_len:
-                raise struct.error("name")
-            pos += name_len
-            ndim, code, offset = struct.unpack_from("<HBQ", data, pos)
-            pos += 11
-            shape = struct.unpack_from(f"<{ndim}Q", data, pos)
-            pos += 8 * ndim
-            if code not in _DTYPES:
-                raise FormatError(path, f"field {name!r} has unknown dtype code {code}")
-            dtype = np.dtype(_DTYPES[code])
-            size = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
-            if offset + size > len(data):
-                raise FormatError(path, f"wrong size: field {name!r} needs bytes "
-                                        f"{offset}..{offset + size}, file has {len(data)} "
-                                        "(truncated?)")
-            fields[name] = np.frombuffer(data, dtype, int(np.prod(shape, dtype=np.int64)),
-                                         offset).reshape(shape)
-    except (struct.error, UnicodeDecodeError):
-        raise FormatError(path, f"truncated or corrupt header (field table of {count} fields "
-                                f"ends past byte {pos} of {len(data)})") from None
-    return fields
+    return {name: np.frombuffer(data, dtype, math.prod(shape), offset).reshape(shape)
+            for name, (dtype, shape, offset) in _field_table(path, data, len(data)).items()}
+
+
+#: The most header bytes :func:`read_tensor_field` reads to find its field.
+HEADER_LIMIT = 1 << 20
+
+
+def read_tensor_field(path, name: str) -> np.ndarray | None:
+    """One field of a tensor file, reading only the header and that field's bytes (the
+    incident angles of an RGL file, to size its table before reading it); None when the
+    file has no such field.
+
+    Raises
+    ------
+    FormatError
+        As :func:`read_tensor_file` for the header (a header longer than
+        :data:`HEADER_LIMIT` bytes is called corrupt).
+    """
+    path = Path(path)
+    with open(path, "rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        table = _field_table(path, fh.read(HEADER_LIMIT), size)
+        if name not in table:
+            return None
+        dtype, shape, offset = table[name]
+        fh.seek(offset)
+        raw = fh.read(math.prod(shape) * dtype.itemsize)
+    return np.frombuffer(raw, dtype).reshape(shape)
 
 
 def _elevation(d):

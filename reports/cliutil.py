@@ -10,13 +10,10 @@ import os
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 import brdf
 import gonio
 import gonio.io
-import gonio.rgl
-from analysis.budget import RGL_BYTES_PER_PAIR, check_memory
+import gonio.tablesize
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
@@ -25,10 +22,11 @@ from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 __all__ = ["add_fabric_options", "fabric_from_args", "fabric_source", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
+           "table_estimate",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
 
-#: Largest --tangent-samples (the default is 32): a fixed cap on the work of each pair.
-MAX_TANGENT_SAMPLES = 4096
+#: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
+MAX_TANGENT_SAMPLES = brdf.MAX_TANGENT_SAMPLES
 #: Largest --ensembles: R-hat needs a few; each is a group of the one checkpoint.
 MAX_ENSEMBLES = 64
 
@@ -142,8 +140,10 @@ def split_ties(ties):
 def reader_options(path, **options) -> dict:
     """The reader options given (not None) for ``path``, each checked against its format:
     ``--sample`` for a CUReT abrdf.dat, ``--step`` for an RGL .bsdf, ``--stride`` for a MERL
-    .binary; another is refused by name (:func:`gonio.io.check_read_options`). An RGL
-    ``--step`` too fine for the memory is refused with its estimate."""
+    .binary; another is refused by name (:func:`gonio.io.check_read_options`). A table whose
+    reading would exceed the memory limit, estimated from the file's size and header (its
+    line count, an OpenEXR or RGL header, the MERL stride: :func:`gonio.tablesize.check_table`),
+    is refused with its estimate, before anything is parsed."""
     path = Path(path)
     given = {k: v for k, v in options.items() if v is not None}
     if given:
@@ -157,22 +157,19 @@ def reader_options(path, **options) -> dict:
         step = given["step"]
         if not (math.isfinite(step) and 0 < step <= 90):
             raise ValueError(f"--step must be in (0, 90] degrees; got {step}")
-        n_o = float(math.ceil(90 / step - 1e-9)) * float(math.ceil(360 / step - 1e-9))
-        pairs = _rgl_incident(path) * n_o
-        check_memory(f"--step {step:g} ({pairs:.3g} pairs: {n_o:.3g} outgoing directions "
-                     f"for each incident one)", pairs * RGL_BYTES_PER_PAIR,
-                     "use a coarser --step")
+    table_estimate(path, **given)
     return given
 
 
-def _rgl_incident(path) -> int:
-    """The incident directions an RGL file is sampled at (89, the most, when unreadable:
-    the reader then says what is wrong)."""
-    try:
-        theta_i = np.asarray(gonio.rgl.read_tensor_file(path)["theta_i"], dtype=float)
-        return max(1, int(np.count_nonzero(theta_i < np.radians(89.9))))
-    except (OSError, ValueError, KeyError, TypeError):
-        return 89
+def table_estimate(path, **options):
+    """The size of the table ``path`` (:class:`gonio.tablesize.Estimate`), refused when its
+    reading would exceed the memory limit (:func:`gonio.tablesize.check_table`); None when
+    it cannot be told (the reader then says what is wrong)."""
+    path = Path(path)
+    kind = gonio.io.table_kind(path, quiet=True)
+    if kind is None or not path.is_file():
+        return None
+    return gonio.tablesize.check_table(path, kind, **options)
 
 
 def read_table(path, **options):

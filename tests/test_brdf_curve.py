@@ -55,5 +55,5 @@ def test_bad_sampling():
     c = TangentCurve((0, 0), (1,))
     with pytest.raises(ValueError, match="tangent_sampling must be one of"):
         c.samples(8, "random")
-    with pytest.raises(ValueError, match="tangent_samples must be an integer >= 1"):
+    with pytest.raises(ValueError, match="tangent_samples must be an integer in 1..4096"):
         c.samples(0)

@@ -294,7 +294,7 @@ def test_bad_fabric_input():
         ("transmission", "fresnel", "transmission must be one of 'half_angle', 'longitudinal'"),
         ("gap", "none", "gap must be one of 'incident', 'outgoing'"),
         ("tangent_sampling", "random", "tangent_sampling must be one of"),
-        ("tangent_samples", 0, "tangent_samples must be an integer >= 1; got 0"),
+        ("tangent_samples", 0, "tangent_samples must be an integer in 1..4096; got 0"),
         ("tangent_samples", 2.5, "tangent_samples must be an integer"),
         ("masking", "maybe", "masking must be True or False"),
         ("rotation", float("inf"), "rotation must be a finite angle in radians"),

@@ -12,13 +12,12 @@ relative), as :class:`analysis.fit.LogPosterior` predicts it.
 from __future__ import annotations
 
 import dataclasses
-import json
 from pathlib import Path
 
 import numpy as np
 
 import brdf
-from analysis.fit.checkpoint import CONFIG_FILE
+from analysis.fit.checkpoint import CONFIG_FILE, read_config
 from analysis.fit.results import read_results
 from brdf import schema
 
@@ -84,21 +83,17 @@ class MedianFabric:
 
 def _config(folder: Path) -> dict:
     path = folder / CONFIG_FILE
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-        cfg = doc["config"]
-        spec = cfg["spec"]
-        extra = cfg["extra"]       # `microcyl fit` and fit-batch: fabric; fit-measured: preset
-        return {"preset": extra.get("fabric", extra.get("preset")),
-                "options": dict(extra.get("options") or {}),
-                "params": spec["params"], "ties": spec.get("ties", {}),
-                "free": tuple(spec["free"])}
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read the fit's configuration ({exc.strerror or exc}); "
-                         f"is {folder} a `microcyl fit` output folder?") from None
-    except (ValueError, KeyError, TypeError) as exc:
-        raise ValueError(f"{path}: not a `microcyl fit` configuration (missing or bad "
-                         f"{exc})") from None
+    if not path.is_file():
+        raise ValueError(f"{path}: cannot read the fit's configuration (no such file); is "
+                         f"{folder} a `microcyl fit` output folder?")
+    cfg = read_config(path)["config"]      # every field used here checked, errors named
+    spec = cfg["spec"]
+    extra = cfg.get("extra", {})   # `microcyl fit` and fit-batch: fabric; fit-measured: preset
+    preset = extra.get("fabric")
+    return {"preset": extra.get("preset") if preset is None else preset,
+            "options": dict(extra.get("options") or {}),
+            "params": spec["params"], "ties": spec.get("ties", {}),
+            "free": tuple(spec["free"])}
 
 
 def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
@@ -147,6 +142,13 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
         scale = values.get(f"tangent_scale{j}", 1.0)
         if scale != 1.0:
             change["offsets"] = tuple(np.clip(np.asarray(t.offsets) * scale, -90, 90).tolist())
-        threads.append(t.replace(**change))
-    fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+        try:
+            threads.append(t.replace(**change))
+        except ValueError as exc:
+            raise ValueError(f"{folder}: the fit's values make no valid fabric (thread {j}: "
+                             f"{exc})") from None
+    try:
+        fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{folder / CONFIG_FILE}: config.extra.options: {exc}") from None
     return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))

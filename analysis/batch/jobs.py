@@ -14,7 +14,6 @@ import dataclasses
 import glob
 import hashlib
 import json
-import tomllib
 from pathlib import Path
 from typing import Callable
 
@@ -23,6 +22,7 @@ import gonio
 from gonio.io import READ_SUFFIXES
 from analysis.fit.workflow import fit_spec
 from gonio.curet import N_SAMPLES
+from gonio.statefields import load_toml
 
 __all__ = ["BatchJob", "jobs_from_inputs", "read_job_table", "parse_samples"]
 
@@ -174,11 +174,7 @@ def _override(job: BatchJob, folder: Path) -> BatchJob:
     toml = folder / f"{job.name}.toml"
     if not toml.is_file():
         return job
-    try:
-        with open(toml, "rb") as fh:
-            doc = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{toml}: not valid TOML: {exc}") from None
+    doc = load_toml(toml, "fit spec")
     preset = doc.get("fabric", job.preset)
     return dataclasses.replace(job, spec=str(toml), free=None, ties=(), preset=preset)
 

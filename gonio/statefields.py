@@ -28,10 +28,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FileFields", "load_json", "load_toml", "MAX_DEPTH"]
+__all__ = ["FileFields", "load_json", "loads_json", "load_toml", "MAX_DEPTH", "MAX_MAGNITUDE"]
 
 #: Deepest nesting of lists and objects a state file may hold (microcyl writes at most ~6).
 MAX_DEPTH = 64
+#: Largest magnitude of a model parameter read from a file (a fabric JSON, a fit's medians):
+#: beyond it f_r and the float32 pixels of a render overflow (an albedo of 1e308 renders inf),
+#: so it is refused like a range error.
+MAX_MAGNITUDE = 1e6
 
 _MISSING = object()
 

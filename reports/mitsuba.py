@@ -41,6 +41,7 @@ from xml.sax.saxutils import quoteattr
 
 import brdf
 from brdf.fabric import OPTIONS
+from gonio.statefields import MAX_MAGNITUDE
 
 __all__ = ["register", "plugin_dict", "plugin_xml", "fabric_from_dict", "PLUGIN_NAME", "MAX_MAGNITUDE", "THREAD_KEYS",
            "OPTION_KEYS", "RGB_VARIANTS"]
@@ -51,9 +52,6 @@ PLUGIN_NAME = "microcylinder"
 THREAD_KEYS = ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area", "offsets", "lengths")
 #: Option keys: :data:`brdf.OPTIONS` (``rotation`` in degrees here).
 OPTION_KEYS = tuple(OPTIONS)
-#: Largest magnitude of a number in a plugin dictionary: beyond it f_r and the float32 pixels
-#: of a render overflow (an albedo of 1e308 renders inf), so it is refused like a range error.
-MAX_MAGNITUDE = 1e6
 #: The variants the plugin supports (their spectra are RGB triples).
 RGB_VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
 

@@ -20,6 +20,7 @@ import brdf
 from analysis.fit.checkpoint import CONFIG_FILE, read_config
 from analysis.fit.results import read_results
 from brdf import schema
+from gonio.statefields import MAX_MAGNITUDE, FileFields
 
 __all__ = ["MedianFabric", "median_fabric", "FitModel"]
 
@@ -96,6 +97,17 @@ def _config(folder: Path) -> dict:
             "free": tuple(spec["free"])}
 
 
+def _check_magnitudes(folder: Path, values: dict, free) -> None:
+    """Every value at most :data:`gonio.statefields.MAX_MAGNITUDE` in magnitude (an albedo of
+    1e308 is finite but renders inf), naming the file and the field it came from."""
+    for n, v in values.items():
+        if abs(v) > MAX_MAGNITUDE:
+            f, field = ((FileFields(folder / "results.json"), f"parameters.{n}.median")
+                        if n in free else (FileFields(folder / CONFIG_FILE),
+                                           f"config.spec.params.{n}.default"))
+            raise f.error(field, f"a number of magnitude at most {MAX_MAGNITUDE:g}", v)
+
+
 def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
     """The fabric at the posterior medians of the fit in ``fit_dir``.
 
@@ -131,6 +143,7 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
         raise ValueError(f"{folder / 'results.json'}: no median for free parameter(s) "
                          f"{', '.join(missing)}")
     values.update({n: float(medians[n]["median"]) for n in cfg["free"]})
+    _check_magnitudes(folder, values, cfg["free"])
     for target, (source, kind) in cfg["ties"].items():
         values[target] = values[source] if kind == "equal" else 1.0 - values[source]
     threads = []

@@ -212,7 +212,8 @@ def _from_first_layout(path, doc: dict) -> dict:
 def check_results(doc: dict, path) -> dict:
     """``doc`` (a results document read from ``path``) with every field a reader uses checked
     for type, shape and finiteness: ``converged``, ``reason``, each parameter's
-    :data:`SUMMARY_COLUMNS`, ``fit.points``, ``quality`` and ``plots``.
+    :data:`SUMMARY_COLUMNS` (only ``median`` required), ``fit.points``, ``quality`` and
+    ``plots``.
 
     Raises
     ------
@@ -229,8 +230,10 @@ def check_results(doc: dict, path) -> dict:
         for col in SUMMARY_COLUMNS:
             if col == "unit":
                 f.string(params[name], col, where, default="")
-            elif col in FINITE_COLUMNS:
+            elif col == "median":
                 f.number(params[name], col, where)
+            elif col in FINITE_COLUMNS:        # absent from a hand-written file; finite if given
+                f.number(params[name], col, where, default=None)
             else:
                 f.number(params[name], col, where, finite=False, default=None, none=True)
     fit = f.mapping(doc, "fit", default={})

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -33,6 +32,7 @@ from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_
                                  defaults_from_fabric, entry, parse_free, parse_ties,
                                  resolve_ties, unknown)
 from brdf import schema
+from gonio.statefields import load_toml
 
 __all__ = ["Param", "ParamSpec", "INTERNAL_LIMIT", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
            "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric", "parse_free", "parse_ties"]
@@ -204,13 +204,7 @@ class ParamSpec:
             once, before any work.
         """
         path = Path(path)
-        try:
-            with open(path, "rb") as fh:
-                doc = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"{path}: not valid TOML: {exc}") from None
-        except UnicodeDecodeError as exc:
-            raise ValueError(f"{path}: not valid TOML (not UTF-8 text: {exc.reason})") from None
+        doc = load_toml(path, "fit spec")     # unreadable, invalid or nested: one line
         try:
             doc = checked_toml(doc)
             d = checked_defaults(defaults)

@@ -24,6 +24,7 @@ import numpy as np
 
 from analysis.colour import luminance
 from analysis.variants import VARIANTS, check_names
+from brdf import validate
 from brdf.frames import to_angles
 from brdf.presets import fabric as preset_fabric
 from brdf.protocols import BRDF
@@ -147,8 +148,7 @@ def random_pairs(n: int, seed=0) -> tuple[np.ndarray, np.ndarray]:
     >>> wi.shape, bool(np.all(wi[:, 2] > 0))
     ((4, 3), True)
     """
-    if int(n) < 1:
-        raise ValueError(f"n must be >= 1; got {n}")
+    n = validate.integer("n", n, lo=1)
     rng = np.random.default_rng(seed)
     u = rng.random((2, int(n), 2))
     z = 1.0 - u[..., 0]                      # uniform in (0, 1]: uniform in solid angle
@@ -278,6 +278,8 @@ def reciprocity(brdf, pairs=None, *, n: int = 20000, seed=0, channel="luminance"
         raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
     if weight not in ("none", "cos_i"):
         raise ValueError(f"weight must be 'none' or 'cos_i'; got {weight!r}")
+    n = validate.integer("n", n, lo=1)
+    n_worst = validate.integer("n_worst", n_worst, lo=0)
     wi, wo = _as_pairs(pairs, n, seed)
     a, b, name = _both_ways(brdf, wi, wo, channel, weight)
     return _statistics(a, b, name, wi, wo, n_worst)

@@ -159,6 +159,9 @@ def read_rows(path) -> CsvRows:
                     meta[key] = json.loads(raw)
                 except json.JSONDecodeError:
                     meta[key] = raw
+                except RecursionError:
+                    raise FormatError(path, f"line {lineno}: metadata {key!r} is nested too "
+                                            f"deeply") from None
             continue
         fields = [c.strip() for c in stripped.split(",")]
         if header is None:

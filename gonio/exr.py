@@ -223,6 +223,8 @@ def _header_meta(path: Path, header: dict) -> dict:
         meta = json.loads(str(header["microcyl_meta"]))
     except json.JSONDecodeError as exc:
         raise FormatError(path, f"microcyl_meta attribute is not JSON: {exc}") from None
+    except RecursionError:
+        raise FormatError(path, "microcyl_meta attribute is nested too deeply") from None
     if not isinstance(meta, dict):
         raise FormatError(path, "microcyl_meta attribute is not a JSON object")
     return meta

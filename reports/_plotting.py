@@ -15,11 +15,11 @@ from matplotlib.figure import Figure
 from matplotlib.transforms import ScaledTranslation
 
 from brdf.frames import half_diff_to_directions
-from brdf.presets import PRESETS
+from brdf.presets import PRESETS, fabric
 from gonio.atomic import atomic_write
 from reports.colour import CHANNEL_COLOURS, luminance
 
-__all__ = ["new_axes", "finish", "save_figure", "eval_brdf", "reduce_quantity",
+__all__ = ["new_axes", "finish", "save_figure", "as_brdf", "eval_brdf", "reduce_quantity",
            "quantity_styles", "QUANTITIES", "check_quantity", "half_diff_to_io", "check_angle",
            "DPI", "FONT", "PALETTE", "series_style", "preset_style", "series_styles",
            "legend_outside", "log_range", "pow10_label", "shade_zero"]
@@ -206,8 +206,38 @@ def check_angle(name: str, value, lo: float, hi: float) -> np.ndarray:
     return arr
 
 
+def as_brdf(brdf, name: str = "brdf"):
+    """What a plot draws: ``brdf`` itself when it has ``eval(wi, wo)`` (a
+    :class:`brdf.Fabric`, a fit's model, a table), the preset's fabric when it is a name of
+    :data:`brdf.PRESETS`.
+
+    Raises
+    ------
+    ValueError
+        A string that names no preset (the presets are listed).
+    TypeError
+        Anything else, naming ``name`` and the type.
+
+    Examples
+    --------
+    >>> as_brdf("velvet").name
+    'velvet'
+    """
+    if isinstance(brdf, str):
+        if brdf not in PRESETS:
+            raise ValueError(f"{name} must be a preset ({', '.join(PRESETS)}) or a BRDF with "
+                             f"eval(wi, wo); got {brdf!r}")
+        return fabric(brdf)
+    if not callable(getattr(brdf, "eval", None)):
+        raise TypeError(f"{name} must be a preset name or a BRDF with eval(wi, wo) (e.g. a "
+                        f"brdf.Fabric); got {type(brdf).__name__}")
+    return brdf
+
+
 def eval_brdf(brdf, wi, wo) -> np.ndarray:
-    """``brdf.eval(wi, wo)`` broadcast to a common shape, as float64 (..., 3) in 1/sr."""
+    """``brdf.eval(wi, wo)`` broadcast to a common shape, as float64 (..., 3) in 1/sr;
+    ``brdf`` may name a preset (:func:`as_brdf`)."""
+    brdf = as_brdf(brdf)
     wi = np.asarray(wi, dtype=np.float64)
     wo = np.asarray(wo, dtype=np.float64)
     shape = np.broadcast_shapes(wi.shape, wo.shape)

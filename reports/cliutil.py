@@ -4,7 +4,6 @@ writes."""
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import tempfile
@@ -14,6 +13,8 @@ import brdf
 import gonio
 import gonio.io
 import gonio.tablesize
+import gonio.rgl
+from gonio.statefields import load_json
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
@@ -224,9 +225,10 @@ def fabric_source(text: str, what: str = "FABRIC") -> brdf.Fabric:
     if path.is_file() and path.suffix.lower() == ".json":
         from reports.mitsuba import fabric_from_dict    # needs no Mitsuba
         try:
-            doc = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise ValueError(f"{what} {text!r}: unreadable JSON ({exc})") from None
+            doc = load_json(path, "fabric dictionary")   # invalid or nested: one line
+        except ValueError as exc:
+            raise ValueError(f"{what} {text!r}: unreadable JSON "
+                             f"({str(exc).removeprefix(f'{path}: ')})") from None
         if not isinstance(doc, dict) or doc.get("type", "microcylinder") != "microcylinder":
             kind = doc.get("type") if isinstance(doc, dict) else type(doc).__name__
             raise ValueError(f"{what} {text!r}: must hold a microcylinder plugin dictionary "

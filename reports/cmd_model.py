@@ -11,6 +11,7 @@ import numpy as np
 import brdf
 import gonio
 from analysis.folderlock import output_lock
+from analysis.fit.results import read_results
 from reports import cliutil
 from reports.report_batch import write_batch_page
 from reports.standard import STANDARD_GEOMETRIES, standard_values
@@ -141,6 +142,7 @@ def run_report(args):
                              f"{', '.join(brdf.PRESETS)}; got {item!r}")
         if not Path(path).is_file():
             raise ValueError(f"--fit {item!r}: no such file {path!r}")
+        read_results(path)          # a damaged file: one line naming it and the field
         fits[name] = path
     index = build_report(names, args.output, progress=not args.quiet, quality=args.quality,
                          fit_results=fits, measured=args.measured,

@@ -35,13 +35,15 @@ scene files) and back (``microcyl export`` writes either for a fit's posterior m
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from xml.sax.saxutils import quoteattr
 
 import brdf
 from brdf.fabric import OPTIONS
+from gonio.statefields import MAX_MAGNITUDE
 
-__all__ = ["register", "plugin_dict", "plugin_xml", "fabric_from_dict", "PLUGIN_NAME", "THREAD_KEYS",
+__all__ = ["register", "plugin_dict", "plugin_xml", "fabric_from_dict", "PLUGIN_NAME", "MAX_MAGNITUDE", "THREAD_KEYS",
            "OPTION_KEYS", "RGB_VARIANTS"]
 
 #: The plugin's name in Mitsuba's registry.
@@ -140,18 +142,33 @@ def _number(x) -> str:
     return text[:-2] if text.endswith(".0") else text
 
 
+def _finite(key, value, what: str = "a number") -> float:
+    """``value`` as a float: a number (or its text), finite, of magnitude at most
+    :data:`MAX_MAGNITUDE`; else a ValueError naming ``key``."""
+    try:
+        if isinstance(value, bool):
+            raise TypeError
+        x = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{key} must be {what}; got {value!r:.60}") from None
+    if not (math.isfinite(x) and abs(x) <= MAX_MAGNITUDE):
+        raise ValueError(f"{key} must be finite, of magnitude at most {MAX_MAGNITUDE:g}; got "
+                         f"{value!r:.60}")
+    return x
+
+
 def _floats(key, value) -> tuple:
     """A comma-separated string (or a number, or a sequence) as a tuple of floats."""
+    what = "numbers separated by commas"
     if isinstance(value, str):
         parts = [p for p in value.replace(",", " ").split() if p]
-    elif isinstance(value, (int, float)):
+    elif isinstance(value, numbers.Real):
         parts = [value]
-    else:
+    elif isinstance(value, (list, tuple)):
         parts = list(value)
-    try:
-        return tuple(float(p) for p in parts)
-    except (TypeError, ValueError):
-        raise ValueError(f"{key} must be numbers separated by commas; got {value!r}") from None
+    else:
+        raise ValueError(f"{key} must be {what}; got {value!r:.60}")
+    return tuple(_finite(key, p, what) for p in parts)
 
 
 def _rgb(key, value) -> tuple:
@@ -161,13 +178,12 @@ def _rgb(key, value) -> tuple:
             raise ValueError(f"{key} must be a number or {{'type': 'rgb', 'value': [r, g, b]}}; "
                              f"got {value!r}")
         value = value["value"]
-    if isinstance(value, (int, float)):
-        return (float(value),) * 3
-    try:
-        rgb = tuple(float(value[i]) for i in range(3))
-    except (TypeError, ValueError, IndexError):
-        raise ValueError(f"{key} must be a number or an RGB triple; got {value!r}") from None
-    return rgb
+    what = "a number or an RGB triple"
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return (_finite(key, value, what),) * 3
+    if not isinstance(value, (list, tuple)) or len(value) != 3:
+        raise ValueError(f"{key} must be {what}; got {value!r:.60}")
+    return tuple(_finite(key, v, what) for v in value)
 
 
 def fabric_from_dict(props: Mapping) -> brdf.Fabric:
@@ -216,10 +232,7 @@ def fabric_from_dict(props: Mapping) -> brdf.Fabric:
             elif key in ("offsets", "lengths"):
                 v = _floats(f"{key}{j}", v)
             else:
-                try:
-                    v = float(v)
-                except (TypeError, ValueError):
-                    raise ValueError(f"{key}{j} must be a number; got {v!r}") from None
+                v = _finite(f"{key}{j}", v)
             changes[key] = v
         try:
             threads[j - 1] = threads[j - 1].replace(**changes)
@@ -227,7 +240,8 @@ def fabric_from_dict(props: Mapping) -> brdf.Fabric:
             raise ValueError(f"thread {j}: {exc}") from None
     options = {k: props[k] for k in OPTION_KEYS if k in props}
     if "rotation" in options:
-        options["rotation"] = math.radians(float(options["rotation"]))
+        options["rotation"] = math.radians(_finite("rotation", options["rotation"],
+                                                   "a number of degrees"))
     return brdf.Fabric(threads, name=str(name), **options)
 
 

@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from brdf.frames import from_angles
-from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish, legend_outside,
+from reports._plotting import (FONT, as_brdf, check_angle, check_quantity, eval_brdf, finish, legend_outside,
                                new_axes, pow10_label, quantity_styles, series_styles,
                                reduce_quantity, series_style)
 
@@ -154,8 +154,8 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
 
     Parameters
     ----------
-    brdf : object
-        Anything with ``.eval(wi, wo) -> (..., 3)`` f_r in 1/sr.
+    brdf : object or str
+        Anything with ``.eval(wi, wo) -> (..., 3)`` f_r in 1/sr, or a preset's name.
     theta_i_deg : float or sequence of float
         Incidence angles in degrees, each in [0, 90).
     phi_deg : float
@@ -197,6 +197,7 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
         "lobe theta_i=<deg> <channel>".
     """
     _check_scale(scale)
+    brdf = as_brdf(brdf)
     thetas = np.atleast_1d(check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999))
     check_angle("phi_deg", phi_deg, -360.0, 360.0)
     if int(resolution) < 3:

@@ -97,3 +97,12 @@ def test_report_variants_and_felts(shared_data):
     if felt.is_file():
         m = [r for r in rep.rows if r["source"] == "measured"][0]
         assert m["random"]["median"] < d["default"]["median"]
+
+
+@pytest.mark.parametrize("n", [2.5, 0, True, "3", None])
+def test_a_pair_count_that_is_no_integer_is_refused_by_name(n):
+    with pytest.raises(ValueError, match="n must be an integer >= 1"):
+        reciprocity(Lambert(), n=n)
+    with pytest.raises(ValueError, match="n_worst must be an integer >= 0"):
+        reciprocity(Lambert(), n=10, n_worst=1.5)
+    assert reciprocity(Lambert(), n=np.int64(3)).n_included == 3

@@ -126,3 +126,12 @@ def test_empty_table_is_refused_before_writing(tmp_path):
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(ValueError, match="digits must be an integer >= 1; got 0"):
         gonio.write_csv(random_table(1), tmp_path / "t.csv", digits=0)
+
+
+def test_deeply_nested_metadata_is_one_line_naming_file_and_line(tmp_path):
+    p = tmp_path / "deep.csv"
+    p.write_text("# source: " + "[" * 100_000 + "]" * 100_000 + "\n"
+                 "theta_i,phi_i,theta_o,phi_o,value\n0,0,0,0,0.3\n")
+    with pytest.raises(ValueError, match=r"deep\.csv.*line 1: metadata 'source' is nested "
+                                         r"too deeply"):
+        gonio.read(p)

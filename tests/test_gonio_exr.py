@@ -116,3 +116,17 @@ def test_tables_are_images_of_a_viewable_shape(tmp_path):
         f.write(str(tmp_path / "old.exr"))
     old = gonio.read(tmp_path / "old.exr")
     np.testing.assert_array_equal(old.values, gonio.read(tmp_path / "pairs.exr").values)
+
+
+def test_deeply_nested_metadata_names_the_file(tmp_path):
+    import OpenEXR
+    chans = {c: np.zeros((1, 2), dtype=np.float32)
+             for c in ("R", "G", "B", "theta_i", "phi_i", "theta_o", "phi_o")}
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
+              "microcyl_format": "microcyl-table/1", "angle_unit": "radian",
+              "microcyl_rows": "2", "microcyl_meta": "[" * 100_000 + "]" * 100_000}
+    with OpenEXR.File(header, chans) as f:
+        f.write(str(tmp_path / "deep.exr"))
+    with pytest.raises(ValueError, match=r"deep\.exr.*microcyl_meta attribute is nested too "
+                                         r"deeply"):
+        gonio.read(tmp_path / "deep.exr")

@@ -384,3 +384,14 @@ def test_reciprocity_map_and_statistics_share_one_definition():
     y = lambda f: f @ np.array([0.2126, 0.7152, 0.0722])
     a, b = y(fab.eval(wi[2, 5], wo[2, 5])), y(fab.eval(wo[2, 5], wi[2, 5]))
     assert err[2, 5] == pytest.approx(abs(a - b) / max(a, b), rel=1e-12)
+
+
+def test_polar_lobe_takes_a_preset_name_and_names_anything_else():
+    fig, ax = plots.plot_polar_lobe("velvet", 30.0, 0.0, resolution=7)
+    ref, _ = plots.plot_polar_lobe(brdf.fabric("velvet"), 30.0, 0.0, resolution=7)
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(),
+                                  ref.axes[0].get_lines()[0].get_ydata())
+    with pytest.raises(ValueError, match="brdf must be a preset.*'velour'"):
+        plots.plot_polar_lobe("velour")
+    with pytest.raises(TypeError, match="brdf must be a preset name or a BRDF.*int"):
+        plots.plot_polar_lobe(3)

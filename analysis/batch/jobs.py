@@ -23,7 +23,6 @@ import glob
 import hashlib
 import json
 import os
-import tomllib
 from pathlib import Path
 from typing import Callable
 
@@ -33,6 +32,7 @@ from gonio.io import READ_SUFFIXES
 from analysis.fit.workflow import fit_spec
 from gonio.curet import N_SAMPLES
 from gonio.safenames import digest, safe_component
+from gonio.statefields import load_toml
 
 __all__ = ["BatchJob", "jobs_from_inputs", "read_job_table", "parse_samples", "table_names"]
 
@@ -234,11 +234,7 @@ def _override(job: BatchJob, folder: Path, stem: str) -> BatchJob:
     toml = folder / f"{stem}.toml"
     if not toml.is_file():
         return job
-    try:
-        with open(toml, "rb") as fh:
-            doc = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{toml}: not valid TOML: {exc}") from None
+    doc = load_toml(toml, "fit spec")
     preset = doc.get("fabric", job.preset)
     return dataclasses.replace(job, spec=str(toml), free=None, ties=(), preset=preset)
 

@@ -12,15 +12,15 @@ relative), as :class:`analysis.fit.LogPosterior` predicts it.
 from __future__ import annotations
 
 import dataclasses
-import json
 from pathlib import Path
 
 import numpy as np
 
 import brdf
-from analysis.fit.checkpoint import CONFIG_FILE
+from analysis.fit.checkpoint import CONFIG_FILE, read_config
 from analysis.fit.results import read_results
 from brdf import schema
+from gonio.statefields import MAX_MAGNITUDE, FileFields
 
 __all__ = ["MedianFabric", "median_fabric", "FitModel"]
 
@@ -84,21 +84,28 @@ class MedianFabric:
 
 def _config(folder: Path) -> dict:
     path = folder / CONFIG_FILE
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-        cfg = doc["config"]
-        spec = cfg["spec"]
-        extra = cfg["extra"]       # `microcyl fit` and fit-batch: fabric; fit-measured: preset
-        return {"preset": extra.get("fabric", extra.get("preset")),
-                "options": dict(extra.get("options") or {}),
-                "params": spec["params"], "ties": spec.get("ties", {}),
-                "free": tuple(spec["free"])}
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read the fit's configuration ({exc.strerror or exc}); "
-                         f"is {folder} a `microcyl fit` output folder?") from None
-    except (ValueError, KeyError, TypeError) as exc:
-        raise ValueError(f"{path}: not a `microcyl fit` configuration (missing or bad "
-                         f"{exc})") from None
+    if not path.is_file():
+        raise ValueError(f"{path}: cannot read the fit's configuration (no such file); is "
+                         f"{folder} a `microcyl fit` output folder?")
+    cfg = read_config(path)["config"]      # every field used here checked, errors named
+    spec = cfg["spec"]
+    extra = cfg.get("extra", {})   # `microcyl fit` and fit-batch: fabric; fit-measured: preset
+    preset = extra.get("fabric")
+    return {"preset": extra.get("preset") if preset is None else preset,
+            "options": dict(extra.get("options") or {}),
+            "params": spec["params"], "ties": spec.get("ties", {}),
+            "free": tuple(spec["free"])}
+
+
+def _check_magnitudes(folder: Path, values: dict, free) -> None:
+    """Every value at most :data:`gonio.statefields.MAX_MAGNITUDE` in magnitude (an albedo of
+    1e308 is finite but renders inf), naming the file and the field it came from."""
+    for n, v in values.items():
+        if abs(v) > MAX_MAGNITUDE:
+            f, field = ((FileFields(folder / "results.json"), f"parameters.{n}.median")
+                        if n in free else (FileFields(folder / CONFIG_FILE),
+                                           f"config.spec.params.{n}.default"))
+            raise f.error(field, f"a number of magnitude at most {MAX_MAGNITUDE:g}", v)
 
 
 def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
@@ -136,6 +143,7 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
         raise ValueError(f"{folder / 'results.json'}: no median for free parameter(s) "
                          f"{', '.join(missing)}")
     values.update({n: float(medians[n]["median"]) for n in cfg["free"]})
+    _check_magnitudes(folder, values, cfg["free"])
     for target, (source, kind) in cfg["ties"].items():
         values[target] = values[source] if kind == "equal" else 1.0 - values[source]
     threads = []
@@ -147,6 +155,13 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
         scale = values.get(f"tangent_scale{j}", 1.0)
         if scale != 1.0:
             change["offsets"] = tuple(np.clip(np.asarray(t.offsets) * scale, -90, 90).tolist())
-        threads.append(t.replace(**change))
-    fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+        try:
+            threads.append(t.replace(**change))
+        except ValueError as exc:
+            raise ValueError(f"{folder}: the fit's values make no valid fabric (thread {j}: "
+                             f"{exc})") from None
+    try:
+        fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{folder / CONFIG_FILE}: config.extra.options: {exc}") from None
     return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))

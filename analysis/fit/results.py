@@ -33,14 +33,19 @@ from analysis import diagnostics
 from analysis.fit.quality import residuals
 from gonio import atomic_write
 from gonio.jsonplain import plain
+from gonio.statefields import FileFields, load_json
 
-__all__ = ["FitResult", "write_results", "read_results", "summarize", "SCHEMA_VERSION", "SUMMARY_COLUMNS"]
+__all__ = ["FitResult", "write_results", "read_results", "summarize", "check_results",
+           "SCHEMA_VERSION", "SUMMARY_COLUMNS"]
 
 #: Version of the ``results.json`` layout.
 SCHEMA_VERSION = 2
 #: Columns of each parameter's summary (and of ``results.csv``).
 SUMMARY_COLUMNS = ("median", "lo68", "hi68", "lo95", "hi95", "tau", "n_over_tau", "rhat",
                    "ess", "unit")
+#: The columns that are always finite (the others may be NaN or infinite: a chain too short
+#: for its autocorrelation time).
+FINITE_COLUMNS = ("median", "lo68", "hi68", "lo95", "hi95")
 
 
 @dataclasses.dataclass
@@ -185,26 +190,78 @@ def read_results(path) -> dict:
     """Read a ``results.json`` into the current layout (schema version 2).
 
     Files of the first layout (parameters at the top level, the rest under ``_fit``) are
-    converted. Returns the document; raises ``ValueError`` naming the file when it is not a
-    fit's results.
+    converted. Every field a reader uses is checked (:func:`check_results`).
+
+    Returns the document; raises ``ValueError`` naming the file (and the field) when it is not
+    a fit's results.
     """
     path = Path(path)
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"{path}: cannot read fit results ({exc})") from None
+    doc = load_json(path, "fit's results.json")
     if not isinstance(doc, dict):
         raise ValueError(f"{path}: not a fit's results.json (not a JSON object)")
-    if doc.get("schema") == "microcyl-fit":
-        return doc
-    old = doc.get("_fit", {})
-    report = old.get("report", {})
-    quality = dict(old.get("quality", {}))
+    if doc.get("schema") != "microcyl-fit":
+        doc = _from_first_layout(path, doc)
+    return check_results(doc, path)
+
+
+def _from_first_layout(path, doc: dict) -> dict:
+    f = FileFields(path)
+    old = f.mapping(doc, "_fit", default={})
+    report = f.mapping(old, "report", "_fit", default={})
+    quality = dict(f.mapping(old, "quality", "_fit", default={}))
     quality.update({k: v for k, v in report.items() if k.startswith("albedo")})
+    plots = f.mapping(report, "plots", "_fit.report", default={})
+    for k, v in plots.items():
+        f.string(plots, k, "_fit.report.plots")
     return {"schema": "microcyl-fit", "schema_version": 1,
             "converged": doc.get("converged"), "reason": old.get("reason", ""),
             "parameters": {k: v for k, v in doc.items()
                            if isinstance(v, dict) and "median" in v},
             "fit": {k: v for k, v in old.items() if k not in ("quality", "report", "reason")},
             "quality": quality,
-            "plots": {k: Path(v).name for k, v in report.get("plots", {}).items()}}
+            "plots": {k: Path(v).name for k, v in plots.items()}}
+
+
+def check_results(doc: dict, path) -> dict:
+    """``doc`` (a results document read from ``path``) with every field a reader uses checked
+    for type, shape and finiteness: ``converged``, ``reason``, each parameter's
+    :data:`SUMMARY_COLUMNS` (only ``median`` required), ``fit.points``, ``quality`` and
+    ``plots``.
+
+    Raises
+    ------
+    ValueError
+        ``PATH: FIELD must be ...; got ...`` for the first bad field.
+    """
+    f = FileFields(path)
+    f.boolean(doc, "converged", none=True)
+    f.string(doc, "reason", default="")
+    params = f.mapping(doc, "parameters")
+    for name in params:
+        where = f"parameters.{name}"
+        f.mapping(params, name, "parameters")
+        for col in SUMMARY_COLUMNS:
+            if col == "unit":
+                f.string(params[name], col, where, default="")
+            elif col == "median":
+                f.number(params[name], col, where)
+            elif col in FINITE_COLUMNS:        # absent from a hand-written file; finite if given
+                f.number(params[name], col, where, default=None)
+            else:
+                f.number(params[name], col, where, finite=False, default=None, none=True)
+    fit = f.mapping(doc, "fit", default={})
+    points = f.mapping(fit, "points", "fit", default={})
+    for k in points:
+        f.integer(points, k, "fit.points", lo=0)
+    for k in ("steps", "burn", "walkers", "ensembles"):
+        f.integer(fit, k, "fit", lo=0, default=None, none=True)
+    quality = f.mapping(doc, "quality", default={})
+    for k in ("rms_residual", "rms_normalized", "albedo_delta_e2000"):
+        f.number(quality, k, "quality", finite=False, default=None, none=True)
+    f.integer(quality, "values", "quality", lo=0, default=None, none=True)
+    for k in ("albedo_measured", "albedo_predicted"):
+        f.array(quality, k, "quality", shape=(3,), finite=False, default=None, none=True)
+    plots = f.mapping(doc, "plots", default={})
+    for k in plots:
+        f.string(plots, k, "plots")
+    return doc

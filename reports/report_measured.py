@@ -100,6 +100,11 @@ def _f(v, fmt=".4g") -> str:
         return str(v)
 
 
+def _interval(p: dict, level: str) -> str:
+    """``[lo, hi]`` of a parameter's interval at ``level`` ("68" or "95"); "-" where absent."""
+    return f"[{_f(p.get('lo' + level))}, {_f(p.get('hi' + level))}]"
+
+
 def _elpd(loo) -> str:
     """``elpd ± se`` of a ``loo`` entry of results.json, "-" without one."""
     if not isinstance(loo, dict) or loo.get("elpd") is None:
@@ -180,10 +185,9 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         doc = e["results"]
         res = doc.get("parameters", {})
         params = list(res)
-        rows = [[k, _f(res[k]["median"]), f"[{_f(res[k]['lo68'])}, {_f(res[k]['hi68'])}]",
-                 f"[{_f(res[k]['lo95'])}, {_f(res[k]['hi95'])}]", res[k].get("unit", ""),
-                 _f(res[k].get("tau"), ".1f"), _f(res[k].get("rhat"), ".4f"),
-                 _f(res[k].get("ess"), ".0f")] for k in params]
+        rows = [[k, _f(res[k].get("median")), _interval(res[k], "68"), _interval(res[k], "95"),
+                 res[k].get("unit", ""), _f(res[k].get("tau"), ".1f"),
+                 _f(res[k].get("rhat"), ".4f"), _f(res[k].get("ess"), ".0f")] for k in params]
         dest = check_inside(root / folder / name, root)     # name: a safe component
         dest.mkdir(parents=True, exist_ok=True)
         figs = []

@@ -53,12 +53,19 @@ def test_fit_writes_results_and_plots(table_file, tmp_path, capsys):
         assert np.isfinite(par["kd1"][k])
     assert par["gamma_s1"]["lo95"] < 5.0 < par["gamma_s1"]["hi95"]
     assert doc["quality"]["albedo_delta_e2000"] < 2.0   # same model, 5% noise: barely visible
-    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals"}
-    for name in ("corner", "traces", "lobes", "residuals"):
+    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "adequacy"}
+    for name in ("corner", "traces", "lobes", "residuals", "adequacy"):
         assert (out / f"{name}.png").stat().st_size > 1000
     assert (out / "results.csv").exists()
+    # the model that made the table describes it; both informed, nothing at a bound
+    assert doc["adequate"] is True and doc["quality"]["adequacy"]["tests"]["distribution"]["p"]
+    assert doc["warnings"] == []
     text = capsys.readouterr().out
     assert "gamma_s1" in text and "results:" in text
+    lines = text.splitlines()
+    verdict = next(i for i, line in enumerate(lines) if line.startswith("CONVERGED") or
+                   "step limit" in line)
+    assert lines[verdict + 1].startswith("ADEQUATE: no test rejects the model")
     # same command again: resumes (no new optimisation), same folder accepted
     assert main(args[:-2] + ["--no-plots", "-o", str(out)]) == 0
 

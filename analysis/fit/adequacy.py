@@ -23,9 +23,11 @@ with the distribution the likelihood (:mod:`analysis.likelihood`) assumes for th
   channels the data may have) and two regions of each split are compared by a two-sided
   Mann-Whitney U test (scipy.stats.mannwhitneyu, distribution-free): forward against back
   scatter (cos(phi_o - phi_i) < 0 or > 0, both directions at least 5 degrees off the normal),
-  warp plane against weft plane (the half vector nearer the x-z or the y-z plane), grazing
+  warp plane against weft plane (the half vector h nearer the x-z or the y-z plane), grazing
   against near-normal (theta_i or theta_o >= 60 degrees, or both below), left against right
-  (h_x < 0 or > 0). A split with fewer than :data:`MIN_REGION` points on a side is skipped.
+  (h_x < 0 or > 0). The warp/weft split leaves out pairs whose h is within 5 degrees of the
+  normal, the left/right split those within 5 degrees of the y-z plane. A split with fewer
+  than :data:`MIN_REGION` points on a side is skipped.
 - ``noise``: where the noise is fitted, its level exp(log_noise) (median, 95% interval)
   against the table's own sigma in the same space (the median of sigma_y), as their ratio.
 
@@ -114,22 +116,26 @@ def regions(wi, wo) -> dict[str, tuple[str, str, np.ndarray, np.ndarray]]:
     >>> wo = np.array([[-0.5, 0, 0.866], [0.5, 0, 0.866]])
     >>> fwd, back = regions(wi, wo)["forward_back"][2:]
     >>> fwd.tolist(), back.tolist()
-    [True, False] [False, True]
+    ([True, False], [False, True])
     """
     wi, wo = np.asarray(wi, float), np.asarray(wo, float)
     sin_pole = np.sin(np.radians(POLE_DEG))
-    off_pole = (np.hypot(wi[:, 0], wi[:, 1]) >= sin_pole) & (np.hypot(wo[:, 0], wo[:, 1]) >= sin_pole)
+    off_pole = ((np.hypot(wi[:, 0], wi[:, 1]) >= sin_pole)
+                & (np.hypot(wo[:, 0], wo[:, 1]) >= sin_pole))
     dot = wi[:, 0] * wo[:, 0] + wi[:, 1] * wo[:, 1]
     h = wi + wo
+    h = h / np.linalg.norm(h, axis=1, keepdims=True)
+    h_off = np.hypot(h[:, 0], h[:, 1]) >= sin_pole      # a half vector with an azimuth
+    hx, hy = np.abs(h[:, 0]), np.abs(h[:, 1])
     cos_graze = np.cos(np.radians(GRAZING_DEG))
     grazing = (wi[:, 2] <= cos_graze) | (wo[:, 2] <= cos_graze)
     return {
         "forward_back": ("forward scatter", "back scatter", off_pole & (dot < 0),
                          off_pole & (dot > 0)),
-        "warp_weft": ("warp plane", "weft plane", np.abs(h[:, 1]) < np.abs(h[:, 0]),
-                      np.abs(h[:, 1]) > np.abs(h[:, 0])),
+        "warp_weft": ("warp plane", "weft plane", h_off & (hy < hx), h_off & (hy > hx)),
         "grazing_normal": ("grazing", "near-normal", grazing, ~grazing),
-        "left_right": ("left (h_x < 0)", "right (h_x > 0)", h[:, 0] < 0, h[:, 0] > 0),
+        "left_right": ("left (h_x < 0)", "right (h_x > 0)", h[:, 0] <= -sin_pole,
+                       h[:, 0] >= sin_pole),
     }
 
 

@@ -18,7 +18,8 @@
 
 ``converged`` is the sampler's verdict; ``adequate`` (true, false or null) whether the model
 describes the data (:mod:`analysis.fit.adequacy`); ``warnings`` what the answer cannot be
-trusted for (:mod:`analysis.fit.trust`). Intervals are central (68%: 15.9-84.1 percentiles), in each parameter's natural unit.
+trusted for (:mod:`analysis.fit.trust`). Intervals are central (68%: 15.9-84.1 percentiles),
+in each parameter's natural unit.
 """
 
 from __future__ import annotations

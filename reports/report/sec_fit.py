@@ -1,4 +1,5 @@
-"""The "fit" section: the posterior summary of a ``microcyl fit`` of the fabric."""
+"""The "fit" section: the posterior summary of a ``microcyl fit`` of the fabric, its verdicts
+(converged, adequate) and its warnings."""
 
 from __future__ import annotations
 
@@ -28,7 +29,8 @@ class FitData:
 
 
 def section_fit(p: Page) -> Section:
-    """Per parameter: median, 68 % and 95 % intervals, τ, R-hat, ESS; and convergence.
+    """Per parameter: median, 68 % and 95 % intervals, τ, R-hat, ESS; convergence, adequacy
+    and the warnings (:mod:`analysis.fit.trust`).
 
     Raises
     ------
@@ -45,5 +47,19 @@ def section_fit(p: Page) -> Section:
     rows = [[k] + [fmt(v.get(f)) for f in _COLUMNS] for k, v in data["parameters"].items()]
     return Section(table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat",
                           "ESS"], rows)
-                   + f"<p>Converged: {html.escape(fmt(data.get('converged')))}</p>",
-                   FitData(data))
+                   + f"<p>Converged: {html.escape(fmt(data.get('converged')))}</p>"
+                   + _trust(data), FitData(data))
+
+
+def _trust(data: dict) -> str:
+    """The adequacy verdict and the warnings (every value escaped)."""
+    adequate = data.get("adequate")
+    out = (f"<p>Adequate (the model describes the data): {html.escape(fmt(adequate))}"
+           f" — {html.escape(str(data.get('adequate_reason', 'not checked')))}</p>")
+    warnings = data.get("warnings") or []
+    if not isinstance(warnings, list):
+        return out
+    rows = [[str(w.get("kind", "")), ", ".join(map(str, w.get("parameters") or [])),
+             str(w.get("message", ""))] for w in warnings if isinstance(w, dict)]
+    return out + (table(["warning", "parameters", "message"], rows) if rows
+                  else "<p>No warnings.</p>")

@@ -24,6 +24,9 @@ PLOTS = {
              "incidence, over the table's points in that plane.",
     "residuals": "Normalized residuals (data minus posterior-median model over the noise "
                  "scale) on the half-vector disk.",
+    "adequacy": "Standardized residuals per point against angle (N(0, 1) where the model "
+                "fits; forward and back scatter in two colours), the adequacy verdict and the "
+                "warnings.",
     "corner": "Posterior marginals and pairs (corner).",
     "traces": "Traces of some walkers of every ensemble (after burn-in).",
 }
@@ -80,16 +83,31 @@ def _table(header, rows) -> str:
 
 
 def overview_table(measured: dict) -> str:
-    """One row per dataset: preset, size, verdict, residuals, colour difference."""
+    """One row per dataset: preset, size, verdicts, warnings, residuals, colour difference."""
     rows = []
     for name, e in measured.items():
         q = e.get("quality", {})
+        doc = e.get("results") or {}
+        kinds = sorted({str(w.get("kind")) for w in doc.get("warnings") or []
+                        if isinstance(w, dict)})
         rows.append([name, e.get("preset", "-"), e.get("values_used", "-"),
                      "yes" if e.get("converged") else "NO", e.get("steps", "-"),
+                     {True: "yes", False: "NO"}.get(doc.get("adequate"), "-"),
+                     ", ".join(kinds) or "-",
                      _f(q.get("rms_residual"), ".3f"), _f(q.get("rms_normalized"), ".2f"),
                      _f(e.get("albedo_delta_e2000"), ".1f")])
-    return _table(["dataset", "start preset", "values", "converged", "steps",
-                   "residual rms", "normalized rms", "albedo ΔE2000"], rows)
+    return _table(["dataset", "start preset", "values", "converged", "steps", "adequate",
+                   "warnings", "residual rms", "normalized rms", "albedo ΔE2000"], rows)
+
+
+def _trust(doc: dict) -> str:
+    """A fit's adequacy verdict and its warnings, escaped."""
+    head = {True: "adequate", False: "NOT adequate"}.get(doc.get("adequate"), "adequacy unknown")
+    items = "".join(f"<li>{html.escape(str(w.get('kind')))}: "
+                    f"{html.escape(str(w.get('message')))}</li>"
+                    for w in doc.get("warnings") or [] if isinstance(w, dict))
+    return (f"<p><b>{head}</b>: {html.escape(str(doc.get('adequate_reason', 'not checked')))}"
+            f"</p>" + (f"<ul>{items}</ul>" if items else "<p>No warnings.</p>"))
 
 
 def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple[str, dict]:
@@ -108,8 +126,11 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             'The residual rms is taken in the likelihood\'s space, log(1 + f_r cos θ<sub>i</sub>); '
             'the normalized rms is in units of the noise the fit found (near 1 when the model '
             'explains the data to within it). ΔE2000 compares the albedo colours of the data and '
-            'of the posterior-median model over the same directions (for grey tables, the grey '
-            'levels).</p>', overview_table(measured)]
+            'of the posterior-median model over the same directions (none for grey tables: '
+            'they hold no colour). <i>Adequate</i> says whether the model describes the data '
+            'to within its noise (posterior predictive tests of the residuals); the warnings '
+            'say which answers the data do not support (parameters at a bound, not informed, '
+            'correlated).</p>', overview_table(measured)]
     summary = {}
     for name, e in measured.items():
         doc = e["results"]
@@ -147,6 +168,7 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             f"<b>{html.escape(str(e.get('preset', '')))}</b>; ties: "
             f"{html.escape(', '.join(e.get('ties', [])))}.</p>"
             f"<p><b>{verdict}</b>: {html.escape(str(e.get('reason', '')))}</p>"
+            + _trust(doc) +
             f"<p>Residual rms {_f(q.get('rms_residual'), '.4f')} (normalized "
             f"{_f(q.get('rms_normalized'), '.2f')}); albedo ΔE2000 "
             f"{_f(e.get('albedo_delta_e2000'), '.2f')}. Data: "
@@ -155,6 +177,7 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             + _table(["parameter", "median", "68%", "95%", "unit", "τ", "R-hat", "ESS"], rows)
             + "".join(figs) + "</section>")
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
+                         "adequate": doc.get("adequate"), "warnings": doc.get("warnings", []),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
                          "parameters": {k: {f: res[k].get(f) for f in
                                             ("median", "lo68", "hi68", "lo95", "hi95", "tau",

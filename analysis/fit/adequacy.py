@@ -31,6 +31,10 @@ with the distribution the likelihood (:mod:`analysis.likelihood`) assumes for th
 - ``noise``: where the noise is fitted, its level exp(log_noise) (median, 95% interval)
   against the table's own sigma in the same space (the median of sigma_y), as their ratio.
 
+Values the likelihood masks do not enter. Where a table's noise makes small values negative
+(an instrument floor), dropping them leaves the rest biased upward there, and the tests see
+it even at the true parameters: the reason then says how many were masked.
+
 The verdict ``adequate`` is false when any test's p-value, Holm-corrected over the tests that
 ran, is below :data:`ALPHA`; true when none is; None when no test could run (too few values,
 or a result without its posterior). With thousands of values the tests detect small
@@ -246,6 +250,11 @@ def adequacy(result, wi=None, wo=None) -> dict:
            "noise": _noise(result, lik),
            "rms_normal_score": float(np.sqrt(np.mean(scores[ok] ** 2)))}
     out.update(_verdict(tests, reg))
+    masked = lik.counts["invalid_value"]
+    if out["adequate"] is False and masked > 0.01 * lik.counts["total"]:
+        out["reason"] += (f"; note: {masked} values were masked as NaN or negative, and "
+                          f"dropping negative values near the noise floor biases the rest "
+                          f"upward (a matter of the likelihood, not of the model)")
     return out
 
 

@@ -62,9 +62,11 @@ def test_three_fits_and_one_error_naming_the_file(batch):
         for p in FREE:     # the simulated tables' truth inside the 95% intervals
             assert r[f"{p}_lo95"] <= truth[p] <= r[f"{p}_hi95"], (name, p)
         assert (out / name / "results.json").exists()
+        # the generating preset describes its own tables; both parameters are informed
+        assert r["adequate"] is True and r["warnings"] == "", (name, r["warnings"])
     csv_lines = (out / "summary.csv").read_text().splitlines()
     assert csv_lines[0].startswith("name,status,error,steps,wall_s")
-    assert "kd1_median" in csv_lines[0] and len(csv_lines) == 5
+    assert "kd1_median" in csv_lines[0] and "adequate" in csv_lines[0] and len(csv_lines) == 5
     assert len(lines) == 4 and any(line.startswith("corrupt: error") for line in lines)
 
 

@@ -71,7 +71,14 @@ def test_implausible_only_outside_the_typical_range():
     spec = ParamSpec("eta1", defaults={"eta1": 1.5}, bounds={"eta1": (1.001, 6.0)})
     w = fit_warnings(_stub(spec, np.random.default_rng(1).normal(4.0, 0.05, (2000, 1))))
     assert _kinds(w) == {("implausible", ("eta1",))}
-    assert "[1.01, 3]" in w[0]["message"]
+    assert "[1.3, 1.8]" in w[0]["message"]
+    # eta 1.06, inside the search range [1.01, 3], is no fibre's (the CUReT linen fit)
+    w = fit_warnings(_stub(ParamSpec("eta1", defaults={"eta1": 1.5}),
+                           np.random.default_rng(1).normal(1.06, 0.01, (2000, 1))))
+    assert _kinds(w) == {("implausible", ("eta1",))}
+    # an albedo has no tighter range than its typical one: 0.9 is plausible
+    spec = ParamSpec("albedo1_r", defaults={"albedo1_r": 0.5})
+    assert fit_warnings(_stub(spec, np.random.default_rng(1).normal(0.9, 0.01, (2000, 1)))) == []
 
 
 def test_checks_are_a_list_another_kind_can_join():

@@ -31,8 +31,10 @@ def run_job(job: BatchJob, out_dir) -> dict:
     -------
     dict
         ``name``, ``status`` (converged, not_converged or error), ``error``, ``steps``,
-        ``wall_s`` (seconds), ``path``, ``sample``, ``preset``, ``reason``, ``folder``, and
-        ``<parameter>_median``, ``_lo95``, ``_hi95`` of every free parameter.
+        ``wall_s`` (seconds), ``path``, ``sample``, ``preset``, ``reason``, ``folder``,
+        ``adequate`` (the fit's adequacy verdict: true, false or None), ``warnings`` (each
+        warning's kind and parameters, ``"; "``-separated), and ``<parameter>_median``,
+        ``_lo95``, ``_hi95`` of every free parameter.
     """
     t0 = time.perf_counter()
     folder = Path(out_dir) / job.name
@@ -75,7 +77,10 @@ def result_row(job: BatchJob, result, wall_s: float) -> dict:
     row = _base(job)
     row.update(status="converged" if result.converged else "not_converged",
                steps=int(result.steps), wall_s=round(float(wall_s), 3), reason=result.reason,
-               resumed_from=int(result.timing.get("resumed_from", 0)))
+               resumed_from=int(result.timing.get("resumed_from", 0)),
+               adequate=result.adequacy.get("adequate"),
+               warnings="; ".join(f"{w['kind']} {','.join(w['parameters'])}".strip()
+                                  for w in result.warnings))
     for name in result.names:
         s = result.summary[name]
         row[f"{name}_median"] = float(s["median"])

@@ -10,8 +10,10 @@ Each warning is ``{"kind", "parameters", "message"}``, computed from the posteri
   its ties and the area constraint included), from :data:`PRIOR_DRAWS` draws of it.
 - ``correlated``: two free parameters with |corr| > 0.95 (Pearson, where each prior is flat):
   the data fix a combination of the two, along a ridge the message describes.
-- ``implausible``: a posterior median outside the typical range real cloth takes
-  (:attr:`brdf.schema.ParamInfo.typical`; only a fit whose bounds were widened can go there).
+- ``implausible``: a posterior median outside the range real cloth takes: brdf.schema's
+  :attr:`~brdf.schema.ParamInfo.plausible` range where it gives one (eta: 1.3 to 1.8, textile
+  fibres), else its :attr:`~brdf.schema.ParamInfo.typical` range (the fit's default bounds,
+  so only a fit whose bounds were widened can leave it).
 - ``misfit``: the model does not describe the data (:func:`analysis.fit.adequacy.adequacy`).
 
 :data:`CHECKS` lists the checks, each ``check(result) -> list of warnings``;
@@ -91,11 +93,13 @@ def at_bound(result) -> list[dict]:
                                      _from_flat(p, g1 - BOUND_ZONE * (g1 - g0)))):
             if q < BOUND_ZONE:
                 a, b = _from_flat(p, lo), _from_flat(p, hi)
+                meaning = ("the data need no noise beyond the table's sigma"
+                           if name == "log_noise" and side == "lower"
+                           else "the bound, not the data, sets this value")
                 out.append(warning("at_bound", [name], (
                     f"{name}: 95% interval [{a:.4g}, {b:.4g}] {p.unit} reaches the {side} "
                     f"bound {edge:.4g} (within the outer {100 * BOUND_ZONE:g}% of the prior "
-                    f"range [{p.lo:.4g}, {p.hi:.4g}], beyond {zone:.4g}): the bound, not the "
-                    f"data, sets this value")))
+                    f"range [{p.lo:.4g}, {p.hi:.4g}], beyond {zone:.4g}): {meaning}")))
     return out
 
 
@@ -141,13 +145,15 @@ def correlated(result) -> list[dict]:
 
 
 def _typical(name: str):
+    """brdf.schema's plausible range of a fit parameter (its typical range where it gives
+    none); None for the fit's own parameters (scale, noise, tangent scales)."""
     base, _ = base_of(name)
     info = schema.THREAD.get(base) or schema.THREAD.get(base.rsplit("_", 1)[0])
-    return None if info is None else info.typical
+    return None if info is None else (info.plausible or info.typical)
 
 
 def implausible(result) -> list[dict]:
-    """``implausible`` warnings: medians outside brdf.schema's typical range."""
+    """``implausible`` warnings: medians outside brdf.schema's plausible (or typical) range."""
     out = []
     for name in result.names:
         typical = _typical(name)

@@ -233,9 +233,15 @@ def adequacy(result, wi=None, wo=None) -> dict:
                 "reason": f"too few values ({lik.n_used} < {MIN_VALUES}) to test the fit"}
     scores = normal_scores(result, result.median_internal()[None])[0]
     ok = np.isfinite(scores)
-    tests = {"distribution": {"p": float(stats.kstest(scores[ok], "norm").pvalue)
-                              if ok.sum() >= MIN_VALUES else None,
-                              "statistic": "Kolmogorov-Smirnov, normal scores at the median"},
+    good = scores[ok]
+    if good.size < MIN_VALUES:
+        return {"adequate": None, "values": lik.n_used,
+                "reason": f"only {good.size} finite residuals at the posterior median"}
+    tests = {"distribution": {"p": float(stats.kstest(good, "norm").pvalue),
+                              "statistic": "Kolmogorov-Smirnov, normal scores at the median",
+                              "mean": float(good.mean()), "sd": float(good.std()),
+                              "skewness": float(stats.skew(good)),
+                              "excess_kurtosis": float(stats.kurtosis(good))},
              "chi_square": _chi_square(result, lik)}
     reg = None
     if wi is not None:
@@ -248,7 +254,7 @@ def adequacy(result, wi=None, wo=None) -> dict:
         tests[k]["p_holm"] = p
     out = {"alpha": ALPHA, "values": int(lik.n_used), "tests": tests, "regions": reg,
            "noise": _noise(result, lik),
-           "rms_normal_score": float(np.sqrt(np.mean(scores[ok] ** 2)))}
+           "rms_normal_score": float(np.sqrt(np.mean(good ** 2)))}
     out.update(_verdict(tests, reg))
     masked = lik.counts["invalid_value"]
     if out["adequate"] is False and masked > 0.01 * lik.counts["total"]:
@@ -279,6 +285,9 @@ def _verdict(tests: dict, reg: dict | None) -> dict:
             parts.append(f"residuals exceed the table's sigma (sum of squares "
                          f"{tests[k]['t_over_dof']:.2f} x its expectation), p = {p:.2g}")
         else:
+            d = tests[k]
             parts.append(f"standardized residuals are not distributed as the likelihood "
-                         f"assumes, p = {p:.2g}")
+                         f"assumes (mean {d['mean']:+.2f}, sd {d['sd']:.2f}, skewness "
+                         f"{d['skewness']:+.2f}, excess kurtosis {d['excess_kurtosis']:+.2f}; "
+                         f"0, 1, 0, 0 for N(0, 1)), p = {p:.2g}")
     return {"adequate": False, "reason": "; ".join(parts) + f" (Holm-corrected, level {ALPHA:g})"}

@@ -1,6 +1,10 @@
 """Tests of ``microcyl fit`` (reports.cmd_fit) end to end on small simulated tables."""
 
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -110,3 +114,31 @@ def test_a_refused_fit_leaves_no_new_folder(tmp_path, capsys):
             assert message in err and len(err.strip().splitlines()) == 1, err
             assert not (tmp_path / "new").exists(), (extra, sorted(tmp_path.iterdir()))
             assert sorted(p.name for p in existing.iterdir()) == ["notes.txt"]
+
+
+def test_fit_prints_each_warning_after_the_verdict(tmp_path):
+    """As a user runs it (a subprocess, progress bar on): a table whose k_d1 is 0, fitted from
+    the preset (k_d1 = 0.2): the verdict, then the adequacy line, then one line per warning,
+    the at_bound of kd1 among them, and results.json holds the same."""
+    import brdf
+    silk = brdf.fabric("silk_crepe_de_chine")
+    t1, t2 = silk.threads
+    kd0 = silk.replace(threads=(t1.replace(kd=0.0), t2))
+    table, _ = fabric_table("silk", n=150, seed=4, fab=kd0)
+    path = tmp_path / "kd0.csv"
+    _write_csv(table, path)
+    out = tmp_path / "fit"
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    p = subprocess.run([sys.executable, "-m", "reports", "fit", str(path), "--fabric",
+                        "silk_crepe_de_chine", "--free", "kd1,gamma_s1", "--tie", "none",
+                        "--max-steps", "100", "--no-plots", "-o", str(out)],
+                       env=env, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    lines = p.stdout.splitlines()
+    k = next(i for i, line in enumerate(lines) if "step limit" in line or "CONVERGED" in line)
+    assert lines[k + 1].startswith(("ADEQUATE: ", "NOT ADEQUATE: "))
+    doc = json.loads((out / "results.json").read_text())
+    printed = lines[k + 2:k + 2 + len(doc["warnings"])]
+    assert printed == [f"warning ({w['kind']}): {w['message']}" for w in doc["warnings"]]
+    assert any(w["kind"] == "at_bound" and w["parameters"] == ["kd1"] for w in doc["warnings"])
+    assert lines[k + 2 + len(doc["warnings"])].startswith("residuals at the posterior median")

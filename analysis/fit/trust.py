@@ -57,6 +57,11 @@ def flat_values(param, x) -> np.ndarray:
     return np.log(x) if param.is_log else x
 
 
+def _unit(unit: str) -> str:
+    """`` deg`` after a number; nothing for a dimensionless ``"1"``."""
+    return "" if unit in ("1", "") else f" {unit}"
+
+
 def _from_flat(param, g: float) -> float:
     return float(np.exp(g) if param.is_log else g)
 
@@ -97,7 +102,7 @@ def at_bound(result) -> list[dict]:
                            if name == "log_noise" and side == "lower"
                            else "the bound, not the data, sets this value")
                 out.append(warning("at_bound", [name], (
-                    f"{name}: 95% interval [{a:.4g}, {b:.4g}] {p.unit} reaches the {side} "
+                    f"{name}: 95% interval [{a:.4g}, {b:.4g}]{_unit(p.unit)} reaches the {side} "
                     f"bound {edge:.4g} (within the outer {100 * BOUND_ZONE:g}% of the prior "
                     f"range [{p.lo:.4g}, {p.hi:.4g}], beyond {zone:.4g}): {meaning}")))
     return out
@@ -162,7 +167,7 @@ def implausible(result) -> list[dict]:
         s = result.summary[name]
         if not typical[0] <= s["median"] <= typical[1]:
             out.append(warning("implausible", [name], (
-                f"{name}: median {s['median']:.4g} {s['unit']} (95% [{s['lo95']:.4g}, "
+                f"{name}: median {s['median']:.4g}{_unit(s['unit'])} (95% [{s['lo95']:.4g}, "
                 f"{s['hi95']:.4g}]) lies outside the range real cloth takes, "
                 f"[{typical[0]:g}, {typical[1]:g}]")))
     return out

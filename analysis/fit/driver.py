@@ -216,6 +216,8 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     Returns
     -------
     FitResult
+        With its ``adequacy`` and ``warnings`` (:func:`analysis.fit.trust.assess`: does the
+        model describe the table, and what the posterior cannot tell).
 
     Raises
     ------

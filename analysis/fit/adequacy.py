@@ -10,8 +10,8 @@ with the distribution the likelihood (:mod:`analysis.likelihood`) assumes for th
   freedom for "student-t"); its normal score n = Phi^-1(F(z)), F the likelihood's standardized
   CDF, is N(0, 1) for every kind, and independent between values.
 - ``distribution``: Kolmogorov-Smirnov test of the normal scores at the posterior median
-  against N(0, 1) (scipy.stats.kstest). The parameters were fitted to these data, which makes
-  the p-value conservative (too large), never too small.
+  against N(0, 1) (scipy.stats.kstest). The parameters were fitted to these data, which
+  makes the p-value conservative (too large, as Lilliefors showed for a fitted normal).
 - ``chi_square``: a posterior predictive p-value of T = sum n^2 (Gelman, Meng & Stern 1996):
   for each of a few dozen posterior draws, T of the data, against T of replicated data,
   which is chi-square with (values) degrees of freedom exactly; the p-value P(T_rep >= T) is
@@ -19,8 +19,9 @@ with the distribution the likelihood (:mod:`analysis.likelihood`) assumes for th
   table's own sigma alone, so a fitted ``log_noise`` cannot absorb the misfit; without a
   table sigma the residual scale is fitted and the test does not apply.
 - ``regions``: residual structure. The normal scores are averaged per point over its channels
-  (times sqrt(channels): N(0, 1) per point under the model, whatever the correlation between
-  channels the data may have) and two regions of each split are compared by a two-sided
+  (times sqrt(channels): N(0, 1) per point under the model; one value a point, so that a
+  correlation between a point's channels, which real data may have, scales both sides alike
+  and does not multiply the evidence) and two regions of each split are compared by a two-sided
   Mann-Whitney U test (scipy.stats.mannwhitneyu, distribution-free): forward against back
   scatter (cos(phi_o - phi_i) < 0 or > 0, both directions at least 5 degrees off the normal),
   warp plane against weft plane (the half vector h nearer the x-z or the y-z plane), grazing

@@ -9,6 +9,9 @@ log-probability evaluations per second, effective samples per second, and the wa
     .venv/bin/python bench/bench_fit.py --recovery      # silk, charmeuse, velvet: truth in 95%?
     .venv/bin/python bench/bench_fit.py --calibration 20  # coverage over 20 replicas
     .venv/bin/python bench/bench_fit.py --real          # RGL felts and CUReT fabrics
+    .venv/bin/python bench/bench_fit.py --diagnostics   # warnings and adequacy, known truth
+
+Every fit prints its adequacy verdict and its warnings (:mod:`analysis.fit.trust`).
 """
 
 from __future__ import annotations
@@ -40,11 +43,60 @@ def simulate(name, spec="full:15:30", snr=20.0, seed=0):
     return table, fab
 
 
-def run_fit(table, fab, free=DEFAULT_FREE, ties=DEFAULT_TIES, out=None, **kw):
-    spec = ParamSpec(free, defaults=defaults_from_fabric(fab), ties=ties)
+def run_fit(table, fab, free=DEFAULT_FREE, ties=DEFAULT_TIES, out=None, spec=None, **kw):
+    spec = spec or ParamSpec(free, defaults=defaults_from_fabric(fab), ties=ties)
     model = FabricModel(fab, table.wi, table.wo)
     with tempfile.TemporaryDirectory() as tmp:
         return fit(table, spec, model, out_dir=out or tmp, **kw)
+
+
+def print_trust(r, indent="   "):
+    """The fit's adequacy verdict and each warning, one line each."""
+    a = r.adequacy
+    verdict = {True: "ADEQUATE", False: "NOT ADEQUATE", None: "adequacy not checked"}
+    print(f"{indent}{verdict[a.get('adequate')]}: {a.get('reason')}")
+    for w in r.warnings:
+        print(f"{indent}warning ({w['kind']}): {w['message']}")
+
+
+def diagnostics(args):
+    """Warnings and adequacy on simulated tables whose truth is known (full:20:45, SNR 20):
+    a parameter without effect (thread 2 covers nothing), a truth at its bound (kd1 = 0),
+    the generating preset, and another preset."""
+    silk = brdf.fabric("silk_crepe_de_chine")
+    t1, t2 = silk.threads
+    no_weft = silk.replace(threads=(t1, t2.replace(area=0.0)))
+    kd0 = silk.replace(threads=(t1.replace(kd=0.0), t2))
+    cases = [  # (title, data fabric, model fabric, free, expectation(result) -> bool)
+        ("kd2 without effect (area2 = 0)", no_weft, no_weft, ("gamma_s1", "kd1", "kd2"),
+         lambda r: _has(r, "not_informed", "kd2")),
+        ("kd1 = 0, at its bound", kd0, kd0, ("gamma_s1", "kd1", "area1"),
+         lambda r: _has(r, "at_bound", "kd1")),
+        ("silk fitted as silk", silk, silk, ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1"),
+         lambda r: r.adequacy["adequate"] is True),
+        ("silk fitted as linen_plain", silk, brdf.fabric("linen_plain"),
+         ("eta1", "kd1", "gamma_s1", "gamma_v1", "area1"),
+         lambda r: r.adequacy["adequate"] is False and _has(r, "misfit")),
+    ]
+    bad = 0
+    for title, data, model, free, expect in cases:
+        table = gonio.measure(data, "full:20:45", gonio.Instrument(snr=20.0, floor=1e-4),
+                              seed=args.seed, progress=False)
+        spec = ParamSpec(free, defaults=defaults_from_fabric(model),
+                         ties=("area2=1-area1",) if "area1" in free else ())
+        r = run_fit(table, model, spec=spec, seed=args.seed, progress=False,
+                    max_steps=args.max_steps)
+        ok = expect(r)
+        bad += not ok
+        print(f"{title}: {'as expected' if ok else 'NOT as expected'}; {r.reason} "
+              f"({r.timing['wall_s']:.0f} s)", flush=True)
+        print_trust(r)
+    return 1 if bad else 0
+
+
+def _has(r, kind, name=None):
+    return any(w["kind"] == kind and (name is None or name in w["parameters"])
+               for w in r.warnings)
 
 
 def speed(args):
@@ -69,6 +121,7 @@ def speed(args):
           f"steps, min N/tau {min(s['n_over_tau'] for s in r.summary.values()):.0f}")
     print(f"CPU time of the fit: {cpu:.1f} s (all threads; less sensitive to a busy machine "
           f"than the wall time), {faults} minor page faults")
+    print_trust(r, indent="")
     return 0 if r.converged and t["wall_s"] < 300 else 1
 
 
@@ -86,6 +139,7 @@ def recovery(args):
             s = r.summary[n]
             print(f"   {n:10s} truth {truth[n]:9.5g}  median {s['median']:9.5g}  95% "
                   f"[{s['lo95']:9.5g}, {s['hi95']:9.5g}] {'' if ok else '  <-- outside'}")
+        print_trust(r)
     return 0
 
 
@@ -103,7 +157,8 @@ def calibration(args):
             hits68 += s["lo68"] <= truth[n] <= s["hi68"]
             hits95 += s["lo95"] <= truth[n] <= s["hi95"]
             total += 1
-        print(f"replica {rep}: converged {r.converged}, running coverage 68% "
+        print(f"replica {rep}: converged {r.converged}, adequate "
+              f"{r.adequacy.get('adequate')}, {len(r.warnings)} warnings, running coverage 68% "
               f"{hits68 / total:.3f}, 95% {hits95 / total:.3f} ({time.perf_counter() - t0:.0f} s)",
               flush=True)
     ok = True
@@ -139,6 +194,7 @@ def real(args):
               f"{r.timing['wall_s']:.0f} s, {r.timing['evals_per_s']:.0f} evals/s; proposal "
               f"refits kept at {kept}; {r.reason}", flush=True)
         print("   " + ", ".join(f"{n}={r.summary[n]['median']:.4g}" for n in r.names))
+        print_trust(r)
         bad += not r.converged
     print(f"chains and configs in {out_root}; {bad} not converged")
     return 1 if bad else 0
@@ -149,6 +205,8 @@ def main():
     ap.add_argument("--recovery", action="store_true")
     ap.add_argument("--calibration", type=int, default=0, metavar="REPLICAS")
     ap.add_argument("--real", action="store_true")
+    ap.add_argument("--diagnostics", action="store_true",
+                    help="warnings and adequacy of fits whose truth is known")
     ap.add_argument("--max-steps", type=int, default=5000)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--only", choices=("rgl", "curet"), default=None,
@@ -164,6 +222,8 @@ def main():
         return calibration(args)
     if args.real:
         return real(args)
+    if args.diagnostics:
+        return diagnostics(args)
     return speed(args)
 
 

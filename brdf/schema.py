@@ -65,6 +65,9 @@ class ParamInfo:
         The typical range spans decades (a fit searches it in the logarithm).
     typical_value : float or None
         A middle value of the typical range (the start of a fit that knows nothing else).
+    plausible : (float, float) or None
+        Where the literature bounds real fibres more tightly than ``typical`` (the search
+        range): a fitted value outside it is physically implausible. None: ``typical``.
     what : str or None
         The allowed values in words, for error messages; None: from the bounds.
     note : str
@@ -85,6 +88,7 @@ class ParamInfo:
     typical_value: float | None = None
     what: str | None = None
     note: str = ""
+    plausible: tuple[float, float] | None = None
 
     @property
     def heading(self) -> str:
@@ -163,7 +167,10 @@ def _thread_params() -> tuple[ParamInfo, ...]:
     P = ParamInfo
     return (
         P("eta", "scalar", "1", 1.0, None, "η", "index of refraction of the fibre",
-          lo_open=True, typical=(1.01, 3.0), typical_value=1.46),
+          lo_open=True, typical=(1.01, 3.0), typical_value=1.46,
+          # textile polymers (cotton, wool, silk, nylon, acrylic, polyester) measure 1.5 to
+          # 1.72; the paper's Table II takes 1.345 to 1.539
+          plausible=(1.3, 1.8)),
         P("albedo", "rgb", "1", 0.0, None, "A", "volume albedo (R, G, B)", typical=(0.0, 1.0), typical_value=0.2,
           what="one or three finite numbers >= 0 (R, G, B)",
           note="scales only the volume term; the surface term is colourless"),

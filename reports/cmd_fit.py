@@ -21,7 +21,7 @@ from analysis.fit.loo import HIGH_K
 from reports import cliutil
 
 __all__ = ["register", "run", "read_table", "format_summary", "format_information",
-           "format_loo"]
+           "format_loo", "format_warnings"]
 
 
 def read_table(path, sample=None):
@@ -95,11 +95,14 @@ def run(args) -> int:
         notify=lambda line: print(line, file=sys.stderr, flush=True),
         config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
     print(format_summary(result))
+    print(format_warnings(result))
     q = result.quality
     print(f"residuals at the posterior median: rms {q['rms_residual']:.4f} in the "
           f"likelihood's space, {q['rms_normalized']:.2f} in units of the noise")
-    print(f"albedo colour, measured vs predicted (posterior median): CIEDE2000 "
-          f"{q['albedo_delta_e2000']:.2f}" + ("" if args.no_plots else f"; plots in {out}"))
+    colour = (f"CIEDE2000 {q['albedo_delta_e2000']:.2f}" if q.get("albedo_delta_e2000")
+              is not None else f"none ({q.get('albedo_delta_e2000_reason', 'not computed')})")
+    print(f"albedo colour, measured vs predicted (posterior median): {colour}"
+          + ("" if args.no_plots else f"; plots in {out}"))
     if result.loo is not None:
         print(format_loo(result.loo.summary(), q.get("loo_pit")))
     print(f"results: {out / 'results.json'}")
@@ -193,4 +196,13 @@ def format_summary(result) -> str:
     if result.timing.get("resumed_from"):
         lines.append(f"resumed from the checkpoint at step {result.timing['resumed_from']}")
     lines.append(("CONVERGED: " if result.converged else "") + result.reason)
+    return "\n".join(lines)
+
+
+def format_warnings(result) -> str:
+    """The adequacy verdict, then each warning, one line each (:mod:`analysis.fit.trust`)."""
+    a = result.adequacy or {}
+    verdict = {True: "ADEQUATE", False: "NOT ADEQUATE", None: "adequacy not checked"}
+    lines = [f"{verdict[a.get('adequate')]}: {a.get('reason', 'not checked')}"]
+    lines += [f"warning ({w['kind']}): {w['message']}" for w in result.warnings]
     return "\n".join(lines)

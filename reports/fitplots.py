@@ -1,5 +1,7 @@
-r"""Plots of a Bayesian fit: corner, traces, posterior-predictive lobes, residual maps (the
-fit's quality figures themselves are computed in :mod:`analysis.fit.quality`).
+r"""Plots of a Bayesian fit: corner, traces, posterior-predictive lobes, residual maps, and the
+adequacy figure (residuals against angle, an optional PIT histogram, the verdict and the
+warnings) (the fit's quality figures themselves are computed in :mod:`analysis.fit.quality`
+and :mod:`analysis.fit.adequacy`).
 
 Every function takes ``ax=`` (or ``fig=`` for the corner plot), returns ``(fig, ax)``, saves only
 when given ``filename`` and never calls ``show()``.
@@ -7,6 +9,7 @@ when given ``filename`` and never calls ``show()``.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import corner
@@ -16,11 +19,12 @@ import numpy as np
 from matplotlib.ticker import MaxNLocator
 
 from analysis.fit import LogPosterior
+from analysis.fit.adequacy import normal_scores, point_scores, regions
 from gonio import atomic_write
 from reports.plot_pit import pit_histogram
 
 __all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "posterior_draws",
-           "write_fit_plots"]
+           "adequacy_plot", "write_fit_plots"]
 
 
 def _plt():
@@ -209,9 +213,87 @@ def residual_map(result, table, prediction, ax=None, filename=None):
     return fig, ax
 
 
+def _verdict_text(result, width: int = 110) -> str:
+    """The adequacy verdict and each warning, wrapped, for a figure's text block."""
+    a = result.adequacy or {}
+    head = {True: "ADEQUATE", False: "NOT ADEQUATE", None: "adequacy not checked"}
+    lines = textwrap.wrap(f"{head[a.get('adequate')]}: {a.get('reason', 'not checked')}", width)
+    for w in result.warnings:
+        lines += textwrap.wrap(f"warning ({w['kind']}): {w['message']}", width,
+                               subsequent_indent="    ")
+    if not result.warnings:
+        lines.append("no warnings")
+    return "\n".join(lines)
+
+
+def adequacy_plot(result, table, pit=None, filename=None):
+    """Standardized residuals against angle, an optional PIT histogram, and the fit's verdict
+    and warnings as text.
+
+    The residual of each point is its normal score averaged over channels times
+    sqrt(channels) (:func:`analysis.fit.adequacy.point_scores`; N(0, 1) under the model) at
+    the posterior median, against theta_i, theta_o and phi_o - phi_i (degrees), forward and
+    back scatter in two colours; the band is +-2.
+
+    Parameters
+    ----------
+    result : analysis.fit.FitResult
+        With its posterior, ``adequacy`` and ``warnings``.
+    table : gonio.Table
+        The fitted table.
+    pit : array_like, optional
+        LOO-PIT values in [0, 1] (one per value); drawn as a histogram beside the residuals
+        when given (uniform when the model is calibrated).
+
+    Returns
+    -------
+    (fig, axes)
+    """
+    plt = _plt()
+    lik = result.logpost.lik
+    scores = normal_scores(result, result.median_internal()[None])[0]
+    points, zp = point_scores(lik, np.where(np.isfinite(scores), scores, 0.0))
+    ang = np.degrees(table.angles)[points]
+    fwd, back = regions(table.wi[points], table.wo[points])["forward_back"][2:]
+    dphi = np.degrees(np.angle(np.exp(1j * np.radians(ang[:, 3] - ang[:, 1]))))
+    n = 3 + (pit is not None)
+    words = _verdict_text(result, width=int(30 * n))
+    text_h = 0.14 * (words.count("\n") + 1) + 0.2
+    fig = plt.figure(figsize=(3.4 * n, 3.4 + text_h))
+    grid = fig.add_gridspec(2, n, height_ratios=(3.0, text_h))
+    axes = [fig.add_subplot(grid[0, k]) for k in range(n)]
+    for a, x, label in zip(axes, (ang[:, 0], ang[:, 2], dphi),
+                           ("θi (deg)", "θo (deg)", "φo - φi (deg)")):
+        other = ~(fwd | back)
+        for sel, col, name in ((fwd, "C3", "forward"), (back, "C0", "back"),
+                               (other, "0.5", "near the normal")):
+            if np.any(sel):
+                a.plot(x[sel], zp[sel], ".", ms=3, color=col, label=name)
+        a.axhspan(-2, 2, color="0.9", zorder=0)
+        a.axhline(0, color="k", lw=0.5)
+        a.set_xlabel(label, fontsize=8)
+        a.tick_params(labelsize=7)
+    axes[0].set_ylabel("standardized residual", fontsize=8)
+    axes[0].legend(fontsize=6, loc="upper left")
+    if pit is not None:
+        p = np.asarray(pit, dtype=np.float64)
+        axes[3].hist(p[np.isfinite(p)], bins=20, range=(0, 1), color="C2", alpha=0.7)
+        axes[3].axhline(np.isfinite(p).sum() / 20, color="k", lw=0.8, ls="--")
+        axes[3].set_xlabel("LOO-PIT", fontsize=8)
+        axes[3].tick_params(labelsize=7)
+    text = fig.add_subplot(grid[1, :])
+    text.axis("off")
+    text.text(0, 1, words, va="top", ha="left",
+              fontsize=7, family="monospace", transform=text.transAxes)
+    fig.suptitle("residuals at the posterior median, per point (N(0, 1) if the model fits)",
+                 fontsize=9)
+    _save(fig, filename)
+    return fig, axes
+
+
 def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
-    """Write corner.png, traces.png, lobes.png, residuals.png (and pit.png, the LOO-PIT
-    histogram, when the result has its PSIS-LOO) into ``out_dir``.
+    """Write corner.png, traces.png, lobes.png, residuals.png, adequacy.png (and pit.png, the
+    LOO-PIT histogram, when the result has its PSIS-LOO) into ``out_dir``.
 
     The signature :func:`analysis.fit.fit_fabric` expects of its ``plots``; returns
     ``{name: path}``.
@@ -224,7 +306,8 @@ def write_fit_plots(result, table, model_factory, out_dir, truths=None) -> dict:
             ("corner.png", lambda f: corner_plot(result, truths=truths, filename=f)),
             ("traces.png", lambda f: trace_plot(result, filename=f)),
             ("lobes.png", lambda f: lobe_plot(result, table, model_factory, filename=f)),
-            ("residuals.png", lambda f: residual_map(result, table, pred, filename=f))):
+            ("residuals.png", lambda f: residual_map(result, table, pred, filename=f)),
+            ("adequacy.png", lambda f: adequacy_plot(result, table, filename=f))):
         fig, _ = call(out / name)
         plt.close(fig)
         files[name[:-4]] = str(out / name)

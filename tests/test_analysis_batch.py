@@ -65,12 +65,14 @@ def test_three_fits_and_one_error_naming_the_file(batch):
         assert r["steps"] > 0 and r["wall_s"] > 0
         for p in FREE:     # the simulated tables' truth inside the 95% intervals
             assert r[f"{p}_lo95"] <= truth[p] <= r[f"{p}_hi95"], (name, p)
-        loo = json.loads((out / name / "results.json").read_text())["loo"]
-        assert (r["elpd"], r["elpd_se"]) == (loo["elpd"], loo["se"])
+        res = json.loads((out / name / "results.json").read_text())
+        assert (r["elpd"], r["elpd_se"]) == (res["loo"]["elpd"], res["loo"]["se"])
+        # the generating preset describes its own tables; both parameters are informed
+        assert r["adequate"] is True and r["warnings"] == "", (name, r["warnings"])
     csv_lines = (out / "summary.csv").read_text().splitlines()
     assert csv_lines[0].startswith("name,status,error,steps,wall_s")
-    assert "kd1_median" in csv_lines[0] and ",elpd,elpd_se," in csv_lines[0]
-    assert len(csv_lines) == 5
+    assert "kd1_median" in csv_lines[0] and ",elpd,elpd_se" in csv_lines[0]
+    assert "adequate" in csv_lines[0] and len(csv_lines) == 5
     assert len(lines) == 4 and any(line.startswith("corrupt: error") for line in lines)
 
 

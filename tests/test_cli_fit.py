@@ -1,6 +1,10 @@
 """Tests of ``microcyl fit`` (reports.cmd_fit) end to end on small simulated tables."""
 
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -53,14 +57,21 @@ def test_fit_writes_results_and_plots(table_file, tmp_path, capsys):
         assert np.isfinite(par["kd1"][k])
     assert par["gamma_s1"]["lo95"] < 5.0 < par["gamma_s1"]["hi95"]
     assert doc["quality"]["albedo_delta_e2000"] < 2.0   # same model, 5% noise: barely visible
-    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "pit"}
-    for name in ("corner", "traces", "lobes", "residuals", "pit"):
+    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "adequacy", "pit"}
+    for name in ("corner", "traces", "lobes", "residuals", "adequacy", "pit"):
         assert (out / f"{name}.png").stat().st_size > 1000
     assert (out / "results.csv").exists() and (out / "loo.npz").exists()
     assert doc["loo"]["elpd"] == pytest.approx(float(np.load(out / "loo.npz")["elpd_i"].sum()))
+    # the model that made the table describes it; both informed, nothing at a bound
+    assert doc["adequate"] is True and doc["quality"]["adequacy"]["tests"]["distribution"]["p"]
+    assert doc["warnings"] == []
     text = capsys.readouterr().out
     assert "gamma_s1" in text and "results:" in text
     assert f"PSIS-LOO: elpd {doc['loo']['elpd']:.1f} ± {doc['loo']['se']:.1f}" in text
+    lines = text.splitlines()
+    verdict = next(i for i, line in enumerate(lines) if line.startswith("CONVERGED") or
+                   "step limit" in line)
+    assert lines[verdict + 1].startswith("ADEQUATE: no test rejects the model")
     # same command again: resumes (no new optimisation), same folder accepted
     assert main(args[:-2] + ["--no-plots", "-o", str(out)]) == 0
 
@@ -105,3 +116,31 @@ def test_a_refused_fit_leaves_no_new_folder(tmp_path, capsys):
             assert message in err and len(err.strip().splitlines()) == 1, err
             assert not (tmp_path / "new").exists(), (extra, sorted(tmp_path.iterdir()))
             assert sorted(p.name for p in existing.iterdir()) == ["notes.txt"]
+
+
+def test_fit_prints_each_warning_after_the_verdict(tmp_path):
+    """As a user runs it (a subprocess, progress bar on): a table whose k_d1 is 0, fitted from
+    the preset (k_d1 = 0.2): the verdict, then the adequacy line, then one line per warning,
+    the at_bound of kd1 among them, and results.json holds the same."""
+    import brdf
+    silk = brdf.fabric("silk_crepe_de_chine")
+    t1, t2 = silk.threads
+    kd0 = silk.replace(threads=(t1.replace(kd=0.0), t2))
+    table, _ = fabric_table("silk", n=150, seed=4, fab=kd0)
+    path = tmp_path / "kd0.csv"
+    _write_csv(table, path)
+    out = tmp_path / "fit"
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    p = subprocess.run([sys.executable, "-m", "reports", "fit", str(path), "--fabric",
+                        "silk_crepe_de_chine", "--free", "kd1,gamma_s1", "--tie", "none",
+                        "--max-steps", "100", "--no-plots", "-o", str(out)],
+                       env=env, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    lines = p.stdout.splitlines()
+    k = next(i for i, line in enumerate(lines) if "step limit" in line or "CONVERGED" in line)
+    assert lines[k + 1].startswith(("ADEQUATE: ", "NOT ADEQUATE: "))
+    doc = json.loads((out / "results.json").read_text())
+    printed = lines[k + 2:k + 2 + len(doc["warnings"])]
+    assert printed == [f"warning ({w['kind']}): {w['message']}" for w in doc["warnings"]]
+    assert any(w["kind"] == "at_bound" and w["parameters"] == ["kd1"] for w in doc["warnings"])
+    assert lines[k + 2 + len(doc["warnings"])].startswith("residuals at the posterior median")

@@ -66,7 +66,7 @@ def test_fit_with_progress_bar_to_convergence(silk_csv, tmp_path):
     for name in free.split(","):
         sd = (par[name]["hi95"] - par[name]["lo95"]) / 3.92
         assert abs(par[name]["median"] - truth[name]) < 4 * sd, (name, par[name])
-    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "pit"}
+    assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "adequacy", "pit"}
     assert all((out / f"{k}.png").stat().st_size > 1000 for k in doc["plots"])
     assert "CONVERGED" in stdout and f"results: {out / 'results.json'}" in stdout
     assert sorted(q.name for q in out.iterdir() if q.name.startswith(".")) == []  # no temp

@@ -3,6 +3,7 @@
 import json
 import re
 
+import markupsafe
 import numpy as np
 import pytest
 
@@ -56,10 +57,13 @@ def test_fit_measured_writes_results_and_summary(fitted):
                                       "log_noise"}
     q = res["quality"]
     assert q == e["quality"] and q["albedo_delta_e2000"] == e["albedo_delta_e2000"]
+    # CUReT is grey: no colour difference, and the reason says so
+    assert e["albedo_delta_e2000"] is None and "grey" in q["albedo_delta_e2000_reason"]
+    assert res["adequate"] in (True, False) and isinstance(res["warnings"], list)
     # the fitted noise explains the residuals: normalized rms near 1, raw rms near exp(noise)
     assert 0.7 < q["rms_normalized"] < 1.3
     assert q["rms_residual"] == pytest.approx(np.exp(res["parameters"]["log_noise"]["median"]), rel=0.3)
-    for name in ("lobes", "residuals", "corner", "traces", "pit"):
+    for name in ("lobes", "residuals", "corner", "traces", "adequacy", "pit"):
         assert (out / "curet_44_linen" / f"{name}.png").stat().st_size > 1000
     assert e["loo"] == res["loo"] and np.isfinite(res["loo"]["elpd"]) and res["loo"]["se"] > 0
 
@@ -73,9 +77,14 @@ def test_report_page_of_measured_fits(fitted, tmp_path):
     page = (root / "measured.html").read_text()
     assert '<section id="curet_44_linen"' in page and "NOT converged" in page
     imgs = re.findall(r'<img src="([^"]+)"', page)
-    assert len(imgs) == 5 and all((root / i).stat().st_size > 1000 for i in imgs)
-    loo = json.loads((out / "curet_44_linen" / "results.json").read_text())["loo"]
+    assert len(imgs) == 6 and all((root / i).stat().st_size > 1000 for i in imgs)
+    res = json.loads((out / "curet_44_linen" / "results.json").read_text())
+    loo = res["loo"]
     assert f"PSIS-LOO elpd {loo['elpd']:.1f} ± {loo['se']:.1f}" in page
+    verdict = {True: "<b>adequate</b>", False: "<b>NOT adequate</b>"}[res["adequate"]]
+    assert verdict in page
+    for w in res["warnings"]:
+        assert str(markupsafe.escape(w["message"])) in page
     assert "measured.html" in index.read_text()
     summary = json.loads((root / "summary.json").read_text())
     assert summary["measured"]["curet_44_linen"]["converged"] is False

@@ -32,7 +32,9 @@ def run_job(job: BatchJob, out_dir) -> dict:
     dict
         ``name``, ``status`` (converged, not_converged or error), ``error``, ``steps``,
         ``wall_s`` (seconds), ``path``, ``sample``, ``preset``, ``reason``, ``folder``,
-        ``elpd`` and ``elpd_se`` (PSIS-LOO; None without it), and ``<parameter>_median``,
+        ``elpd`` and ``elpd_se`` (PSIS-LOO; None without it), ``adequate`` (the fit's adequacy
+        verdict: true, false or None), ``warnings`` (each warning's kind and parameters,
+        ``"; "``-separated), and ``<parameter>_median``,
         ``_lo95``, ``_hi95`` of every free parameter.
     """
     t0 = time.perf_counter()
@@ -76,7 +78,10 @@ def result_row(job: BatchJob, result, wall_s: float) -> dict:
     row = _base(job)
     row.update(status="converged" if result.converged else "not_converged",
                steps=int(result.steps), wall_s=round(float(wall_s), 3), reason=result.reason,
-               resumed_from=int(result.timing.get("resumed_from", 0)))
+               resumed_from=int(result.timing.get("resumed_from", 0)),
+               adequate=result.adequacy.get("adequate"),
+               warnings="; ".join(f"{w['kind']} {','.join(w['parameters'])}".strip()
+                                  for w in result.warnings))
     loo = None if result.loo is None else result.loo.summary()
     row.update(elpd=None if loo is None else loo["elpd"],
                elpd_se=None if loo is None else loo["se"])

@@ -22,11 +22,14 @@ Pipeline (:func:`fit`, module by module):
    are written whole to ``checkpoint.h5`` (atomically); the same call resumes from it, a
    finished fit is summarized again without sampling, a killed one loses at most one check
    interval, and Ctrl-C checkpoints the steps done before it raises :class:`FitInterrupted`.
-6. :mod:`~analysis.fit.results` and :mod:`~analysis.fit.quality` -- :class:`FitResult`,
+6. :mod:`~analysis.fit.adequacy` and :mod:`~analysis.fit.trust` -- every fit is checked:
+   ``adequacy`` (posterior predictive tests: is the model adequate to the data?) and
+   ``warnings`` (parameters at a bound, not informed, correlated, implausible; misfit).
+7. :mod:`~analysis.fit.results` and :mod:`~analysis.fit.quality` -- :class:`FitResult`,
    ``results.json`` (versioned schema) and ``results.csv``; residuals and the albedo colour
-   difference. :func:`fit_fabric` (:mod:`~analysis.fit.workflow`) is the whole of
-   ``microcyl fit``: fit, quality, PSIS-LOO, plots, files.
-7. :mod:`~analysis.fit.loo` -- PSIS-LOO (ArviZ) over thinned posterior draws: ``loo`` in
+   difference (none for a grey table). :func:`fit_fabric` (:mod:`~analysis.fit.workflow`)
+   is the whole of ``microcyl fit``: fit, quality, PSIS-LOO, plots, files.
+8. :mod:`~analysis.fit.loo` -- PSIS-LOO (ArviZ) over thinned posterior draws: ``loo`` in
    ``results.json``, the pointwise values in ``loo.npz``, the LOO-PIT;
    :mod:`~analysis.fit.compare` ranks fits of one table by it (``microcyl compare``).
 
@@ -72,6 +75,8 @@ from analysis.fit.proposal import LaplaceMove
 from analysis.fit.quality import albedo_colours, albedo_delta_e, fit_quality
 from analysis.fit.results import SCHEMA_VERSION, FitResult, write_results
 from analysis.fit.sampler import FitInterrupted
+from analysis.fit.adequacy import adequacy
+from analysis.fit.trust import fit_warnings
 from analysis.fit.workflow import fit_fabric, fit_spec
 
 __all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInterrupted",
@@ -80,4 +85,5 @@ __all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInter
            "EnsembleRunner", "EnsembleMoves", "LaplaceMove", "Criteria", "Diagnosis",
            "FitFolder", "fit_quality", "albedo_colours", "albedo_delta_e", "CONFIG_FILE",
            "CHECKPOINT_FILE", "SCHEMA_VERSION", "MedianFabric", "median_fabric", "FitModel",
-           "Loo", "psis_loo", "load_loo", "LOO_FILE", "compare_fits"]
+           "Loo", "psis_loo", "load_loo", "LOO_FILE", "compare_fits", "adequacy",
+           "fit_warnings"]

@@ -23,6 +23,7 @@ from analysis.fit.posterior import LogPosterior
 from analysis.fit.progress import fit_progress
 from analysis.fit.results import FitResult, summarize
 from analysis.fit.sampler import FitSampler
+from analysis.fit.trust import assess
 from analysis.likelihood import Likelihood
 from analysis.params import INTERNAL_LIMIT, ParamSpec
 
@@ -197,6 +198,8 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     Returns
     -------
     FitResult
+        With its ``adequacy`` and ``warnings`` (:func:`analysis.fit.trust.assess`: does the
+        model describe the table, and what the posterior cannot tell).
 
     Raises
     ------
@@ -350,9 +353,10 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
         resumed = sampler.steps if ckpt is not None else 0
         with fit_progress(progress, opts, sampler.steps) as (tick, postfix):
             out = sampler.run(folder, tick, t0, postfix)
-    return _result(spec, lik, logpost, opts, sampler, out, best, best_logp,
-                   {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt,
-                    "resumed_from": resumed})
+    result = _result(spec, lik, logpost, opts, sampler, out, best, best_logp,
+                     {"wall_s": time.perf_counter() - t0, "optimize_s": t_opt,
+                      "resumed_from": resumed})
+    return assess(result, table)          # adequacy and warnings (analysis.fit.trust)
 
 
 def _result(spec, lik, logpost, opts, sampler, out, best, best_logp, timing) -> FitResult:

@@ -1,6 +1,9 @@
 r"""How well a fit explains its table: residuals at the posterior median, and the albedo colour
 of the table against the fit's (CIEDE2000, colour-science; :func:`albedo_colours` and
-:func:`albedo_delta_e` live in :mod:`analysis.colour` and are re-exported here).
+:func:`albedo_delta_e` live in :mod:`analysis.colour` and are re-exported here). A grey table
+(the same value in R, G and B at every point: CUReT, a one-column CSV) has no colour: its
+colour difference is None, with the reason. Whether the model describes the data at all is
+:mod:`analysis.fit.adequacy`.
 """
 
 from __future__ import annotations
@@ -8,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from analysis.colour import albedo_colours, albedo_delta_e
+from analysis.likelihood import is_grey
 
 __all__ = ["residuals", "albedo_colours", "albedo_delta_e", "fit_quality"]
 
@@ -42,10 +46,21 @@ def residuals(result, prediction=None) -> dict:
 def fit_quality(result, table) -> dict:
     """The quality figures of ``results.json``: residual rms (likelihood space and normalized),
     the number of values, and the measured and predicted albedo colours with their CIEDE2000
-    difference, all at the posterior median (JSON-ready)."""
+    difference, all at the posterior median (JSON-ready).
+
+    For a grey table ``albedo_delta_e2000`` is None and ``albedo_delta_e2000_reason`` says
+    why: its one channel holds no colour, and a CIEDE2000 of two greys would be their
+    lightness difference alone (the albedos themselves are still given).
+    """
     pred = result.logpost.predict(result.median_internal()[None])[0]
     q = residuals(result, pred)
     meas, prd = albedo_colours(table, pred)
-    return {"rms_residual": q["rms"], "rms_normalized": q["rms_normalized"],
-            "values": int(q["residual"].size), "albedo_measured": meas.tolist(),
-            "albedo_predicted": prd.tolist(), "albedo_delta_e2000": albedo_delta_e(meas, prd)}
+    out = {"rms_residual": q["rms"], "rms_normalized": q["rms_normalized"],
+           "values": int(q["residual"].size), "albedo_measured": meas.tolist(),
+           "albedo_predicted": prd.tolist()}
+    if is_grey(table.values):
+        out.update(albedo_delta_e2000=None, albedo_delta_e2000_reason=(
+            "grey table (the same value in R, G and B at every point): no colour to compare"))
+    else:
+        out["albedo_delta_e2000"] = albedo_delta_e(meas, prd)
+    return out

@@ -4,21 +4,26 @@
 
     {"schema": "microcyl-fit", "schema_version": 2,
      "converged": true, "reason": "converged at step 350: ...",
+     "adequate": false, "adequate_reason": "residuals differ between ...",
+     "warnings": [{"kind": "at_bound", "parameters": ["eta1"], "message": "..."}, ...],
      "parameters": {"kd1": {"median": ..., "lo68": ..., "hi68": ..., "lo95": ..., "hi95": ...,
                             "tau": ..., "n_over_tau": ..., "rhat": ..., "ess": ...,
                             "unit": "1"}, ...},
      "fit": {"steps", "burn", "walkers", "ensembles", "acceptance_fraction", "map",
              "map_log_posterior", "points", "ties", "timing", "proposal"},
      "quality": {"rms_residual", "rms_normalized", "values", and with the table:
-                 "albedo_measured", "albedo_predicted", "albedo_delta_e2000"},
+                 "albedo_measured", "albedo_predicted", "albedo_delta_e2000" (null for a
+                 grey table, "albedo_delta_e2000_reason" says why), "adequacy": the tests},
      "plots": {"corner": "corner.png", ...},
-     "loo": {"elpd", "se", "p_loo", "pareto_k_max", "n_high_k"} (or null),
-     "warnings": [{"kind", "parameters", "message"}, ...]}
+     "loo": {"elpd", "se", "p_loo", "pareto_k_max", "n_high_k"} (or null)}
 
 ``loo`` is the PSIS-LOO of the fit (:mod:`analysis.fit.loo`; its pointwise values in
 ``loo.npz``), ``quality["loo_pit"]`` the uniformity test of its LOO-PIT.
 
-Intervals are central (68%: 15.9-84.1 percentiles), in each parameter's natural unit.
+``converged`` is the sampler's verdict; ``adequate`` (true, false or null) whether the model
+describes the data (:mod:`analysis.fit.adequacy`); ``warnings`` what the answer cannot be
+trusted for (:mod:`analysis.fit.trust`). Intervals are central (68%: 15.9-84.1 percentiles),
+in each parameter's natural unit.
 """
 
 from __future__ import annotations
@@ -83,8 +88,12 @@ class FitResult:
         Plot names -> file names, when plots were written.
     loo : analysis.fit.loo.Loo or None
         The PSIS-LOO, when the workflow computed it.
+    adequacy : dict
+        Whether the model describes the data (:func:`analysis.fit.adequacy.adequacy`):
+        ``adequate`` (bool or None), ``reason``, the tests.
     warnings : list of dict
-        ``{"kind", "parameters", "message"}`` each: what the fit cannot be trusted for.
+        ``{"kind", "parameters", "message"}`` each: what the fit cannot be trusted for
+        (:mod:`analysis.fit.trust`; the PSIS-LOO's ``pareto_k``).
     """
 
     names: tuple
@@ -108,6 +117,7 @@ class FitResult:
     quality: dict = dataclasses.field(default_factory=dict)
     plots: dict = dataclasses.field(default_factory=dict)
     loo: object = dataclasses.field(repr=False, default=None)
+    adequacy: dict = dataclasses.field(default_factory=dict)
     warnings: list = dataclasses.field(default_factory=list)
     spec: object = dataclasses.field(repr=False, default=None)
     logpost: object = dataclasses.field(repr=False, default=None)
@@ -131,9 +141,14 @@ class FitResult:
             q = self.residuals()
             quality.update(rms_residual=q["rms"], rms_normalized=q["rms_normalized"],
                            values=int(q["residual"].size))
+        if self.adequacy:
+            quality["adequacy"] = self.adequacy
         doc = {
             "schema": "microcyl-fit", "schema_version": SCHEMA_VERSION,
             "converged": bool(self.converged), "reason": self.reason,
+            "adequate": self.adequacy.get("adequate"),
+            "adequate_reason": self.adequacy.get("reason", "not checked"),
+            "warnings": [dict(w) for w in self.warnings],
             "parameters": {n: dict(self.summary[n]) for n in self.names},
             "fit": {"steps": self.steps, "burn": self.burn, "walkers": self.walkers,
                     "ensembles": self.ensembles,
@@ -144,8 +159,7 @@ class FitResult:
                              if self.spec is not None else {}),
                     "proposal": self.proposal},
             "quality": quality, "plots": dict(self.plots),
-            "loo": None if self.loo is None else self.loo.summary(),
-            "warnings": [dict(w) for w in self.warnings]}
+            "loo": None if self.loo is None else self.loo.summary()}
         return plain(doc)
 
 

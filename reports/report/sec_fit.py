@@ -1,4 +1,5 @@
-"""The "fit" section: the posterior summary of a ``microcyl fit`` of the fabric."""
+"""The "fit" section: the posterior summary of a ``microcyl fit`` of the fabric, its verdicts
+(converged, adequate) and its warnings."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import dataclasses
 from typing import Any
 
 from analysis.fit.results import read_results
-from reports.report.markup import fmt, html, table
+from reports.report.markup import Markup, fmt, html, table
 from reports.report.page import Page
 from reports.report.settings import Section, Unavailable
 
@@ -27,7 +28,8 @@ class FitData:
 
 
 def section_fit(p: Page) -> Section:
-    """Per parameter: median, 68 % and 95 % intervals, τ, R-hat, ESS; and convergence.
+    """Per parameter: median, 68 % and 95 % intervals, τ, R-hat, ESS; convergence, adequacy
+    and the warnings (:mod:`analysis.fit.trust`).
 
     Raises
     ------
@@ -44,5 +46,18 @@ def section_fit(p: Page) -> Section:
     rows = [[k] + [fmt(v.get(f)) for f in _COLUMNS] for k, v in data["parameters"].items()]
     return Section(table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat",
                           "ESS"], rows)
-                   + html("<p>Converged: {}</p>", fmt(data.get("converged"))),
-                   FitData(data))
+                   + html("<p>Converged: {}</p>", fmt(data.get("converged")))
+                   + _trust(data), FitData(data))
+
+
+def _trust(data: dict) -> Markup:
+    """The adequacy verdict and the warnings (every value escaped)."""
+    out = html("<p>Adequate (the model describes the data): {} — {}</p>",
+               fmt(data.get("adequate")), data.get("adequate_reason", "not checked"))
+    warnings = data.get("warnings") or []
+    if not isinstance(warnings, list):
+        return out
+    rows = [[str(w.get("kind", "")), ", ".join(map(str, w.get("parameters") or [])),
+             str(w.get("message", ""))] for w in warnings if isinstance(w, dict)]
+    return out + (table(["warning", "parameters", "message"], rows) if rows
+                  else Markup("<p>No warnings.</p>"))

@@ -6,14 +6,18 @@ of two threads, the paper's six presets, and every variant; importance sampling 
 """
 
 from brdf import directions, frames, sampling, schema, terms
-from brdf.curve import SAMPLING_METHODS, TangentCurve
-from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
+from brdf.curve import TangentCurve
+from brdf.fabric import Fabric, Prepared
+from brdf.options import (GAP_METHODS, OPTIONS, SAMPLING_METHODS, TRANSMISSION_METHODS,
+                          FabricOptions, Gap, TangentSampling, Transmission)
+from brdf.plan import FabricPlan, ThreadPlan
 from brdf.presets import PRESETS, fabric, preset_threads
 from brdf.protocols import BRDF, SampledBRDF, ThreadedBRDF
 from brdf.thread import Thread
 
 __all__ = [
-    "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
+    "Thread", "TangentCurve", "Fabric", "FabricPlan", "ThreadPlan", "FabricOptions",
+    "Transmission", "Gap", "TangentSampling", "Prepared", "fabric", "preset_threads", "PRESETS",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
     "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
 ]

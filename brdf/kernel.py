@@ -59,7 +59,8 @@ import numpy as np
 from brdf.terms import SIGMA_U
 
 __all__ = ["ThreadGeometry", "Sides", "thread_geometry", "longitudinal", "half_difference",
-           "azimuth", "masking", "reweighting", "pair_blend"]
+           "azimuth", "masking", "reweighting", "pair_blend", "u_of_cos", "f_rs_geometry",
+           "f_rv_geometry"]
 
 _K_U = -0.5 / SIGMA_U**2          # u(x) = exp(_K_U x^2)
 #: Below this a cosine or an in-plane length is "tiny": its square may underflow (2^-500,
@@ -282,17 +283,38 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, with_masking=True
     cg2 = c2d * hp
     cg2 *= 0.25
     cg = np.sqrt(cg2)
+    k *= 2.0
+    ks = f_rs_geometry(hp, k)
+    kv = f_rv_geometry(sd.ci, sd.cr, k, degenerate)
+    return ThreadGeometry(th2, cg, cg2, ks, kv, sd.ci if keep_cos else None,
+                          sd.cr if keep_cos else None, pmean)
+
+
+def f_rs_geometry(hp, k):
+    r"""The direction factor of f_rs, :math:`\cos(\phi_d/2)`, times the common factor ``k``:
+    ``ks`` (computed in ``hp``'s storage, which holds :math:`1 + \cos\phi_d` on entry).
+
+    :math:`\cos(\phi_d/2) = \sqrt{(1 + \cos\phi_d)/2} \ge 0` (twin: ``np.cos(phi_d / 2)``).
+    """
     hp *= 0.5
     np.sqrt(hp, out=hp)              # cos(phi_d / 2) >= 0
-    k *= 2.0
-    ks = hp
-    ks *= k
-    kv = sd.ci + sd.cr
+    hp *= k
+    return hp
+
+
+def f_rv_geometry(ci, cr, k, degenerate=False):
+    r"""The direction factor of f_rv, :math:`1/(\cos\theta_i + \cos\theta_r)`, times the
+    common factor ``k``: ``kv`` (a new array).
+
+    With ``degenerate`` (some cos theta = 0), a pair with both directions along the tangent
+    gets 0 (its ``k`` is 0 there) instead of 0/0. The rest of f_rv is
+    :func:`brdf.shading.f_rv`.
+    """
+    kv = ci + cr
     if degenerate:
         np.copyto(kv, 1.0, where=kv == 0.0)   # both along the tangent: k = 0 there
     np.divide(k, kv, out=kv)
-    return ThreadGeometry(th2, cg, cg2, ks, kv, sd.ci if keep_cos else None,
-                          sd.cr if keep_cos else None, pmean)
+    return kv
 
 
 def pair_blend(a, b, cos_delta, k):
@@ -301,10 +323,7 @@ def pair_blend(a, b, cos_delta, k):
     The in-place form of ``terms.pair_weight``: multiplies ``k`` by the result and returns
     the result (computed in ``a``'s storage). ``a`` and ``b`` are overwritten.
     """
-    u = np.arccos(cos_delta)
-    u *= u
-    u *= _K_U
-    np.exp(u, out=u)
+    u = u_of_cos(cos_delta)
     prod = a * b
     np.minimum(a, b, out=a)
     a -= prod
@@ -312,3 +331,14 @@ def pair_blend(a, b, cos_delta, k):
     a += prod
     k *= a
     return a
+
+
+def u_of_cos(cos_delta):
+    r"""MODEL.md's unit-height Gaussian :math:`u(\delta) = \exp(-\delta^2 / (2\sigma_u^2))`
+    of the angle :math:`\delta = \arccos(c)` whose cosine ``cos_delta`` is given (a new
+    array; twin: ``terms.u``)."""
+    u = np.arccos(cos_delta)
+    u *= u
+    u *= _K_U
+    np.exp(u, out=u)
+    return u

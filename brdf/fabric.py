@@ -32,7 +32,8 @@ class Fabric:
     tangent_sampling : {"midpoint", "control_points"}, default "midpoint"
     transmission : {"half_angle", "longitudinal"}, default "half_angle"
     gap : {"incident", "outgoing"}, default "incident"
-        Gap term c_gap of Q: n . wi or n . wo.
+        Gap term c_gap of Q: n . wi or n . wo. The variants are strings or the members of
+        :class:`brdf.TangentSampling`, :class:`brdf.Transmission`, :class:`brdf.Gap`.
     rotation : float, default 0
         Rotation of both threads about n, radians (:data:`brdf.schema.FABRIC`).
     name : str, optional

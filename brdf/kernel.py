@@ -2,25 +2,24 @@ r"""The fast evaluation of the microcylinder model, in MODEL.md's names.
 
 :func:`thread_geometry` computes, for one thread and a chunk of direction pairs, everything
 that depends on the directions and the tangent samples but not on the optical parameters
-(eta, k_d, the gammas, albedo, area); :func:`brdf.shading.thread_shade` turns that into the thread's
-weighted sums for given parameters. ``Fabric.eval`` runs both per chunk; ``Fabric.prepare``
-keeps the geometry so that a fit can shade the same pairs for many parameter sets.
+(eta, k_d, the gammas, albedo, area); :func:`brdf.shading.thread_shade` turns that into the
+thread's weighted sums for given parameters. :class:`brdf.FabricPlan` runs both per chunk
+(``Fabric.eval``); ``Fabric.prepare`` keeps the geometry so that a fit can shade the same pairs
+for many parameter sets.
 
 The blocks carry the names of MODEL.md, and each has a twin in :mod:`brdf.terms` (the same
-equation written from angles) that ``tests/test_brdf_kernel.py`` compares it with:
+equation written from angles) that ``tests/test_brdf_kernel.py`` compares it with (the table of
+every name, shading's included, is in :mod:`brdf`'s docstring)::
 
-=======================  ==========================================  =====================
-block                    computes                                    twin in brdf.terms
-=======================  ==========================================  =====================
-:func:`longitudinal`     s = sin(theta) = w.t, x = w.n_t, cos(theta)  (the frame of MODEL.md)
-:func:`half_difference`  (theta_i + theta_r)^2, 2 cos^2(theta_d)      --
-:func:`azimuth`          cos(phi_d)                                   --
-:func:`masking`          M(wi, wo)                                    ``pair_weight``, ``visibility``
-:func:`reweighting`      P(wi, wo) and its mean over samples          ``pair_weight``, ``visibility``
-:func:`~brdf.shading.fresnel2_into`    2 F_r(eta, cos_g)                            ``fresnel``
-:func:`~brdf.shading.surface_term`     sum_t f_rs M P cos(theta_i) / cos^2(theta_d)  ``gaussian``, ``fresnel``
-:func:`~brdf.shading.volume_term`      sum_t f_rv/A M P cos(theta_i) / cos^2        ``transmission``, ``gaussian``
-=======================  ==========================================  =====================
+    block              computes                                    twin in brdf.terms
+    longitudinal       s = sin(theta) = w.t, x = w.n_t, cos(theta)  (the frame of MODEL.md)
+    half_difference    (theta_i + theta_r)^2, 2 cos^2(theta_d)      --
+    azimuth            cos(phi_d)                                   --
+    masking            M(wi, wo)                                    pair_weight, visibility
+    reweighting        P(wi, wo) and its mean over samples          pair_weight, visibility
+    u_of_cos           u(delta) from cos(delta)                     u
+    f_rs_geometry      cos(phi_d / 2) k: f_rs's direction factor    --
+    f_rv_geometry      k / (cos theta_i + cos theta_r): f_rv's      --
 
 Symbols (arrays (C, S): C pairs by S distinct tangent samples; suffix i for wi, r for wo):
 

@@ -15,6 +15,7 @@ separate (the first once, the second per parameter set):
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -125,12 +126,14 @@ class FabricPlan:
         """The larger number of distinct tangent samples of the two threads."""
         return max(t.ca.size for t in self.threads)
 
+    @functools.cached_property
     def params(self) -> ShadeParams:
-        """The threads' own optical parameters as a batch of one set."""
+        """The threads' own optical parameters as a batch of one set (read-only arrays,
+        made on first use)."""
         th = self.threads
-        row = lambda name: np.array([[getattr(t, name) for t in th]])  # noqa: E731
+        row = lambda name: _frozen([[getattr(t, name) for t in th]])  # noqa: E731
         return ShadeParams(row("eta"), row("kd"), row("gamma_s"), row("gamma_v"),
-                           row("area"), np.array([[t.albedo for t in th]], dtype=np.float64))
+                           row("area"), _frozen([[t.albedo for t in th]]))
 
     # -- the kernel, step 1: geometry ----------------------------------------------------
     def frames(self, wi, wo):
@@ -224,7 +227,7 @@ class FabricPlan:
         return out.reshape(shape + out.shape[1:])
 
     def _eval_into(self, wi, wo, out, split):
-        par = self.params()
+        par = self.params
         chunk = max(64, CHUNK_ELEMENTS // self.samples)
         for start in range(0, wi.shape[0], chunk):
             sl = slice(start, start + chunk)

@@ -116,7 +116,7 @@ class Prepared:
     def _params(self, eta, albedo, kd, gamma_s, gamma_v, area) -> tuple[ShadeParams, tuple]:
         """The parameters checked (the plan's where omitted; gammas to radians) and
         broadcast to one batch, flattened: ``(ShadeParams, batch shape)``."""
-        own = self.plan.params()
+        own = self.plan.params
 
         def param(name, value, default, radians=False):
             if value is None:

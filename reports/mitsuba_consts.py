@@ -108,8 +108,9 @@ def _thread_consts(c: ThreadPlan, lobe_p) -> ThreadConsts:
         opaque(len(c.ca), mi.UInt32), opaque(ca, mi.Float64), opaque(sa, mi.Float64),
         opaque(w), opaque(eta2), opaque(eta2 - 1.0), opaque(kd), opaque(float(c.area)),
         tuple(opaque(float(a)) for a in c.albedo),
-        opaque(-0.125 / gs**2), opaque(GAUSS_NORM / gs), opaque(-0.125 / gv**2),
-        opaque((1.0 - kd) * GAUSS_NORM / gv), (opaque(0.5 / gs), opaque(0.5 / gv)),
+        opaque(float(shading.gaussian_exponent(gs))), opaque(float(shading.gaussian_norm(gs))),
+        opaque(float(shading.gaussian_exponent(gv))),
+        opaque(float(shading.f_rv_coefficients(kd, gv))), (opaque(0.5 / gs), opaque(0.5 / gv)),
         tuple(opaque(float(p)) for p in lobe_p))
 
 

@@ -26,7 +26,7 @@ from brdf.kernel import ThreadGeometry, thread_geometry
 from brdf.options import FabricOptions, Gap, Transmission
 from brdf.shading import SHADE_BLOCK, thread_shade
 
-__all__ = ["FabricPlan", "ThreadPlan", "ShadeParams", "CHUNK_ELEMENTS"]
+__all__ = ["FabricPlan", "ThreadPlan", "ShadeParams", "plan_of", "CHUNK_ELEMENTS"]
 
 #: Target number of (pair, sample) elements per chunk of :meth:`FabricPlan.eval`: large
 #: enough to amortize NumPy's per-call cost, small enough that the working set stays in
@@ -239,3 +239,15 @@ class FabricPlan:
                 self.split_into(shades, pmeans, zi, zo, par, out[sl])
             else:
                 self.combine_into(shades, pmeans, zi, zo, par, out[None, sl])
+
+
+def plan_of(fabric) -> FabricPlan:
+    """The :class:`FabricPlan` of a :class:`brdf.Fabric` (its ``plan``), or the plan itself;
+    what :class:`brdf.Prepared` and :mod:`brdf.sampling` take."""
+    if isinstance(fabric, FabricPlan):
+        return fabric
+    plan = getattr(fabric, "plan", None)
+    if not isinstance(plan, FabricPlan):
+        raise ValueError(f"fabric must be a brdf.Fabric or a brdf.FabricPlan; got "
+                         f"{type(fabric).__name__}")
+    return plan

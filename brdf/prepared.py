@@ -9,7 +9,7 @@ import numpy as np
 from brdf import schema
 from brdf.frames import flat_pairs
 from brdf.kernel import ThreadGeometry
-from brdf.plan import FabricPlan, ShadeParams
+from brdf.plan import FabricPlan, ShadeParams, plan_of
 from brdf.scratch import Scratch
 from brdf.shading import shade_dtype
 
@@ -24,8 +24,9 @@ class Prepared:
 
     Parameters
     ----------
-    plan : brdf.FabricPlan
-        The fabric's compiled form (``Fabric.prepare`` passes its own).
+    plan : brdf.FabricPlan or brdf.Fabric
+        The fabric's compiled form (``Fabric.prepare`` passes its own; a Fabric stands for
+        its ``plan``).
     wi, wo : array_like, shape (n, 3)
         Direction pairs (broadcast, normalized; below-horizon or bad pairs give 0 / NaN).
 
@@ -54,9 +55,7 @@ class Prepared:
     block_elements: int | None = None
 
     def __init__(self, plan: FabricPlan, wi, wo):
-        if not isinstance(plan, FabricPlan):
-            raise ValueError(f"plan must be a brdf.FabricPlan (Fabric.plan); got "
-                             f"{type(plan).__name__}")
+        plan = plan_of(plan)
         wi, wo, shape, bad, below = flat_pairs(wi, wo)
         self.plan = plan
         self.shape = shape

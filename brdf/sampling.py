@@ -39,10 +39,10 @@ import numpy as np
 from scipy.special import ndtr, ndtri
 
 from brdf.frames import as_directions, flat_pairs, normalize
-from brdf.plan import FabricPlan
+from brdf.plan import plan_of
 from brdf.shading import GAUSS_NORM
 
-__all__ = ["COSINE_SHARE", "LOBE_FLOOR", "sample", "pdf", "lobe_probabilities", "plan_of"]
+__all__ = ["COSINE_SHARE", "LOBE_FLOOR", "sample", "pdf", "lobe_probabilities"]
 
 #: Probability of the cosine-weighted hemisphere component.
 COSINE_SHARE = 0.25
@@ -54,18 +54,6 @@ _COS_MIN = 1e-12
 #: (pair, tangent sample) elements per chunk of the pdf.
 _CHUNK = 1 << 15
 _HALF_PI = 0.5 * np.pi
-
-
-def plan_of(fabric) -> FabricPlan:
-    """The :class:`brdf.FabricPlan` of a :class:`brdf.Fabric` (its ``plan``), or the plan
-    itself; what every function here reads."""
-    if isinstance(fabric, FabricPlan):
-        return fabric
-    plan = getattr(fabric, "plan", None)
-    if not isinstance(plan, FabricPlan):
-        raise ValueError(f"fabric must be a brdf.Fabric or a brdf.FabricPlan; got "
-                         f"{type(fabric).__name__}")
-    return plan
 
 
 def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,7 @@ import mitsuba as mi
 
 from brdf import sampling, shading
 from brdf.options import Gap, Transmission
-from brdf.plan import FabricPlan, ThreadPlan
+from brdf.plan import FabricPlan, ThreadPlan, plan_of
 
 __all__ = ["Consts", "ThreadConsts", "consts", "MIN_COMPONENTS", "GAUSS_NORM"]
 
@@ -130,7 +130,7 @@ def _components(plan: FabricPlan, thread_p, lobe_p) -> list:
 def consts(fabric) -> Consts:
     """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric` or its
     :class:`brdf.FabricPlan`) for the variant set."""
-    plan = sampling.plan_of(fabric)
+    plan = plan_of(fabric)
     thread_p, lobe_p = sampling.lobe_probabilities(plan)
     threads = tuple(_thread_consts(c, lobe_p[j]) for j, c in enumerate(plan.threads))
     rows = _components(plan, thread_p, lobe_p)

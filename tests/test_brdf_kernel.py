@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import brdf
-from brdf import combine, kernel, shading, terms
+from brdf import kernel, shading, terms
 
 C, S = 400, 5
 
@@ -125,16 +125,6 @@ def test_surface_and_volume_terms(case, transmission, gammas):
             * ((1 - kd) * terms.gaussian(gv, ang["theta_h"]) + kd) / (ci + cr))
     np.testing.assert_allclose(surf, (f_rs / cos2d * mp * ci) @ weight, rtol=1e-9)
     np.testing.assert_allclose(vol, (f_rv / cos2d * mp * ci) @ weight, rtol=1e-9)
-
-
-def test_combine_rgb_by_hand():
-    rng = np.random.default_rng(3)
-    s, v = rng.random((2, 2, 4, 6))                 # (thread, set, pair)
-    area, albedo, inv = rng.random((4, 2)), rng.random((4, 2, 3)), rng.random((4, 6))
-    out = combine.combine_rgb(s, v, area, albedo, inv, np.empty((4, 6, 3)))
-    b, c, ch = 2, 5, 1
-    want = sum(area[b, j] * (s[j, b, c] + albedo[b, j, ch] * v[j, b, c]) for j in range(2))
-    assert out[b, c, ch] == pytest.approx(want * inv[b, c], rel=1e-14)
 
 
 # -- each of MODEL.md's names (brdf/__init__'s table) against its transliteration ------------

@@ -42,11 +42,12 @@ def test_plan_eval_is_fabric_eval_and_prepared_reads_the_plan():
     np.testing.assert_array_equal(fab.plan.eval(wi, wo, split=True), fab.eval_threads(wi, wo))
     prep = brdf.Prepared(fab.plan, wi, wo)
     np.testing.assert_allclose(prep.eval(), fab.eval(wi, wo), rtol=1e-13, atol=0)
-    with pytest.raises(ValueError, match="plan must be a brdf.FabricPlan"):
-        brdf.Prepared(fab, wi, wo)
+    assert brdf.Prepared(fab, wi, wo).plan is fab.plan
+    with pytest.raises(ValueError, match="fabric must be a brdf.Fabric or a brdf.FabricPlan"):
+        brdf.Prepared(fab.threads, wi, wo)
     with pytest.raises(ValueError, match="fabric must be a brdf.Fabric or a brdf.FabricPlan"):
         brdf.sampling.pdf(object(), wo, wi)
-    assert brdf.sampling.plan_of(fab) is fab.plan and isinstance(fab.plan, FabricPlan)
+    assert brdf.plan.plan_of(fab) is fab.plan and isinstance(fab.plan, FabricPlan)
 
 
 def _sources():

@@ -18,8 +18,8 @@ every name, shading's included, is in :mod:`brdf`'s docstring)::
     masking            M(wi, wo)                                    pair_weight, visibility
     reweighting        P(wi, wo) and its mean over samples          pair_weight, visibility
     u_of_cos           u(delta) from cos(delta)                     u
-    f_rs_geometry      cos(phi_d / 2) k: f_rs's direction factor    --
-    f_rv_geometry      k / (cos theta_i + cos theta_r): f_rv's      --
+    f_rs_geometry      k cos(phi_d / 2), f_rs's direction factor     cos(phi_d / 2), in the tests
+    f_rv_geometry      k / (cos theta_i + cos theta_r), f_rv's one   1 / (ci + cr), in the tests
 
 Symbols (arrays (C, S): C pairs by S distinct tangent samples; suffix i for wi, r for wo):
 

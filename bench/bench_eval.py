@@ -53,7 +53,7 @@ def main():
             best = min(best, time.perf_counter() - t)
         rate = args.pairs * fab.options["tangent_samples"] * 2 / best
         worst = min(worst, rate)
-        distinct = "+".join(str(c.ca.size) for c in fab._const)
+        distinct = "+".join(str(c.ca.size) for c in fab.plan.threads)
         print(f"{name:34s} {distinct:>16s} {best:8.3f} {rate:17.3e}")
     print(f"slowest preset: {worst:.3e} thread-sample evaluations per second (target >= 1e7)")
 

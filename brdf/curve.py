@@ -7,18 +7,11 @@ import dataclasses
 import numpy as np
 
 from brdf import schema, validate
+from brdf.options import MAX_TANGENT_SAMPLES, SAMPLING_METHODS, TangentSampling, validate_method
 
 __all__ = ["TangentCurve", "SAMPLING_METHODS"]
 
 _OFFSETS, _LENGTHS = schema.THREAD["offsets"], schema.THREAD["lengths"]
-
-#: Names accepted by ``tangent_sampling``.
-SAMPLING_METHODS = ("midpoint", "control_points")
-#: The most tangent samples a curve takes (the default is 32): a fixed cap on the work and
-#: memory of each direction pair, whoever asks (a preset's options, a fabric JSON or TOML,
-#: the command line's --tangent-samples, the API).
-MAX_TANGENT_SAMPLES = 4096
-
 
 @dataclasses.dataclass(frozen=True)
 class TangentCurve:
@@ -97,8 +90,8 @@ class TangentCurve:
         ----------
         n : int
             Number of samples N (``tangent_samples``), used by ``"midpoint"``: an integer in
-            1..:data:`MAX_TANGENT_SAMPLES`.
-        method : {"midpoint", "control_points"}
+            1..:data:`brdf.options.MAX_TANGENT_SAMPLES`.
+        method : {"midpoint", "control_points"} or TangentSampling
             ``"midpoint"``: N samples at arc-length midpoints
             :math:`s_m = (m + 1/2) / N \sum l`; ``"control_points"``: the K + 1 listed offsets,
             equally weighted.
@@ -111,8 +104,8 @@ class TangentCurve:
             Their weights (count / number of samples), summing to 1. Evaluating each distinct
             offset once with its weight equals the plain average over all samples.
         """
-        validate.choice("tangent_sampling", method, SAMPLING_METHODS)
-        if method == "control_points":
+        method = validate_method("tangent_sampling", method, TangentSampling)
+        if method is TangentSampling.CONTROL_POINTS:
             alpha = np.asarray(self.offsets)
         else:
             n = validate.integer("tangent_samples", n, lo=1, hi=MAX_TANGENT_SAMPLES)

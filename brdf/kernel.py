@@ -2,25 +2,24 @@ r"""The fast evaluation of the microcylinder model, in MODEL.md's names.
 
 :func:`thread_geometry` computes, for one thread and a chunk of direction pairs, everything
 that depends on the directions and the tangent samples but not on the optical parameters
-(eta, k_d, the gammas, albedo, area); :func:`brdf.shading.thread_shade` turns that into the thread's
-weighted sums for given parameters. ``Fabric.eval`` runs both per chunk; ``Fabric.prepare``
-keeps the geometry so that a fit can shade the same pairs for many parameter sets.
+(eta, k_d, the gammas, albedo, area); :func:`brdf.shading.thread_shade` turns that into the
+thread's weighted sums for given parameters. :class:`brdf.FabricPlan` runs both per chunk
+(``Fabric.eval``); ``Fabric.prepare`` keeps the geometry so that a fit can shade the same pairs
+for many parameter sets.
 
 The blocks carry the names of MODEL.md, and each has a twin in :mod:`brdf.terms` (the same
-equation written from angles) that ``tests/test_brdf_kernel.py`` compares it with:
+equation written from angles) that ``tests/test_brdf_kernel.py`` compares it with (the table of
+every name, shading's included, is in :mod:`brdf`'s docstring)::
 
-=======================  ==========================================  =====================
-block                    computes                                    twin in brdf.terms
-=======================  ==========================================  =====================
-:func:`longitudinal`     s = sin(theta) = w.t, x = w.n_t, cos(theta)  (the frame of MODEL.md)
-:func:`half_difference`  (theta_i + theta_r)^2, 2 cos^2(theta_d)      --
-:func:`azimuth`          cos(phi_d)                                   --
-:func:`masking`          M(wi, wo)                                    ``pair_weight``, ``visibility``
-:func:`reweighting`      P(wi, wo) and its mean over samples          ``pair_weight``, ``visibility``
-:func:`~brdf.shading.fresnel2_into`    2 F_r(eta, cos_g)                            ``fresnel``
-:func:`~brdf.shading.surface_term`     sum_t f_rs M P cos(theta_i) / cos^2(theta_d)  ``gaussian``, ``fresnel``
-:func:`~brdf.shading.volume_term`      sum_t f_rv/A M P cos(theta_i) / cos^2        ``transmission``, ``gaussian``
-=======================  ==========================================  =====================
+    block              computes                                    twin in brdf.terms
+    longitudinal       s = sin(theta) = w.t, x = w.n_t, cos(theta)  (the frame of MODEL.md)
+    half_difference    (theta_i + theta_r)^2, 2 cos^2(theta_d)      --
+    azimuth            cos(phi_d)                                   --
+    masking            M(wi, wo)                                    pair_weight, visibility
+    reweighting        P(wi, wo) and its mean over samples          pair_weight, visibility
+    u_of_cos           u(delta) from cos(delta)                     u
+    f_rs_geometry      k cos(phi_d / 2), f_rs's direction factor     cos(phi_d / 2), in the tests
+    f_rv_geometry      k / (cos theta_i + cos theta_r), f_rv's one   1 / (ci + cr), in the tests
 
 Symbols (arrays (C, S): C pairs by S distinct tangent samples; suffix i for wi, r for wo):
 
@@ -59,7 +58,8 @@ import numpy as np
 from brdf.terms import SIGMA_U
 
 __all__ = ["ThreadGeometry", "Sides", "thread_geometry", "longitudinal", "half_difference",
-           "azimuth", "masking", "reweighting", "pair_blend"]
+           "azimuth", "masking", "reweighting", "pair_blend", "u_of_cos", "f_rs_geometry",
+           "f_rv_geometry"]
 
 _K_U = -0.5 / SIGMA_U**2          # u(x) = exp(_K_U x^2)
 #: Below this a cosine or an in-plane length is "tiny": its square may underflow (2^-500,
@@ -282,17 +282,38 @@ def thread_geometry(ti, bi, zi, to, bo, zo, ca, sa, weight, *, with_masking=True
     cg2 = c2d * hp
     cg2 *= 0.25
     cg = np.sqrt(cg2)
+    k *= 2.0
+    ks = f_rs_geometry(hp, k)
+    kv = f_rv_geometry(sd.ci, sd.cr, k, degenerate)
+    return ThreadGeometry(th2, cg, cg2, ks, kv, sd.ci if keep_cos else None,
+                          sd.cr if keep_cos else None, pmean)
+
+
+def f_rs_geometry(hp, k):
+    r"""The direction factor of f_rs, :math:`\cos(\phi_d/2)`, times the common factor ``k``:
+    ``ks`` (computed in ``hp``'s storage, which holds :math:`1 + \cos\phi_d` on entry).
+
+    :math:`\cos(\phi_d/2) = \sqrt{(1 + \cos\phi_d)/2} \ge 0` (twin: ``np.cos(phi_d / 2)``).
+    """
     hp *= 0.5
     np.sqrt(hp, out=hp)              # cos(phi_d / 2) >= 0
-    k *= 2.0
-    ks = hp
-    ks *= k
-    kv = sd.ci + sd.cr
+    hp *= k
+    return hp
+
+
+def f_rv_geometry(ci, cr, k, degenerate=False):
+    r"""The direction factor of f_rv, :math:`1/(\cos\theta_i + \cos\theta_r)`, times the
+    common factor ``k``: ``kv`` (a new array).
+
+    With ``degenerate`` (some cos theta = 0), a pair with both directions along the tangent
+    gets 0 (its ``k`` is 0 there) instead of 0/0. The rest of f_rv is
+    :func:`brdf.shading.f_rv`.
+    """
+    kv = ci + cr
     if degenerate:
         np.copyto(kv, 1.0, where=kv == 0.0)   # both along the tangent: k = 0 there
     np.divide(k, kv, out=kv)
-    return ThreadGeometry(th2, cg, cg2, ks, kv, sd.ci if keep_cos else None,
-                          sd.cr if keep_cos else None, pmean)
+    return kv
 
 
 def pair_blend(a, b, cos_delta, k):
@@ -301,10 +322,7 @@ def pair_blend(a, b, cos_delta, k):
     The in-place form of ``terms.pair_weight``: multiplies ``k`` by the result and returns
     the result (computed in ``a``'s storage). ``a`` and ``b`` are overwritten.
     """
-    u = np.arccos(cos_delta)
-    u *= u
-    u *= _K_U
-    np.exp(u, out=u)
+    u = u_of_cos(cos_delta)
     prod = a * b
     np.minimum(a, b, out=a)
     a -= prod
@@ -312,3 +330,14 @@ def pair_blend(a, b, cos_delta, k):
     a += prod
     k *= a
     return a
+
+
+def u_of_cos(cos_delta):
+    r"""MODEL.md's unit-height Gaussian :math:`u(\delta) = \exp(-\delta^2 / (2\sigma_u^2))`
+    of the angle :math:`\delta = \arccos(c)` whose cosine ``cos_delta`` is given (a new
+    array; twin: ``terms.u``)."""
+    u = np.arccos(cos_delta)
+    u *= u
+    u *= _K_U
+    np.exp(u, out=u)
+    return u

@@ -3,28 +3,32 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from brdf import schema
 from brdf.frames import flat_pairs
 from brdf.kernel import ThreadGeometry
+from brdf.plan import FabricPlan, ShadeParams, plan_of
 from brdf.scratch import Scratch
-from brdf.shading import (SHADE_BLOCK, combine_rgb, inverse_denominator, shade_dtype,
-                          thread_shade)
-
-if TYPE_CHECKING:                    # brdf.fabric imports this module
-    from brdf.fabric import Fabric
+from brdf.shading import shade_dtype
 
 __all__ = ["Prepared"]
 
 
 class Prepared:
-    """Direction-dependent work of a Fabric done once for n fixed pairs.
+    """Direction-dependent work of a fabric done once for n fixed pairs.
 
     ``eval`` shades the pairs for batches of optical parameters; tangent curves and options
-    are those of the fabric it was prepared from.
+    are those of the plan (:attr:`brdf.Fabric.plan`) it was prepared from.
+
+    Parameters
+    ----------
+    plan : brdf.FabricPlan or brdf.Fabric
+        The fabric's compiled form (``Fabric.prepare`` passes its own; a Fabric stands for
+        its ``plan``).
+    wi, wo : array_like, shape (n, 3)
+        Direction pairs (broadcast, normalized; below-horizon or bad pairs give 0 / NaN).
 
     Attributes
     ----------
@@ -50,15 +54,15 @@ class Prepared:
 
     block_elements: int | None = None
 
-    def __init__(self, fabric: Fabric, wi, wo):
+    def __init__(self, plan: FabricPlan, wi, wo):
+        plan = plan_of(plan)
         wi, wo, shape, bad, below = flat_pairs(wi, wo)
-        self.fabric = fabric
+        self.plan = plan
         self.shape = shape
         self._bad = bad
         self._ok = ~(bad | below)
         wi_ok, wo_ok = wi[self._ok], wo[self._ok]
-        sides = fabric._frames(wi_ok, wo_ok)
-        self._geoms = [fabric._geometry(j, sides[j]) for j in range(2)]
+        self._geoms = plan.geometry(wi_ok, wo_ok)
         self._geoms32: list[ThreadGeometry] | None = None
         self._scratch = Scratch()
         self._zi = wi_ok[:, 2]
@@ -95,29 +99,45 @@ class Prepared:
             whole batch before any shading. If ``dtype`` is not float64 or float32.
         """
         geoms = self._geometries(dtype)
-        fab = self.fabric
-        th = fab.threads
+        par, batch = self._params(eta, albedo, kd, gamma_s, gamma_v, area)
+        nb = par.eta.shape[0]
+        plan, block = self.plan, self.block_elements
+        shades = plan.shade(geoms, par, block=block, scratch=self._scratch)
+        out = (np.empty if self._ok.all() else np.zeros)((nb, self._ok.size, 3))
+        vals = out if self._ok.all() else self._scratch.array("vals", (nb, self._zi.size, 3))
+        plan.combine_into(shades, [g.pmean for g in self._geoms], self._zi, self._zo, par,
+                          vals, block=block)
+        if vals is not out:
+            out[:, self._ok] = vals
+        out[:, self._bad] = np.nan
+        return out.reshape(batch + self.shape + (3,))
 
-        def param(name, value, default):
+    def _params(self, eta, albedo, kd, gamma_s, gamma_v, area) -> tuple[ShadeParams, tuple]:
+        """The parameters checked (the plan's where omitted; gammas to radians) and
+        broadcast to one batch, flattened: ``(ShadeParams, batch shape)``."""
+        own = self.plan.params
+
+        def param(name, value, default, radians=False):
             if value is None:
-                return np.asarray(default, dtype=np.float64)
+                return default[0]
             try:
                 v = np.asarray(value, dtype=np.float64)
             except (TypeError, ValueError):
                 raise ValueError(f"{name} must be a numeric array; got {value!r}") from None
-            want = np.shape(default)
+            want = default.shape[1:]
             if v.shape[v.ndim - len(want):] != want:
                 raise ValueError(f"{name} must have shape (..., {', '.join(map(str, want))}); "
                                  f"got {v.shape}")
-            return schema.THREAD[name].check_array(v)
+            v = schema.THREAD[name].check_array(v)
+            return np.radians(v) if radians else v
 
-        eta = param("eta", eta, [t.eta for t in th])
-        kd = param("kd", kd, [t.kd for t in th])
-        gs = np.radians(param("gamma_s", gamma_s, [t.gamma_s for t in th]))
-        gv = np.radians(param("gamma_v", gamma_v, [t.gamma_v for t in th]))
-        area = param("area", area, [t.area for t in th])
+        eta = param("eta", eta, own.eta)
+        kd = param("kd", kd, own.kd)
+        gs = param("gamma_s", gamma_s, own.gamma_s, radians=True)
+        gv = param("gamma_v", gamma_v, own.gamma_v, radians=True)
+        area = param("area", area, own.area)
         schema.check_area_sums(area)
-        alb = param("albedo", albedo, [t.albedo for t in th])
+        alb = param("albedo", albedo, own.albedo)
         batch = np.broadcast_shapes(eta.shape[:-1], kd.shape[:-1], gs.shape[:-1],
                                     gv.shape[:-1], area.shape[:-1], alb.shape[:-2])
         nb = math.prod(batch)
@@ -126,20 +146,7 @@ class Prepared:
             tail = x.shape[x.ndim - k:]
             return np.broadcast_to(x, batch + tail).reshape((nb,) + tail)
 
-        eta, kd, gs, gv, area = (flat(x, 1) for x in (eta, kd, gs, gv, area))
-        # thread, (surface, volume), set, pair
-        shades = self._scratch.array("sums", (2, 2, nb, self._zi.size), geoms[0].th2.dtype)
-        for j, (g, c) in enumerate(zip(geoms, fab._const)):
-            thread_shade(g, c.weight, eta[:, j], kd[:, j], gs[:, j], gv[:, j],
-                         fab.options["transmission"], out=tuple(shades[j]),
-                         block=self.block_elements, scratch=self._scratch)
-        out = (np.empty if self._ok.all() else np.zeros)((nb, self._ok.size, 3))
-        vals = out if self._ok.all() else self._scratch.array("vals", (nb, self._zi.size, 3))
-        self._combine_into(shades, area, flat(alb, 2), vals)
-        if vals is not out:
-            out[:, self._ok] = vals
-        out[:, self._bad] = np.nan
-        return out.reshape(batch + self.shape + (3,))
+        return ShadeParams(*(flat(x, 1) for x in (eta, kd, gs, gv, area)), flat(alb, 2)), batch
 
     def _geometries(self, dtype) -> list[ThreadGeometry]:
         """The threads' geometry in ``dtype`` (float32 copies made once, on first use)."""
@@ -149,23 +156,6 @@ class Prepared:
             self._geoms32 = [ThreadGeometry(*(None if a is None else _to_float32(a) for a in g))
                              for g in self._geoms]
         return self._geoms32
-
-    def _combine_into(self, shades, area, alb, vals):
-        """f_r = (a_1 S_1 + a_2 S_2) / (Q n.wi) into ``vals`` (nb, C, 3), in blocks of pairs.
-
-        ``shades`` (2, 2, nb, C): per thread the surface and volume sums; ``area`` (nb, 2),
-        ``alb`` (nb, 2, 3).
-        """
-        nb, nc = shades.shape[2:]
-        step = max(1, (self.block_elements or SHADE_BLOCK) // (4 * max(nb, 1)))
-        a1, a2 = area[:, 0, None], area[:, 1, None]
-        for c0 in range(0, nc, step):
-            sl = slice(c0, c0 + step)
-            pmeans = [None if g.pmean is None else g.pmean[sl] for g in self._geoms]
-            q = self.fabric._q(pmeans, a1, a2, self._zi[sl], self._zo[sl])
-            inv = inverse_denominator(q, self._zi[sl])
-            combine_rgb(shades[:, 0, :, sl], shades[:, 1, :, sl], area, alb, inv,
-                        vals[:, sl])
 
 
 def _to_float32(a: np.ndarray) -> np.ndarray:

@@ -39,6 +39,8 @@ import numpy as np
 from scipy.special import ndtr, ndtri
 
 from brdf.frames import as_directions, flat_pairs, normalize
+from brdf.plan import plan_of
+from brdf.shading import GAUSS_NORM
 
 __all__ = ["COSINE_SHARE", "LOBE_FLOOR", "sample", "pdf", "lobe_probabilities"]
 
@@ -52,7 +54,6 @@ _COS_MIN = 1e-12
 #: (pair, tangent sample) elements per chunk of the pdf.
 _CHUNK = 1 << 15
 _HALF_PI = 0.5 * np.pi
-_GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
 
 
 def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
@@ -60,7 +61,7 @@ def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    fabric : brdf.Fabric
+    fabric : brdf.Fabric or brdf.FabricPlan
 
     Returns
     -------
@@ -88,13 +89,14 @@ def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
     >>> thread.round(3).tolist(), lobe.sum(axis=1).round(12).tolist()
     ([0.375, 0.375], [1.0, 1.0])
     """
+    plan = plan_of(fabric)
     energy = np.empty((2, 3))
-    for j, t in enumerate(fabric.threads):
+    for j, t in enumerate(plan.threads):
         f0 = ((t.eta - 1.0) / (t.eta + 1.0)) ** 2
         vol = (1.0 - f0) ** 2 * max(t.albedo)
         energy[j] = (2.0 * f0, 2.0 * (1.0 - t.kd) * vol, 0.5 * np.pi * t.kd * vol)
     lobe = LOBE_FLOOR + (1.0 - 3.0 * LOBE_FLOOR) * energy / energy.sum(axis=1, keepdims=True)
-    area = np.array([t.area for t in fabric.threads])
+    area = np.array([t.area for t in plan.threads])
     e = area * energy.sum(axis=1)
     live = area > 0
     thread = np.zeros(2)
@@ -105,18 +107,18 @@ def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
     return thread * (1.0 - COSINE_SHARE) if live.any() else thread, lobe
 
 
-def _axes(fabric):
+def _axes(plan):
     """In-plane tangent t0 and binormal b = n x t0 of each thread, shape (2, 3) each."""
-    rot = fabric.options["rotation"]
+    rot = plan.options.rotation
     c, s = np.cos(rot), np.sin(rot)
     t0 = np.array([[c, s, 0.0], [-s, c, 0.0]])
     b = np.array([[-s, c, 0.0], [-c, -s, 0.0]])
     return t0, b
 
 
-def _sigmas(fabric):
+def _sigmas(plan):
     """Standard deviations 2 gamma_s, 2 gamma_v of the longitudinal lobes, (2, 2) radians."""
-    return np.array([[2.0 * c.gamma_s, 2.0 * c.gamma_v] for c in fabric._const])
+    return np.array([[2.0 * c.gamma_s, 2.0 * c.gamma_v] for c in plan.threads])
 
 
 def _gauss_mass(mu, sigma):
@@ -129,7 +131,7 @@ def pdf(fabric, wo, wi) -> np.ndarray:
 
     Parameters
     ----------
-    fabric : brdf.Fabric
+    fabric : brdf.Fabric or brdf.FabricPlan
     wo : array_like, shape (..., 3)
         Directions toward the viewer (normalized here).
     wi : array_like, shape (..., 3)
@@ -161,27 +163,27 @@ def pdf(fabric, wo, wi) -> np.ndarray:
     >>> bool(pdf(fab, wo, [0.5, 0.0, 0.8660254]) > 0)
     True
     """
+    plan = plan_of(fabric)
     wi, wo, shape, bad, _ = flat_pairs(wi, wo)
     out = np.empty(wi.shape[0])
-    smax = max(c.ca.size for c in fabric._const)
-    chunk = max(64, _CHUNK // smax)
+    chunk = max(64, _CHUNK // plan.samples)
     for start in range(0, wi.shape[0], chunk):
         sl = slice(start, start + chunk)
-        out[sl] = _pdf_flat(fabric, wi[sl], wo[sl])
+        out[sl] = _pdf_flat(plan, wi[sl], wo[sl])
     out[bad] = np.nan
     return out.reshape(shape)
 
 
-def _pdf_flat(fabric, wi, wo):
+def _pdf_flat(plan, wi, wo):
     """The mixture density for unit (n, 3) arrays."""
-    thread, lobe = lobe_probabilities(fabric)
-    t0, b = _axes(fabric)
-    sig = _sigmas(fabric)
-    masking = fabric.options["masking"]
+    thread, lobe = lobe_probabilities(plan)
+    t0, b = _axes(plan)
+    sig = _sigmas(plan)
+    masking = plan.options.masking
     if wo.shape[0] > 1 and np.all(wo == wo[:1]):
         wo = wo[:1]                     # one viewer (the common case): its terms once
     total = (1.0 - thread.sum()) / np.pi * np.maximum(wi[:, 2], 0.0)
-    for j, c in enumerate(fabric._const):
+    for j, c in enumerate(plan.threads):
         if thread[j] == 0.0:
             continue
         (ti, bi, zi), (to, zo) = (wi @ t0[j], wi @ b[j], wi[:, 2]), (wo @ t0[j], wo[:, 2])
@@ -194,7 +196,7 @@ def _pdf_flat(fabric, wi, wo):
         br = wo @ b[j]                                    # only theta_r of wo is needed
         mu = -np.arctan2(sr, np.sqrt(xr * xr + br[:, None] ** 2))
         th = np.arctan2(si, cth)
-        scale = [_GAUSS_NORM / (s * _gauss_mass(mu, s)) for s in sig[j]]
+        scale = [GAUSS_NORM / (s * _gauss_mass(mu, s)) for s in sig[j]]
         # p_phi / cos(theta) and p_phi for the two parametrizations
         if masking:
             pphi = np.maximum(xi, 0.0) / (2.0 * cth)
@@ -230,13 +232,13 @@ def _check_u(u, shape):
     return arr, out
 
 
-def _components(fabric):
+def _components(plan):
     """Flat component table: cumulative probabilities and, per lobe component, its thread,
     tangent offset (cos, sin) and kind (0 surface, 1 volume, 2 isotropic). Component 0 is
     the cosine-weighted hemisphere."""
-    thread, lobe = lobe_probabilities(fabric)
+    thread, lobe = lobe_probabilities(plan)
     prob, jj, ca, sa, kind = [1.0 - thread.sum()], [0], [1.0], [0.0], [-1]
-    for j, c in enumerate(fabric._const):
+    for j, c in enumerate(plan.threads):
         if thread[j] == 0.0:
             continue
         p = thread[j] * c.weight[:, None] * lobe[j][None, :]        # (S, 3)
@@ -251,14 +253,14 @@ def _components(fabric):
     return cdf, np.asarray(jj), np.asarray(ca), np.asarray(sa), np.asarray(kind)
 
 
-def _draw(fabric, wo, u0, u1):
+def _draw(plan, wo, u0, u1):
     """Directions wi (n, 3) for unit wo (n, 3) and uniforms u0, u1 (n,)."""
-    cdf, jj, ca, sa, kind = _components(fabric)
+    cdf, jj, ca, sa, kind = _components(plan)
     k = np.minimum(np.searchsorted(cdf, u0, side="right"), cdf.size - 1)
     lo = np.where(k > 0, cdf[np.maximum(k - 1, 0)], 0.0)
     v = np.clip((u0 - lo) / (cdf[k] - lo), 0.0, np.nextafter(1.0, 0.0))
     j, ca, sa, kind = jj[k], ca[k], sa[k], kind[k]
-    t0, b = _axes(fabric)
+    t0, b = _axes(plan)
     t0, b = t0[j], b[j]
     n = np.array([0.0, 0.0, 1.0])
     t = ca[:, None] * t0 + sa[:, None] * n
@@ -268,7 +270,7 @@ def _draw(fabric, wo, u0, u1):
     xr = np.einsum("ij,ij->i", wo, nt)
     br = np.einsum("ij,ij->i", wo, b)
     mu = -np.arctan2(sr, np.hypot(xr, br))
-    sig = _sigmas(fabric)[j, np.minimum(kind, 1)]
+    sig = _sigmas(plan)[j, np.minimum(kind, 1)]
     lo_p = ndtr((-_HALF_PI - mu) / sig)
     th = mu + sig * ndtri(lo_p + v * _gauss_mass(mu, sig))
     th = np.clip(th, -_HALF_PI, _HALF_PI)
@@ -276,7 +278,7 @@ def _draw(fabric, wo, u0, u1):
     iso = kind == 2
     s[iso] = 2.0 * v[iso] - 1.0
     c[iso] = 2.0 * np.sqrt(v[iso] * (1.0 - v[iso]))
-    if fabric.options["masking"]:
+    if plan.options.masking:
         phi = np.arcsin(2.0 * u1 - 1.0)
     else:
         phi = np.pi * (2.0 * u1 - 1.0)
@@ -293,7 +295,7 @@ def sample(fabric, wo, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    fabric : brdf.Fabric
+    fabric : brdf.Fabric or brdf.FabricPlan
     wo : array_like, shape (..., 3)
         Directions toward the viewer, local frame (normalized here).
     u : array_like, shape (..., 2)
@@ -338,14 +340,15 @@ def sample(fabric, wo, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     >>> bool(np.allclose(p, pdf(fab, wo, wi)))
     True
     """
+    plan = plan_of(fabric)
     wo = as_directions("wo", wo)
     u, shape = _check_u(u, wo.shape[:-1])
     wo_f = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
     u_f = np.broadcast_to(u, shape + (2,)).reshape(-1, 2)
     wo_f, bad = normalize(wo_f)
-    wi = _draw(fabric, wo_f, u_f[:, 0], u_f[:, 1])
-    p = pdf(fabric, wo_f, wi)
-    f = fabric.eval(wi, wo_f)
+    wi = _draw(plan, wo_f, u_f[:, 0], u_f[:, 1])
+    p = pdf(plan, wo_f, wi)
+    f = plan.eval(wi, wo_f)
     zi = np.maximum(wi[:, 2], 0.0)
     weight = np.divide(f * zi[:, None], p[:, None], out=np.zeros_like(f),
                        where=(p[:, None] > 0) & (f > 0))

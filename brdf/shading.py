@@ -13,11 +13,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+from brdf.combine import DENOM_MIN  # noqa: F401  (its older home: gonio.rgl imports it here)
 from brdf.kernel import ThreadGeometry
+from brdf.options import Transmission, validate_method
 
-__all__ = ["thread_shade", "combine_rgb", "fresnel2_into", "surface_term", "volume_term",
-           "inverse_denominator", "shade_dtype", "GAUSS_NORM", "SHADE_BLOCK", "DENOM_MIN",
-           "SHADE_DTYPES"]
+__all__ = ["thread_shade", "fresnel2_into", "transmission_into", "gaussian_norm",
+           "gaussian_exponent", "gaussian_into", "surface_term", "volume_term", "f_rv",
+           "f_rv_coefficients", "shade_dtype", "GAUSS_NORM", "SHADE_BLOCK", "SHADE_DTYPES"]
 
 GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
 
@@ -27,10 +29,30 @@ GAUSS_NORM = 1.0 / np.sqrt(2.0 * np.pi)
 #: NumPy calls a block costs than they gained; 2^18 was no faster.
 SHADE_BLOCK = 1 << 17
 
-#: The least Q (n . wi) that f_r is divided by, 2^-1000 (about 9.3e-302). MODEL.md's f_r grows
-#: like 1/(n . wi) at grazing incidence (the thread-frame cos(theta_i) in S_j does not vanish
-#: with n . wi); below this the exact value would leave the float64 range, so it saturates.
-DENOM_MIN = 2.0 ** -1000
+def gaussian_norm(gamma):
+    r"""The factor :math:`1/(\gamma\sqrt{2\pi})` of MODEL.md's unit-area Gaussian g, 1/rad.
+
+    >>> float(gaussian_norm(1.0)) == float(GAUSS_NORM)
+    True
+    """
+    return GAUSS_NORM / gamma
+
+
+def gaussian_exponent(gamma):
+    r"""The exponent of g per unit of ``th2`` = :math:`(\theta_i + \theta_r)^2 = 4\theta_h^2`:
+    :math:`-1/(8\gamma^2)`, 1/rad^2, so that :math:`e^{-\theta_h^2/(2\gamma^2)} =
+    e^{\mathrm{th2}\cdot(-1/(8\gamma^2))}`."""
+    return -0.125 / (gamma * gamma)
+
+
+def gaussian_into(th2, exponent, out):
+    r"""The exponential of MODEL.md's Gaussian :math:`g(\gamma, \theta_h)`, into ``out``:
+    :math:`\exp(\mathrm{th2}\cdot\mathrm{exponent})` (``exponent`` from
+    :func:`gaussian_exponent`); g is this times :func:`gaussian_norm`, a per-row factor the
+    callers apply after the sum over samples (twin: ``terms.gaussian``). Returns ``out``."""
+    np.multiply(th2, exponent, out=out)
+    np.exp(out, out=out)
+    return out
 
 
 def _fresnel_from_cos(eta2, c, c2):
@@ -116,11 +138,11 @@ def _shade_params(eta, kd, gamma_s, gamma_v, dtype=np.float64) -> _ShadeParams:
     c3 = (slice(None), None, None)
     clamp = PARAM_CLAMP if np.dtype(dtype) == np.float64 else PARAM_CLAMP_32
     eta, gamma_s, gamma_v = (np.clip(x, *clamp) for x in (eta, gamma_s, gamma_v))
-    s_scale = GAUSS_NORM / gamma_s
+    s_scale = gaussian_norm(gamma_s)
     s_scale *= 0.5
-    par = _ShadeParams((eta * eta)[c3], (-0.125 / (gamma_s * gamma_s))[c3],
-                       (-0.125 / (gamma_v * gamma_v))[c3], gamma_v == 2.0 * gamma_s,
-                       s_scale[:, None], ((1.0 - kd) * GAUSS_NORM / gamma_v)[c3], kd[c3])
+    par = _ShadeParams((eta * eta)[c3], gaussian_exponent(gamma_s)[c3],
+                       gaussian_exponent(gamma_v)[c3], gamma_v == 2.0 * gamma_s,
+                       s_scale[:, None], f_rv_coefficients(kd, gamma_v)[c3], kd[c3])
     if np.dtype(dtype) == np.float64:
         return par
     return _ShadeParams(*(a if a.dtype == bool else a.astype(dtype) for a in par))
@@ -165,8 +187,7 @@ def surface_term(geom, weight, par, f2, ev, es, out):
         np.multiply(ev, ev, out=es)     # exp(a)^4 = exp(4 a): gamma_s = gamma_v / 2 (Table II)
         es *= es
     else:
-        np.multiply(geom.th2, par.cs, out=es)
-        np.exp(es, out=es)
+        gaussian_into(geom.th2, par.cs, es)
         if par.once.any():              # those rows as in the single-set evaluation
             once = par.once
             lobe = ev[once]
@@ -179,33 +200,69 @@ def surface_term(geom, weight, par, f2, ev, es, out):
     out *= par.s_scale
 
 
-def volume_term(geom, weight, par, f2, ev, transmission, out):
-    r"""The volume sums :math:`\sum_t w_t (f_{rv}/A) M P \cos\theta_i / \cos^2\theta_d`
-    (1/sr) of a block of rows, into ``out`` (b, c).
+def transmission_into(f2, geom, eta2, transmission):
+    r"""MODEL.md's transmission F_T, up to a constant factor: ``(ft, scale)`` with
+    :math:`F_T` = ``ft * scale``.
 
-    :math:`f_{rv}/A = F_T ((1 - k_d) g(\gamma_v, \theta_h) + k_d) / (\cos\theta_i +
-    \cos\theta_r)` (twins: ``terms.transmission``, ``terms.gaussian``), summed as
-    :math:`(1-k_d)\,\mathrm{norm} \sum_t w F_T k_v e_v + k_d \sum_t w F_T k_v`. ``f2`` (2F
-    of cos g) and ``ev`` (the lobe's exponential) are overwritten.
+    ``"half_angle"``: :math:`F_T = (1 - F_r(\eta, \cos g))^2` = (2 - 2F)^2 / 4, formed in
+    ``f2`` (2F of cos g, overwritten; scale 1/4, a power of two: exact);
+    ``"longitudinal"``: :math:`(1 - F_r(\eta, \cos\theta_i))(1 - F_r(\eta,
+    \cos\theta_r))` from the geometry's cosines (a new array; scale 1). Twin:
+    ``terms.transmission``.
     """
-    if transmission == "half_angle":
+    if transmission is Transmission.HALF_ANGLE:
         ft = np.subtract(2.0, f2, out=f2)   # 2 (1 - F), exactly; F_T = ft^2 / 4
         ft *= ft
-        scale = 0.25
-    else:
-        ft = 1.0 - _fresnel_from_cos(par.eta2, geom.ci, geom.ci * geom.ci)
-        ft *= 1.0 - _fresnel_from_cos(par.eta2, geom.cr, geom.cr * geom.cr)
-        scale = 1.0
-    ft *= geom.kv
+        return ft, 0.25
+    ft = 1.0 - _fresnel_from_cos(eta2, geom.ci, geom.ci * geom.ci)
+    ft *= 1.0 - _fresnel_from_cos(eta2, geom.cr, geom.cr * geom.cr)
+    return ft, 1.0
+
+
+def f_rv_coefficients(kd, gamma_v):
+    r"""The per-row factor of f_rv's lobe, :math:`(1 - k_d)/(\gamma_v\sqrt{2\pi})`, 1/rad
+    (its flat part's factor is k_d itself): :math:`(1 - k_d) g(\gamma_v, \theta_h) + k_d`
+    is this times the lobe's exponential (:func:`gaussian_into`) plus k_d."""
+    return (1.0 - kd) * GAUSS_NORM / gamma_v
+
+
+def f_rv(ft, ev, weight, v_scale, kd, scale, out):
+    r"""MODEL.md's volume term f_rv, summed over the samples: into ``out`` (b, c),
+    :math:`\sum_t w_t\, (f_{rv}/A)\, k` in 1/sr.
+
+    .. math::
+        f_{rv} = A\, F_T\, ((1 - k_d)\, g(\gamma_v, \theta_h) + k_d)
+        / (\cos\theta_i + \cos\theta_r)
+
+    assembled from its factors, each computed where it is cheapest and named after it:
+    ``ft`` (b, c, S) is F_T / ``scale`` (:func:`transmission_into`) already multiplied by
+    ``kv`` = k / (cos theta_i + cos theta_r) (:func:`brdf.kernel.f_rv_geometry`, per pair and
+    sample, k the common factor cos(theta_i) M P / cos^2(theta_d)); ``ev`` (b, c, S) the
+    lobe's exponential (:func:`gaussian_into`), overwritten; ``v_scale`` (b, 1) the factor
+    :func:`f_rv_coefficients` and ``kd`` (b, 1) k_d, per row. The sum is taken as
+    :math:`v \sum_t w F_T k_v e_v + k_d \sum_t w F_T k_v`; the albedo A, constant over
+    the samples, multiplies the sums in :func:`brdf.combine.combine_rgb`.
+    """
     ev *= ft
     _weighted_sum(ev, weight, out)
-    out *= par.v_scale[:, :, 0]
+    out *= v_scale
     flat = np.empty_like(out)
     _weighted_sum(ft, weight, flat)
-    flat *= par.kd[:, :, 0]
+    flat *= kd
     out += flat
     if scale != 1.0:
         out *= scale
+
+
+def volume_term(geom, weight, par, f2, ev, transmission, out):
+    r"""The volume sums :math:`\sum_t w_t (f_{rv}/A) M P \cos\theta_i / \cos^2\theta_d`
+    (1/sr) of a block of rows, into ``out`` (b, c): :func:`transmission_into`, then
+    :func:`f_rv` (twins: ``terms.transmission``, ``terms.gaussian``). ``f2`` (2F of cos g)
+    and ``ev`` (the lobe's exponential) are overwritten.
+    """
+    ft, scale = transmission_into(f2, geom, par.eta2, transmission)
+    ft *= geom.kv
+    f_rv(ft, ev, weight, par.v_scale[:, :, 0], par.kd[:, :, 0], scale, out)
 
 
 def _shade_block(geom, weight, par, transmission, surf, vol, work):
@@ -218,8 +275,7 @@ def _shade_block(geom, weight, par, transmission, surf, vol, work):
     a, f2, es, d = (work[k * n:(k + 1) * n].reshape(shape) for k in range(4))
     fresnel2_into(par.eta2, geom.cg, geom.cg2, a, f2, es, d)     # 2F in f2
     # The volume lobe's exponential exp(-theta_h^2 / (2 gamma_v^2)); theta_h^2 = th2 / 4.
-    ev = np.multiply(geom.th2, par.cv, out=a)
-    np.exp(ev, out=ev)
+    ev = gaussian_into(geom.th2, par.cv, a)
     surface_term(geom, weight, par, f2, ev, es, surf)
     volume_term(geom, weight, par, f2, ev, transmission, vol)
 
@@ -266,6 +322,7 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
     surface lobe is the volume lobe to the fourth power, one ``exp`` for both.
     """
     dtype = shade_dtype(geom.th2.dtype)
+    transmission = validate_method("transmission", transmission, Transmission)
     params = [np.asarray(x, dtype=np.float64) for x in (eta, kd, gamma_s, gamma_v)]
     batch = np.broadcast_shapes(*(x.shape for x in params))
     nb = math.prod(batch)
@@ -282,55 +339,4 @@ def thread_shade(geom: ThreadGeometry, weight, eta, kd, gamma_s, gamma_v,
         g = ThreadGeometry(*(None if x is None else x[pairs] for x in geom))
         _shade_block(g, weight, par.rows(rows), transmission, surf[rows, pairs],
                      vol[rows, pairs], work)
-    return out
-
-
-def inverse_denominator(q, zi) -> np.ndarray:
-    r""":math:`1 / (Q\, n\cdot w_i)` (broadcast), 0 where Q or n . wi is not positive.
-
-    The product is taken as at least :data:`DENOM_MIN`, so that f_r stays finite for every
-    direction above the horizon, however close to it (n . wi = 1e-200 gives about 1e200 / sr
-    times the cosine-weighted value, as MODEL.md's equation does).
-    """
-    denom = np.multiply(q, zi)
-    ok = (np.asarray(q) > 0) & (zi > 0)
-    return np.divide(1.0, np.maximum(denom, DENOM_MIN), out=np.zeros(np.shape(denom)),
-                     where=np.broadcast_to(ok, np.shape(denom)))
-
-
-def combine_rgb(surf, vol, area, albedo, inv, out):
-    r"""The fabric's RGB f_r from its threads' sums, into ``out``.
-
-    :math:`f_r = \sum_j a_j (S_j + \mathrm{albedo}_j V_j) / (Q\, n\cdot w_i)`, computed one
-    channel at a time on (set, pair) planes (long inner loops; broadcasting over a last axis
-    of 3 would run NumPy's loops three elements at a time).
-
-    Parameters
-    ----------
-    surf, vol : sequence of two ndarray, shape (B, C)
-        Per thread the surface and volume sums of :func:`thread_shade`, 1/sr.
-    area : ndarray, shape (B, 2)
-        The threads' area shares.
-    albedo : ndarray, shape (B, 2, 3)
-        The threads' volume albedos (RGB).
-    inv : ndarray, shape (B, C) or (C,)
-        :math:`1 / (Q\, n\cdot w_i)` (0 where that is not positive).
-    out : ndarray, shape (B, C, 3)
-        Written (any strides); returned.
-    """
-    a1, a2 = area[:, 0, None], area[:, 1, None]
-    base = np.multiply(surf[0], a1)
-    base += surf[1] * a2
-    base *= inv
-    w1 = np.multiply(vol[0], inv)
-    w1 *= a1
-    w2 = np.multiply(vol[1], inv)
-    w2 *= a2
-    tmp, tmp2 = np.empty_like(base), np.empty_like(base)
-    for ch in range(3):
-        np.multiply(w1, albedo[:, 0, ch, None], out=tmp)
-        tmp += base
-        np.multiply(w2, albedo[:, 1, ch, None], out=tmp2)
-        tmp += tmp2
-        out[..., ch] = tmp
     return out

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from brdf.options import Transmission, validate_method
 from brdf.validate import array
 
 __all__ = ["SIGMA_U", "fresnel", "gaussian", "u", "visibility", "pair_weight",
@@ -170,7 +171,7 @@ def transmission(eta, cos_g, cos_theta_i, cos_theta_r, method="half_angle"):
         Effective incidence cosine :math:`\cos\theta_d \cos(\phi_d / 2)`.
     cos_theta_i, cos_theta_r : array_like
         Longitudinal cosines of the two directions (used by ``"longitudinal"``).
-    method : {"half_angle", "longitudinal"}
+    method : {"half_angle", "longitudinal"} or brdf.Transmission
         ``"half_angle"``: :math:`(1 - F_r(\eta, \cos g))^2`;
         ``"longitudinal"``: :math:`(1 - F_r(\eta, \cos\theta_i))(1 - F_r(\eta, \cos\theta_r))`.
 
@@ -187,8 +188,7 @@ def transmission(eta, cos_g, cos_theta_i, cos_theta_r, method="half_angle"):
     eta, cos_g = array("eta", eta), array("cos_g", cos_g)
     cos_theta_i = array("cos_theta_i", cos_theta_i)
     cos_theta_r = array("cos_theta_r", cos_theta_r)
-    if method == "half_angle":
+    method = validate_method("transmission", method, Transmission)
+    if method is Transmission.HALF_ANGLE:
         return (1.0 - fresnel(eta, cos_g)) ** 2
-    if method == "longitudinal":
-        return (1.0 - fresnel(eta, cos_theta_i)) * (1.0 - fresnel(eta, cos_theta_r))
-    raise ValueError(f"transmission must be one of 'half_angle', 'longitudinal'; got {method!r}")
+    return (1.0 - fresnel(eta, cos_theta_i)) * (1.0 - fresnel(eta, cos_theta_r))

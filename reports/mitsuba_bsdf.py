@@ -87,7 +87,7 @@ def _values_of(fabric, textured=()) -> dict:
             if f"{key}{j}" not in textured:
                 v = getattr(t, key)
                 out[f"{key}{j}"] = tuple(map(float, v)) if key == "albedo" else float(v)
-    out["rotation"] = math.degrees(fabric.options["rotation"])
+    out["rotation"] = math.degrees(fabric.plan.options.rotation)
     return out
 
 
@@ -129,7 +129,7 @@ def _fabric_with(fabric, params, keys) -> brdf.Fabric:
         except ValueError as exc:
             raise ValueError(f"{PLUGIN_NAME}: thread {j}: {exc}") from None
     rotation = (math.radians(_read(params["rotation"])) if "rotation" in keys
-                else fabric.options["rotation"])
+                else fabric.plan.options.rotation)
     return fabric.replace(threads=threads, rotation=rotation)
 
 

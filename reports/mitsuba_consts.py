@@ -14,18 +14,20 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import math
 
 # optional dependencies: this module is imported only by reports.mitsuba.register()
 import drjit as dr
 import mitsuba as mi
 
-from brdf import sampling
+from brdf import sampling, shading
+from brdf.options import Gap, Transmission
+from brdf.plan import FabricPlan, ThreadPlan, plan_of
 
 __all__ = ["Consts", "ThreadConsts", "consts", "MIN_COMPONENTS", "GAUSS_NORM"]
 
-#: 1 / sqrt(2 pi), the normal density's factor.
-GAUSS_NORM = 1.0 / math.sqrt(2.0 * math.pi)
+#: 1 / sqrt(2 pi), the normal density's factor (:data:`brdf.shading.GAUSS_NORM`), a Python
+#: float (a NumPy scalar times a Dr.Jit value would go through NumPy).
+GAUSS_NORM = float(shading.GAUSS_NORM)
 #: The sampler's component table is padded to a power of two at least this long: the binary
 #: search that picks a component has as many steps as the table has bits, and every preset
 #: (at most 1 + 3 x 64 components) then shares one kernel.
@@ -55,7 +57,8 @@ class ThreadConsts:
 
 @dataclasses.dataclass(frozen=True)
 class Consts:
-    """Everything the kernel needs of a :class:`brdf.Fabric`.
+    """Everything the kernel needs of a :class:`brdf.Fabric`, from its plan
+    (:class:`brdf.FabricPlan`); the options typed as the plan types them.
 
     ``comp_*`` is the sampler's flat component table (component 0 the cosine-weighted
     hemisphere, then per thread, tangent offset and lobe; :func:`brdf.sampling.sample`'s
@@ -67,8 +70,8 @@ class Consts:
     threads: tuple
     masking: bool
     reweighting: bool
-    transmission: str
-    gap: str
+    transmission: Transmission
+    gap: Gap
     rotation: float     # radians
     gap_area: object    # 1 - A_1 - A_2: the gap's share of the area
     sampled: tuple      # bool per thread: does the sampler draw its lobes (thread_p > 0)
@@ -94,26 +97,27 @@ def opaque(x, kind=None):
     return dr.opaque(kind, x)
 
 
-def _thread_consts(t, c, lobe_p) -> ThreadConsts:
-    """:class:`ThreadConsts` of the thread ``t`` with the tangent constants ``c``."""
-    kd, gs, gv, eta2 = float(t.kd), float(c.gamma_s), float(c.gamma_v), float(t.eta) ** 2
+def _thread_consts(c: ThreadPlan, lobe_p) -> ThreadConsts:
+    """:class:`ThreadConsts` of the thread whose plan is ``c``."""
+    kd, gs, gv, eta2 = float(c.kd), float(c.gamma_s), float(c.gamma_v), float(c.eta) ** 2
     # a table of one entry would be a scalar to Dr.Jit, and another kernel: each gets an
     # entry the loop never reads
     ca, sa, w = (tuple(map(float, x)) + (v,) for x, v in ((c.ca, 1.0), (c.sa, 0.0),
                                                             (c.weight, 0.0)))
     return ThreadConsts(
         opaque(len(c.ca), mi.UInt32), opaque(ca, mi.Float64), opaque(sa, mi.Float64),
-        opaque(w), opaque(eta2), opaque(eta2 - 1.0), opaque(kd), opaque(float(t.area)),
-        tuple(opaque(float(a)) for a in t.albedo),
-        opaque(-0.125 / gs**2), opaque(GAUSS_NORM / gs), opaque(-0.125 / gv**2),
-        opaque((1.0 - kd) * GAUSS_NORM / gv), (opaque(0.5 / gs), opaque(0.5 / gv)),
+        opaque(w), opaque(eta2), opaque(eta2 - 1.0), opaque(kd), opaque(float(c.area)),
+        tuple(opaque(float(a)) for a in c.albedo),
+        opaque(float(shading.gaussian_exponent(gs))), opaque(float(shading.gaussian_norm(gs))),
+        opaque(float(shading.gaussian_exponent(gv))),
+        opaque(float(shading.f_rv_coefficients(kd, gv))), (opaque(0.5 / gs), opaque(0.5 / gv)),
         tuple(opaque(float(p)) for p in lobe_p))
 
 
-def _components(fabric, thread_p, lobe_p) -> list:
+def _components(plan: FabricPlan, thread_p, lobe_p) -> list:
     """The sampler's components: (probability, thread, cos, sin, kind, sigma) each."""
     rows = [(1.0 - float(thread_p.sum()), 0, 1.0, 0.0, -1, 1.0)]
-    for j, c in enumerate(fabric._const):
+    for j, c in enumerate(plan.threads):
         if thread_p[j] == 0.0:
             continue
         for cj, sj, w in zip(c.ca, c.sa, c.weight):
@@ -124,20 +128,21 @@ def _components(fabric, thread_p, lobe_p) -> list:
 
 
 def consts(fabric) -> Consts:
-    """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric`) for the variant set."""
-    thread_p, lobe_p = sampling.lobe_probabilities(fabric)
-    threads = tuple(_thread_consts(t, c, lobe_p[j])
-                    for j, (t, c) in enumerate(zip(fabric.threads, fabric._const)))
-    rows = _components(fabric, thread_p, lobe_p)
+    """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric` or its
+    :class:`brdf.FabricPlan`) for the variant set."""
+    plan = plan_of(fabric)
+    thread_p, lobe_p = sampling.lobe_probabilities(plan)
+    threads = tuple(_thread_consts(c, lobe_p[j]) for j, c in enumerate(plan.threads))
+    rows = _components(plan, thread_p, lobe_p)
     size = max(MIN_COMPONENTS, 1 << (len(rows) - 1).bit_length())
     cdf = list(itertools.accumulate(r[0] for r in rows))
     cdf = [min(x / cdf[-1], 1.0) for x in cdf[:-1]] + [1.0] * (size - len(rows) + 1)
     rows += [rows[0]] * (size - len(rows))     # never drawn: u < 1 = the last real cdf
     cols = list(zip(*rows))
-    opts = fabric.options
-    area = 1.0 - float(fabric.threads[0].area) - float(fabric.threads[1].area)
-    return Consts(threads, opts["masking"], opts["reweighting"], opts["transmission"],
-                  opts["gap"], float(opts["rotation"]), opaque(area),
+    opts = plan.options
+    area = 1.0 - float(plan.threads[0].area) - float(plan.threads[1].area)
+    return Consts(threads, opts.masking, opts.reweighting, opts.transmission,
+                  opts.gap, float(opts.rotation), opaque(area),
                   tuple(bool(p > 0.0) for p in thread_p), opaque(1.0 - float(thread_p.sum())),
                   tuple(opaque(float(p)) for p in thread_p), size, opaque(cdf),
                   opaque([float(j) for j in cols[1]]), opaque(list(cols[2])),

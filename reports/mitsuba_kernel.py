@@ -33,6 +33,7 @@ from typing import NamedTuple
 import drjit as dr
 import mitsuba as mi
 
+from brdf.options import Gap, Transmission
 from brdf.terms import SIGMA_U
 from reports.mitsuba_consts import GAUSS_NORM, Consts, consts
 
@@ -142,7 +143,7 @@ def _sample_terms(th, ca, sa, light, view, k, density):
         geo *= p
     cg = dr.sqrt(0.5 * c2d * hp)                           # cos_g
     fr, tr = _fresnel(th.eta2, th.eta2m1, cg)
-    if k.transmission == "half_angle":
+    if k.transmission is Transmission.HALF_ANGLE:
         ft = tr * tr
     else:
         ft = _fresnel(th.eta2, th.eta2m1, ci)[1] * _fresnel(th.eta2, th.eta2m1, cr)[1]
@@ -179,7 +180,7 @@ def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True, albedo=(None, 
     rgb = [0.0, 0.0, 0.0]
     q = 1.0
     if k.reweighting:
-        gap = light.z if k.gap == "incident" else view.z
+        gap = light.z if k.gap is Gap.INCIDENT else view.z
         q = k.gap_area * gap
     total = k.cos_p * (1.0 / math.pi) * dr.maximum(light.z, 0.0)
     for j, th in enumerate(k.threads):

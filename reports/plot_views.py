@@ -18,12 +18,13 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from analysis import albedo_curve
+from analysis.views import compute_lobes, compute_masking_lobes
 from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
 from reports.plot_fit import plot_table_models, table_panels, table_points
 from reports.plot_hemisphere import plot_hemisphere
-from reports.plot_lobes import lobe_peak, plane_name, plot_lobe_comparison, plot_lobe_planes
-from reports.plot_masking import plot_masking_lobes
+from reports.plot_lobes import draw_lobe_comparison, plane_name, plot_lobe_planes
+from reports.plot_masking import draw_masking_lobes
 from reports.plot_reciprocity import plot_reciprocity_map
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)
@@ -69,11 +70,13 @@ def lobes_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",
     if scale == "normalized":
         raise ValueError("--scale normalized draws one fabric only; give log or linear")
     fig, axes = _grid(len(theta_i), len(planes), (4.2, 2.7), polar=True)
-    peak = lobe_peak(fabrics, theta_i, planes, quantity=quantity, resolution=res)
+    views = {name: compute_lobes(fab, theta_i, planes, resolution=res)
+             for name, fab in fabrics.items()}
+    peak = max(v.peak(quantity) for v in views.values())
     for row, ti in zip(axes, theta_i):
         for ax, phi in zip(row, planes):     # one peak: the same decades in every panel
-            plot_lobe_comparison(fabrics, ti, phi, scale=scale, resolution=res,
-                                 quantity=quantity, legend=False, peak=peak, ax=ax)
+            draw_lobe_comparison(views, ti, phi, scale=scale, quantity=quantity,
+                                 legend=False, peak=peak, ax=ax)
     _figure_legend(fig, axes[0][0], ncol=3)
     return fig
 
@@ -134,10 +137,12 @@ def masking_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log
     planes = planes or (0.0,)
     rows = [(name, fab, ti) for name, fab in fabrics.items() for ti in theta_i]
     fig, axes = _grid(len(rows), len(planes), (4.2, 2.9), polar=True)
+    views = {name: compute_masking_lobes(fab, theta_i, planes, resolution=resolution or 181)
+             for name, fab in fabrics.items()}
     for row, (name, fab, ti) in zip(axes, rows):
         for ax, phi in zip(row, planes):
-            plot_masking_lobes(fab, ti, phi, scale="log" if scale == "log" else "linear",
-                               resolution=resolution or 181, legend=False, ax=ax,
+            draw_masking_lobes(views[name], ti, phi, legend=False, ax=ax,
+                               scale="log" if scale == "log" else "linear",
                                title=f"{name}: θi = {ti:g}°, φ = {phi:g}° "
                                      f"({plane_name(phi)})")
     _figure_legend(fig, axes[0][0])

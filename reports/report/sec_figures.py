@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import FONT, eval_brdf
+from analysis.views import compute_lobes, compute_masking_lobes
+from reports._plotting import FONT
 from reports.colour import luminance
 from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
 from reports.plot_lobe3d import plot_lobe_3d
-from reports.plot_lobes import plane_directions, plot_lobe_planes
-from reports.plot_masking import plot_masking_lobes
+from reports.plot_lobes import draw_lobe_planes
+from reports.plot_masking import draw_masking_lobes
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)
 from reports.report.markup import Markup, html, join
@@ -41,40 +42,25 @@ def can_unmask(fab) -> bool:
     return True
 
 
-def _lobes_csv(p: Page) -> Markup:
-    """f_r (1/sr) per channel and luminance in every plane and incidence, as lobes.csv."""
-    theta_o = np.linspace(-90.0, 90.0, p.q["lobe"])
-    cols, header = [theta_o], ["theta_o_deg"]
-    for phi in PLANES:
-        for ti in LOBE_THETAS:
-            wi, wo = plane_directions(ti, theta_o, phi)
-            f = eval_brdf(p.fabric, wi, wo)
-            for k, c in enumerate("rgb"):
-                cols.append(f[:, k])
-                header.append(f"f_{c}_phi{phi:g}_ti{ti:g}")
-            cols.append(luminance(f))
-            header.append(f"f_Y_phi{phi:g}_ti{ti:g}")
-    return p.csv("lobes.csv", header, np.stack(cols, axis=1))
-
-
 def section_lobes(p: Page) -> Section:
-    """Polar lobes in the warp, diagonal and weft planes, linear, log and per channel."""
-    fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale="linear", normalize=True,
-                              resolution=p.q["lobe"])
+    """Polar lobes in the warp, diagonal and weft planes, linear, log and per channel, and
+    their numbers as lobes.csv: one :class:`analysis.views.LobeView` (each curve evaluated
+    once) that every figure draws and the CSV writes."""
+    view = compute_lobes(p.fabric, LOBE_THETAS, PLANES, resolution=p.q["lobe"])
+    fig, _ = draw_lobe_planes(view, scale="linear", normalize=True)
     out = [p.figure(fig, "lobes_linear.png",
                     "Luminance f_r, linear, each curve divided by its own peak (the peaks, in "
                     "1/sr, are in the legends) so that every incidence shows, in the planes "
                     "φ = 0° (warp), 45° and 90° (weft), for θi = 0°, 30°, 60°.")]
-    fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale="log",
-                              resolution=p.q["lobe"])
+    fig, _ = draw_lobe_planes(view, scale="log")
     out.append(p.figure(fig, "lobes_log.png",
                         "Luminance f_r (1/sr, log, four decades below the peak) in the same "
                         "planes and incidences."))
-    fig, _ = plot_lobe_planes(p.fabric, (30.0, 60.0), PLANES, quantity="rgb", scale="linear",
-                              resolution=p.q["lobe"])
+    fig, _ = draw_lobe_planes(view.select(theta_i_deg=(30.0, 60.0)), quantity="rgb",
+                              scale="linear")
     out.append(p.figure(fig, "lobes_rgb.png", "f_r per channel (red, green, blue curves), "
                         "linear, θi = 30° (solid) and 60° (dashed)."))
-    link = _lobes_csv(p)
+    link = p.csv("lobes.csv", *view.columns())
     return Section(join(out) + html("<p>Data (f_r in 1/sr, signed θo in degrees): {}</p>", link))
 
 
@@ -138,6 +124,7 @@ def section_masking(p: Page) -> Section:
     """
     if not can_unmask(p.fabric):
         raise Unavailable("this BRDF has no replace(masking=...)")
+    view = compute_masking_lobes(p.fabric, (60.0, 80.0), PLANES, resolution=p.q["lobe"])
     out = []
     for ti, scale, stem, caption in (
             (60.0, "log", "masking_lobes.png", "Luminance f_r (1/sr, log) at θi = 60° with "
@@ -147,8 +134,7 @@ def section_masking(p: Page) -> Section:
              "θi = 80°.")):
         fig, axes = new_figure(3, 1, figsize=(12.6, 3.1), polar=True)
         for ax, phi in zip(axes, PLANES):
-            plot_masking_lobes(p.fabric, ti, phi, resolution=p.q["lobe"], ax=ax, scale=scale,
-                               legend=False)
+            draw_masking_lobes(view, ti, phi, ax=ax, scale=scale, legend=False)
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=FONT["small"],
                    frameon=False)

@@ -143,3 +143,18 @@ def test_masking_section_evaluates_each_curve_once(drawn, monkeypatch):
     assert sorted(count.pairs) == sorted(2 * _curve_pairs((60.0, 80.0)))
     assert {gid for ax in figures["masking_lobes.png"] for gid, *_ in ax} == \
         {"masking on", "masking off"}
+
+
+def test_hemisphere_section_evaluates_each_light_once(drawn, monkeypatch):
+    """Three lights over the disc (the first drawn twice: luminance and colour) and the 3-D
+    lobe's grid: each evaluated once."""
+    page, figures = drawn
+    count = Counter(monkeypatch)
+    sec_figures.section_hemisphere(page)
+    n, (nt, npf) = page.q["hemi"], page.q["lobe3d"]
+    assert len(count.pairs) == 3 * n * n + nt * npf        # was 5 n^2 + nt np
+    lights = {p[:3] for p in count.pairs}
+    assert len(lights) == 3
+    assert sorted(sum(p[:3] == wi for p in count.pairs) for wi in lights) == \
+        [n * n, n * n, n * n + nt * npf]                    # 45° warp: disc and 3-D lobe
+    assert set(figures) == {"hemisphere.png", "lobe3d.png"}

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.views.common import (check_angle, check_quantity, check_resolution, eval_brdf,
+from analysis.views.common import (check_angle, check_resolution, eval_brdf,
                                    finite_max, reduce_quantity)
 from brdf.frames import from_angles
 

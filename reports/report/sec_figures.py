@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.views import compute_lobes, compute_masking_lobes
+from analysis.views import (HemisphereView, compute_hemisphere, compute_lobes,
+                            compute_masking_lobes)
 from reports._plotting import FONT
-from reports.colour import luminance
-from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
+from reports.plot_hemisphere import draw_hemisphere
 from reports.plot_lobe3d import plot_lobe_3d
 from reports.plot_lobes import draw_lobe_planes
 from reports.plot_masking import draw_masking_lobes
@@ -61,7 +61,8 @@ def section_lobes(p: Page) -> Section:
     out.append(p.figure(fig, "lobes_rgb.png", "f_r per channel (red, green, blue curves), "
                         "linear, θi = 30° (solid) and 60° (dashed)."))
     link = p.csv("lobes.csv", *view.columns())
-    return Section(join(out) + html("<p>Data (f_r in 1/sr, signed θo in degrees): {}</p>", link))
+    return Section(join(out) + html("<p>Data (f_r in 1/sr, signed θo in degrees): {}</p>",
+                                    link))
 
 
 def section_slices(p: Page) -> Section:
@@ -82,15 +83,13 @@ def section_slices(p: Page) -> Section:
     return Section(join(out))
 
 
-def _colour_and_lobe3d(p: Page) -> Markup:
-    """The sRGB colour of f_r(wo) at θi = 45° beside the 3-D lobe."""
-    img = hemisphere_image(p.fabric, 45.0, 0.0, p.q["hemi"])
-    peak = float(np.nanmax(luminance(img))) if np.any(np.isfinite(img)) else 0.0
+def _colour_and_lobe3d(p: Page, view: HemisphereView) -> Markup:
+    """The sRGB colour of f_r(wo) at θi = 45° (``view``) beside the 3-D lobe."""
+    peak = view.peak()
     exposure = float(np.log2(0.7 / peak)) if peak > 0 else 0.0
     fig, axes = new_figure(2, 1, figsize=(10.0, 4.2))
     fig.get_layout_engine().set(w_pad=0.25)   # room the 3-D axes' layout leaves out
-    plot_hemisphere(p.fabric, 45.0, 0.0, quantity="srgb", exposure=exposure,
-                    resolution=p.q["hemi"], ax=axes[0],
+    draw_hemisphere(view, quantity="srgb", exposure=exposure, ax=axes[0],
                     title=f"f_r(wo) colour, sRGB, exposure {exposure:+.1f} stops")
     plot_lobe_3d(p.fabric, 45.0, 0.0, resolution=p.q["lobe3d"], ax=replace_3d(fig, axes[1]))
     return p.figure(fig, "lobe3d.png", "Left: the colour of f_r(wo) (θi = 45°, φi = 0), "
@@ -100,17 +99,19 @@ def _colour_and_lobe3d(p: Page) -> Markup:
 
 
 def section_hemisphere(p: Page) -> Section:
-    """f_r over the viewing hemisphere for three lights, its colour, and the 3-D lobe."""
+    """f_r over the viewing hemisphere for three lights, its colour, and the 3-D lobe; the
+    light at 45° along the warp evaluated once for its luminance and its colour."""
+    views = [compute_hemisphere(p.fabric, ti, phi, p.q["hemi"])
+             for ti, phi in ((45.0, 0.0), (45.0, 90.0), (60.0, 45.0))]
     fig, axes = new_figure(3, 1, figsize=(15.0, 4.2))
-    plot_hemisphere(p.fabric, 45.0, 0.0, resolution=p.q["hemi"], ax=axes[0])
-    plot_hemisphere(p.fabric, 45.0, 90.0, resolution=p.q["hemi"], ax=axes[1])
-    plot_hemisphere(p.fabric, 60.0, 45.0, resolution=p.q["hemi"], ax=axes[2])
+    for ax, view in zip(axes, views):
+        draw_hemisphere(view, ax=ax)
     out = [p.figure(fig, "hemisphere.png", "Luminance f_r(wo) (1/sr, log colour scale) over "
                     "the viewing hemisphere, equal-area projection (+x warp, +y weft), for the "
                     "light at θi = 45° along the warp, 45° along the weft, and 60° at φ = 45°; "
                     "black: more than four decades below the peak; grey: f_r = 0 (where the "
                     "colour bar says so).")]
-    out.append(_colour_and_lobe3d(p))
+    out.append(_colour_and_lobe3d(p, views[0]))
     return Section(join(out))
 
 

@@ -20,7 +20,7 @@ from reports._plotting import (FONT, check_angle, check_quantity, finish, legend
 
 __all__ = ["plane_directions", "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison",
            "draw_polar_lobe", "draw_lobe_planes", "draw_lobe_comparison", "log_radius",
-           "plane_name", "lobe_peak"]
+           "log_floor", "setup_polar", "plane_name", "lobe_peak"]
 
 
 def log_radius(values, floor):
@@ -34,7 +34,7 @@ def log_radius(values, floor):
     return np.log10(np.maximum(np.asarray(values, dtype=np.float64), floor) / floor)
 
 
-def _log_floor(peak, decades):
+def log_floor(peak, decades):
     """The power of 10 at least ``decades`` below ``peak`` (1e-12 for a zero peak)."""
     if not peak > 0:
         return 1e-12
@@ -71,7 +71,7 @@ def lobe_peak(brdfs, theta_i_deg, planes_deg, *, quantity="luminance", resolutio
                              cosine=cosine).peak(quantity) for b in many)
 
 
-def _setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
+def setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
     """Half-disc polar axes (theta_o from -90 to 90 degrees, the normal up) with radial ticks
     in 8 pt: decades 10^k on a log scale (every other one when more than five), and the
     radial axis labelled ``label`` under the disc."""
@@ -200,13 +200,13 @@ def draw_polar_lobe(view: LobeView, phi_deg=None, *, quantity="luminance", scale
     thetas, theta_o = view.theta_i_deg, view.theta_o_deg
     curves = view.curves(phi_deg, quantity)
     own = max(finite_max(c) for c in curves)
-    floor = _log_floor(own if peak is None else peak, decades)
+    floor = log_floor(own if peak is None else peak, decades)
     rmax = _draw_lobes(ax, thetas, theta_o, curves, quantity_styles(quantity, colour), colour,
                        floor if scale == "log" else None, normalize)
     if peak is not None and not normalize:
         rmax = max(rmax, _radius(peak, scale, floor))
     label = view.label
-    _setup_polar(ax, scale, floor, rmax, f"{label} / its peak (per curve)" if normalize
+    setup_polar(ax, scale, floor, rmax, f"{label} / its peak (per curve)" if normalize
                  else f"{label} ({view.unit})")
     for ti in thetas:  # incident directions as arrows from the centre
         ax.annotate("", xy=(np.radians(-ti), rmax * 1.0), xytext=(0, 0),
@@ -369,7 +369,7 @@ def draw_lobe_comparison(views, theta_i_deg, phi_deg, *, scale="log", decades=4.
     fig, ax = new_axes(ax, projection="polar", figsize=(5.6, 3.7))
     data = {name: v.curve(phi_deg, theta_i_deg, quantity) for name, v in views.items()}
     own = max((finite_max(v) for v in data.values()), default=0.0)
-    floor = _log_floor(own if peak is None else peak, decades)
+    floor = log_floor(own if peak is None else peak, decades)
     rmax = 0.0 if peak is None else _radius(peak, scale, floor)
     styles = series_styles(data)
     for name, y in data.items():
@@ -379,7 +379,7 @@ def draw_lobe_comparison(views, theta_i_deg, phi_deg, *, scale="log", decades=4.
         line, = ax.plot(np.radians(views[name].theta_o_deg), r, color=st["color"],
                         ls=st["ls"], lw=1.5, label=name)
         line.set_gid(f"lobe {name}")
-    _setup_polar(ax, scale, floor, rmax, f"{_what(quantity)} f_r (1/sr)")
+    setup_polar(ax, scale, floor, rmax, f"{_what(quantity)} f_r (1/sr)")
     ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {float(phi_deg):g}° "
                  f"({plane_name(phi_deg)})", fontsize=FONT["title"])
     if legend:

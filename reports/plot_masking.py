@@ -12,7 +12,7 @@ import numpy as np
 
 from analysis.views import MaskingLobesView, compute_masking_lobes, masking_terms
 from reports._plotting import FONT, PALETTE, finish, legend_outside, new_axes, series_style
-from reports.plot_lobes import _log_floor, _setup_polar, log_radius
+from reports.plot_lobes import log_floor, setup_polar, log_radius
 
 __all__ = ["plot_masking_lobes", "plot_masking_terms", "masking_terms", "draw_masking_lobes"]
 
@@ -102,7 +102,7 @@ def draw_masking_lobes(view: MaskingLobesView, theta_i_deg, phi_deg, *, scale="l
     curves = view.curves(phi_deg, theta_i_deg)
     theta_o = view.on.theta_o_deg
     peak = max(float(np.nanmax(c)) for c in curves.values())
-    floor = _log_floor(peak, decades)
+    floor = log_floor(peak, decades)
     rmax = 0.0
     for n, (name, y) in enumerate(curves.items()):
         r = log_radius(y, floor) if scale == "log" else y
@@ -111,7 +111,7 @@ def draw_masking_lobes(view: MaskingLobesView, theta_i_deg, phi_deg, *, scale="l
         line, = ax.plot(np.radians(theta_o), r, color=st["color"], ls=st["ls"], lw=1.5,
                         label=name)
         line.set_gid(name)
-    _setup_polar(ax, scale, floor, rmax, "luminance f_r (1/sr)")
+    setup_polar(ax, scale, floor, rmax, "luminance f_r (1/sr)")
     if legend:
         legend_outside(ax, "below", ncol=2)
     ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {float(phi_deg):g}°",

@@ -1,4 +1,5 @@
-"""Shared helpers of the plot modules: axes, atomic saving, BRDF evaluation, quantities.
+"""Shared helpers of the plot modules: axes, atomic saving, styles, quantities (BRDF
+evaluation and the quantities' reduction are :mod:`analysis.views`', re-exported here).
 
 Private to :mod:`reports`; the public plot functions live in ``reports/plot_*.py`` and are
 gathered in :mod:`reports.plots`.
@@ -14,18 +15,18 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.transforms import ScaledTranslation
 
+from analysis.views.common import (QUANTITIES, as_brdf, check_angle, check_quantity,
+                                   eval_brdf, reduce_quantity)
 from brdf.frames import half_diff_to_directions
-from brdf.presets import PRESETS, fabric
+from brdf.presets import PRESETS
 from gonio.atomic import atomic_write
-from reports.colour import CHANNEL_COLOURS, luminance
+from reports.colour import CHANNEL_COLOURS
 
 __all__ = ["new_axes", "finish", "save_figure", "as_brdf", "eval_brdf", "reduce_quantity",
            "quantity_styles", "QUANTITIES", "check_quantity", "half_diff_to_io", "check_angle",
            "DPI", "FONT", "PALETTE", "series_style", "preset_style", "series_styles",
            "legend_outside", "log_range", "pow10_label", "shade_zero"]
 
-#: What a plot can show of an RGB f_r: its Rec. 709 luminance, each channel, or one channel.
-QUANTITIES = ("luminance", "rgb", "r", "g", "b")
 #: Resolution of raster (PNG) figures, dots per inch.
 DPI = 200
 #: Font sizes in points: tick labels and legends (the smallest text of any figure), axis
@@ -191,70 +192,6 @@ def finish(fig, ax, filename=None, *, dpi: int = DPI):
     if filename is not None:
         save_figure(fig, filename, dpi=dpi)
     return fig, ax
-
-
-def check_quantity(quantity: str) -> str:
-    if quantity not in QUANTITIES:
-        raise ValueError(f"quantity must be one of {', '.join(QUANTITIES)}; got {quantity!r}")
-    return quantity
-
-
-def check_angle(name: str, value, lo: float, hi: float) -> np.ndarray:
-    arr = np.asarray(value, dtype=np.float64)
-    if not np.all(np.isfinite(arr)) or np.any(arr < lo) or np.any(arr > hi):
-        raise ValueError(f"{name} must be in [{lo:g}, {hi:g}] degrees; got {value!r}")
-    return arr
-
-
-def as_brdf(brdf, name: str = "brdf"):
-    """What a plot draws: ``brdf`` itself when it has ``eval(wi, wo)`` (a
-    :class:`brdf.Fabric`, a fit's model, a table), the preset's fabric when it is a name of
-    :data:`brdf.PRESETS`.
-
-    Raises
-    ------
-    ValueError
-        A string that names no preset (the presets are listed).
-    TypeError
-        Anything else, naming ``name`` and the type.
-
-    Examples
-    --------
-    >>> as_brdf("velvet").name
-    'velvet'
-    """
-    if isinstance(brdf, str):
-        if brdf not in PRESETS:
-            raise ValueError(f"{name} must be a preset ({', '.join(PRESETS)}) or a BRDF with "
-                             f"eval(wi, wo); got {brdf!r}")
-        return fabric(brdf)
-    if not callable(getattr(brdf, "eval", None)):
-        raise TypeError(f"{name} must be a preset name or a BRDF with eval(wi, wo) (e.g. a "
-                        f"brdf.Fabric); got {type(brdf).__name__}")
-    return brdf
-
-
-def eval_brdf(brdf, wi, wo) -> np.ndarray:
-    """``brdf.eval(wi, wo)`` broadcast to a common shape, as float64 (..., 3) in 1/sr;
-    ``brdf`` may name a preset (:func:`as_brdf`)."""
-    brdf = as_brdf(brdf)
-    wi = np.asarray(wi, dtype=np.float64)
-    wo = np.asarray(wo, dtype=np.float64)
-    shape = np.broadcast_shapes(wi.shape, wo.shape)
-    wi = np.broadcast_to(wi, shape)
-    wo = np.broadcast_to(wo, shape)
-    flat = np.asarray(brdf.eval(wi.reshape(-1, 3), wo.reshape(-1, 3)), dtype=np.float64)
-    return flat.reshape(shape[:-1] + (3,))
-
-
-def reduce_quantity(values: np.ndarray, quantity: str) -> np.ndarray:
-    """(..., 3) RGB -> (...,) luminance or one channel, or (..., 3) unchanged for "rgb"."""
-    check_quantity(quantity)
-    if quantity == "luminance":
-        return luminance(values)
-    if quantity == "rgb":
-        return values
-    return values[..., "rgb".index(quantity)]
 
 
 def quantity_styles(quantity: str, colour=None):

@@ -209,11 +209,14 @@ def run_plot(args):
             models[label] = model
         table = gonio.read(args.sources[0])
         _check_incidences(table, args)
-        fig = plot_views.table_view(table, models, source=Path(args.sources[0]).name, **opts)
-        if args.data is not None:
-            rows = plot_views.table_view_data(table, models, channel=args.channel,
-                                              theta_i=args.theta_i, planes=args.plane)
-            write_table_data(args.data, rows)
+        panels = plot_views.table_view_panels(table, models, channel=args.channel,
+                                              theta_i=args.theta_i, planes=args.plane,
+                                              resolution=args.resolution)
+        fig = plot_views.table_view(table, models, source=Path(args.sources[0]).name,
+                                    panels=panels, **opts)
+        if args.data is not None:      # the numbers the figure drew at the measured points
+            write_table_data(args.data, plot_views.table_view_data(table, models,
+                                                                   panels=panels))
     else:
         fabrics = {n: cliutil.fabric_from_args(n, args) for n in args.sources}
         fig = plot_views.VIEW_FUNCTIONS[args.view](fabrics, **opts)

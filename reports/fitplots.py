@@ -20,6 +20,7 @@ from matplotlib.ticker import MaxNLocator
 
 from analysis.fit import LogPosterior
 from analysis.fit.adequacy import normal_scores, point_scores, regions
+from analysis.views.posterior import compute_posterior_lobes, posterior_draws
 from gonio import atomic_write
 from reports.plot_pit import pit_histogram
 
@@ -85,13 +86,6 @@ def trace_plot(result, ax=None, filename=None, max_walkers: int = 8):
     return fig, ax
 
 
-def posterior_draws(result, n: int = 64, seed: int = 0) -> np.ndarray:
-    """``n`` posterior draws in the sampler's internal coordinates, shape (n, ndim)."""
-    flat = result.chains_internal.reshape(-1, len(result.names))
-    idx = np.random.default_rng(seed).choice(flat.shape[0], min(n, flat.shape[0]), False)
-    return flat[idx]
-
-
 def _predict_at(result, model_factory, wi, wo, theta):
     lp = LogPosterior(result.spec, None, model_factory(wi, wo))
     return lp.predict(theta)
@@ -116,56 +110,29 @@ def lobe_plot(result, table, model_factory, theta_i_deg=None, phi_i_deg=None, ax
         Incidence angles; default: up to three of the table's most common ones.
     """
     plt = _plt()
-    ang = np.degrees(table.angles)
-    if theta_i_deg is None:
-        vals, cnt = np.unique(np.round(ang[:, 0]), return_counts=True)
-        if len(vals) > 12:   # scattered directions: use quantiles
-            theta_i_deg = list(np.percentile(ang[:, 0], [20, 50, 80]).round())
-        else:
-            theta_i_deg = list(vals[np.argsort(-cnt)[:3]])
-    if phi_i_deg is None:
-        phi_i_deg = 0.0
+    lobes = compute_posterior_lobes(result, table, model_factory, theta_i_deg, phi_i_deg,
+                                    n_draws=n_draws, plane_tol_deg=plane_tol_deg,
+                                    theta_tol_deg=theta_tol_deg)
     if ax is None:
-        fig, ax = plt.subplots(1, len(theta_i_deg), subplot_kw={"projection": "polar"},
-                               figsize=(4.2 * len(theta_i_deg), 3.6), squeeze=False)
+        fig, ax = plt.subplots(1, len(lobes), subplot_kw={"projection": "polar"},
+                               figsize=(4.2 * len(lobes), 3.6), squeeze=False)
         ax = ax[0]
     else:
         ax = np.atleast_1d(ax)
         fig = ax[0].figure
-    draws = posterior_draws(result, n_draws)
-    signed = np.linspace(-89, 89, 121)
-    for a, ti in zip(ax, theta_i_deg):
-        ti_r, pi_r = np.radians(ti), np.radians(phi_i_deg)
-        wi = np.tile([np.sin(ti_r) * np.cos(pi_r), np.sin(ti_r) * np.sin(pi_r), np.cos(ti_r)],
-                     (signed.size, 1))
-        po = np.where(signed >= 0, pi_r + np.pi, pi_r)
-        to = np.radians(np.abs(signed))
-        wo = np.stack([np.sin(to) * np.cos(po), np.sin(to) * np.sin(po), np.cos(to)], -1)
-        pred = _predict_at(result, model_factory, wi, wo, draws).mean(-1) * np.cos(to)
-        lo, med, hi = np.percentile(pred, [5, 50, 95], axis=0)
-        th = np.radians(signed)
+    for a, lobe in zip(ax, lobes):
+        th = np.radians(lobe.signed_deg)
         a.set_theta_zero_location("N")
         a.set_thetamin(-90)
         a.set_thetamax(90)
-        a.fill_between(th, lo, hi, alpha=0.35, color="C0", label="90% band")
-        a.plot(th, med, color="C0", lw=1)
-        # data near this plane
-        dphi = np.angle(np.exp(1j * np.radians(ang[:, 3] - phi_i_deg)))
-        near_i = np.abs(ang[:, 0] - ti) <= theta_tol_deg
-        fwd = np.abs(np.abs(dphi) - np.pi) <= np.radians(plane_tol_deg)
-        back = np.abs(dphi) <= np.radians(plane_tol_deg)
-        dphi_i = np.abs(np.angle(np.exp(1j * np.radians(ang[:, 1] - phi_i_deg))))
-        near_i &= dphi_i <= np.radians(plane_tol_deg)
-        sel = near_i & (fwd | back)
-        if np.any(sel):
-            s = np.where(fwd[sel], 1.0, -1.0) * np.radians(ang[sel, 2])
-            v = np.nanmean(np.where(table.valid[sel], table.values[sel], np.nan), -1) \
-                * np.cos(np.radians(ang[sel, 2]))
-            a.plot(s, v, "k.", ms=3, label="data")
+        a.fill_between(th, lobe.lo, lobe.hi, alpha=0.35, color="C0", label="90% band")
+        a.plot(th, lobe.median, color="C0", lw=1)
+        if lobe.data.size:
+            a.plot(np.radians(lobe.data_signed_deg), lobe.data, "k.", ms=3, label="data")
         a.yaxis.set_major_locator(MaxNLocator(3))
         a.tick_params(labelsize=7)
-        a.set_title(f"theta_i = {ti:g} deg: f_r cos(theta_o), mean RGB\n"
-                    f"(+ forward, - backward in the plane phi_i = {phi_i_deg:g} deg)",
+        a.set_title(f"theta_i = {lobe.theta_i_deg:g} deg: f_r cos(theta_o), mean RGB\n"
+                    f"(+ forward, - backward in the plane phi_i = {lobe.phi_i_deg:g} deg)",
                     fontsize=8)
     ax[0].legend(fontsize=7, loc="lower left")
     _save(fig, filename)

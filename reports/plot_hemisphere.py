@@ -12,73 +12,24 @@ import matplotlib
 import matplotlib.colors as mcolors
 import numpy as np
 
-from brdf.frames import from_angles
-from reports._plotting import FONT, check_angle, eval_brdf, finish, legend_outside, new_axes
+from analysis.views import HemisphereView, compute_hemisphere, equal_area_grid, equal_area_xy
+from reports._plotting import FONT, finish, legend_outside, new_axes
 from reports.colour import luminance, to_srgb
 
-__all__ = ["equal_area_grid", "equal_area_xy", "hemisphere_image", "plot_hemisphere"]
-
-
-def equal_area_xy(w):
-    """Disc coordinates (x, y) of unit directions (..., 3) in the equal-area projection.
-
-    Examples
-    --------
-    >>> [round(float(v), 6) for v in equal_area_xy(np.array([1.0, 0.0, 0.0]))]
-    [1.0, 0.0]
-    """
-    w = np.asarray(w, dtype=np.float64)
-    theta = np.arccos(np.clip(w[..., 2], -1.0, 1.0))
-    phi = np.arctan2(w[..., 1], w[..., 0])
-    rho = np.sqrt(2.0) * np.sin(theta / 2.0)
-    return rho * np.cos(phi), rho * np.sin(phi)
-
-
-def equal_area_grid(resolution=101):
-    """Pixel centres of a square image over [-1, 1]^2 and their directions.
-
-    Parameters
-    ----------
-    resolution : int
-        Pixels per side.
-
-    Returns
-    -------
-    x, y : numpy.ndarray, shape (resolution, resolution)
-        Pixel centres (row index = y, increasing upward when drawn with origin="lower").
-    inside : numpy.ndarray of bool
-        Pixels inside the unit disc (the hemisphere).
-    wo : numpy.ndarray, shape (resolution, resolution, 3)
-        Directions of the pixels (those outside the disc are clamped to the horizon).
-
-    Notes
-    -----
-    Inverse projection: rho = sqrt(x^2 + y^2), theta = 2 asin(rho / sqrt 2), phi = atan2(y, x).
-    """
-    n = int(resolution)
-    if n < 2:
-        raise ValueError(f"resolution must be at least 2; got {resolution}")
-    c = (np.arange(n) + 0.5) / n * 2.0 - 1.0
-    y, x = np.meshgrid(c, c, indexing="ij")
-    rho = np.hypot(x, y)
-    inside = rho <= 1.0
-    theta = 2.0 * np.arcsin(np.clip(rho, 0.0, 1.0) / np.sqrt(2.0))
-    return x, y, inside, from_angles(theta, np.arctan2(y, x))
+__all__ = ["equal_area_grid", "equal_area_xy", "hemisphere_image", "plot_hemisphere",
+           "draw_hemisphere"]
 
 
 def hemisphere_image(brdf, theta_i_deg=45.0, phi_i_deg=0.0, resolution=101):
-    """RGB f_r (1/sr) over the equal-area disc for the light at (theta_i, phi_i) degrees.
+    """RGB f_r (1/sr) over the equal-area disc for the light at (theta_i, phi_i) degrees
+    (:func:`analysis.views.compute_hemisphere`'s ``rgb``).
 
     Returns
     -------
     values : numpy.ndarray, shape (resolution, resolution, 3)
         f_r; NaN outside the disc.
     """
-    _, _, inside, wo = equal_area_grid(resolution)
-    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
-    values = eval_brdf(brdf, wi, wo)
-    values[~inside] = np.nan
-    return values
+    return compute_hemisphere(brdf, theta_i_deg, phi_i_deg, resolution).rgb
 
 
 def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminance", log=True,
@@ -109,13 +60,24 @@ def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminanc
         ``ax.images[0].get_array()`` is the plotted image: luminance in 1/sr (masked outside
         the disc) or the sRGB image. The light's direction and its mirror are marked.
     """
+    _check_hemisphere_quantity(quantity)
+    view = compute_hemisphere(brdf, theta_i_deg, phi_i_deg, resolution)
+    return draw_hemisphere(view, quantity=quantity, log=log, decades=decades, cosine=cosine,
+                           exposure=exposure, ax=ax, filename=filename, title=title)
+
+
+def _check_hemisphere_quantity(quantity):
     if quantity not in ("luminance", "srgb"):
         raise ValueError(f"quantity must be 'luminance' or 'srgb'; got {quantity!r}")
-    check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
-    values = hemisphere_image(brdf, theta_i_deg, phi_i_deg, resolution)
-    if cosine:
-        _, _, _, wo = equal_area_grid(resolution)
-        values = values * wo[..., 2:3]
+
+
+def draw_hemisphere(view: HemisphereView, *, quantity="luminance", log=True, decades=4.0,
+                    cosine=False, exposure=0.0, ax=None, filename=None, title=None):
+    """Draw a :class:`analysis.views.HemisphereView` (:func:`plot_hemisphere` computes one
+    and calls this); the arguments and the result as :func:`plot_hemisphere`'s."""
+    _check_hemisphere_quantity(quantity)
+    theta_i_deg, phi_i_deg = view.theta_i_deg, view.phi_i_deg
+    values = view.values(cosine)
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
     extent = (-1, 1, -1, 1)
     if quantity == "luminance":
@@ -130,7 +92,7 @@ def plot_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, quantity="luminanc
     for deg in (30, 60):
         r = np.sqrt(2.0) * np.sin(np.radians(deg) / 2.0)
         ax.plot(r * np.cos(t), r * np.sin(t), color="0.6", lw=0.5, ls=":")
-    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
+    wi = view.wi
     xi, yi = equal_area_xy(wi)
     xm, ym = equal_area_xy(wi * np.array([-1.0, -1.0, 1.0]))
     ax.plot([xi], [yi], marker="*", color="#56B4E9", mec="k", mew=0.5, ms=10, ls="",

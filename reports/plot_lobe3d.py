@@ -6,11 +6,10 @@ import matplotlib
 import numpy as np
 from matplotlib.ticker import MaxNLocator
 
-from brdf.frames import from_angles
-from reports._plotting import FONT, check_angle, eval_brdf, finish, new_axes
-from reports.colour import luminance
+from analysis.views import Lobe3DView, compute_lobe_3d
+from reports._plotting import FONT, finish, new_axes
 
-__all__ = ["plot_lobe_3d"]
+__all__ = ["plot_lobe_3d", "draw_lobe_3d"]
 
 
 def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resolution=(30, 60),
@@ -35,20 +34,17 @@ def plot_lobe_3d(brdf, theta_i_deg=45.0, phi_i_deg=0.0, *, cosine=True, resoluti
     (fig, ax)
         The surface is ``ax.collections[0]``; its z extent is the largest r cos(theta_o).
     """
-    check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999)
-    nt, npf = (int(v) for v in resolution)
-    if nt < 2 or npf < 3:
-        raise ValueError(f"resolution must be at least (2, 3); got {resolution}")
+    view = compute_lobe_3d(brdf, theta_i_deg, phi_i_deg, cosine=cosine, resolution=resolution)
+    return draw_lobe_3d(view, ax=ax, filename=filename, title=title)
+
+
+def draw_lobe_3d(view: Lobe3DView, *, ax=None, filename=None, title=None):
+    """Draw a :class:`analysis.views.Lobe3DView` (:func:`plot_lobe_3d` computes one and
+    calls this); the arguments and the result as :func:`plot_lobe_3d`'s."""
     fig, ax = new_axes(ax, projection="3d", figsize=(5.0, 4.5))
-    t = np.radians(np.linspace(0.0, 90.0, nt))
-    p = np.radians(np.linspace(0.0, 360.0, npf))
-    T, P = np.meshgrid(t, p, indexing="ij")
-    wo = from_angles(T, P)
-    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
-    r = luminance(eval_brdf(brdf, wi, wo))
-    if cosine:
-        r = r * np.cos(T)
-    X, Y, Z = (r * wo[..., k] for k in range(3))
+    r, wi, cosine = view.r, view.wi, view.cosine
+    theta_i_deg, phi_i_deg = view.theta_i_deg, view.phi_i_deg
+    X, Y, Z = view.xyz
     norm = matplotlib.colors.Normalize(0.0, max(float(np.nanmax(r)), 1e-12))
     facecolors = matplotlib.colormaps["viridis"](norm(r))
     ax.plot_surface(X, Y, Z, facecolors=facecolors, rstride=1, cstride=1, linewidth=0,

@@ -13,43 +13,14 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, MaxNLocator
 
-from brdf.frames import from_angles
-from reports._plotting import (FONT, as_brdf, check_angle, check_quantity, eval_brdf, finish, legend_outside,
+from analysis.views import LobeView, compute_lobes, finite_max, plane_directions
+from reports._plotting import (FONT, check_angle, check_quantity, finish, legend_outside,
                                new_axes, pow10_label, quantity_styles, series_styles,
-                               reduce_quantity, series_style)
+                               series_style)
 
 __all__ = ["plane_directions", "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison",
-           "log_radius", "plane_name", "lobe_peak"]
-
-
-def plane_directions(theta_i_deg, theta_o_deg, phi_deg=0.0):
-    """Directions in the plane of incidence at azimuth ``phi_deg``.
-
-    Parameters
-    ----------
-    theta_i_deg : float
-        Polar angle of the light in degrees, [0, 90); wi lies at azimuth phi + 180.
-    theta_o_deg : array_like
-        Signed viewing angles in degrees, [-90, 90]; positive toward azimuth phi.
-    phi_deg : float
-        Azimuth of the plane in degrees (from the warp, +x, toward the weft, +y).
-
-    Returns
-    -------
-    wi : numpy.ndarray, shape (3,)
-    wo : numpy.ndarray, shape (n, 3)
-
-    Examples
-    --------
-    >>> wi, wo = plane_directions(30.0, [30.0], 0.0)
-    >>> np.round(wi, 6).tolist(), np.round(wo, 6).tolist()
-    ([-0.5, 0.0, 0.866025], [[0.5, 0.0, 0.866025]])
-    """
-    phi = np.radians(float(phi_deg))
-    wi = from_angles(np.radians(float(theta_i_deg)), phi + np.pi)
-    s = np.radians(np.atleast_1d(np.asarray(theta_o_deg, dtype=np.float64)))
-    wo = np.stack([np.sin(s) * np.cos(phi), np.sin(s) * np.sin(phi), np.cos(s)], axis=-1)
-    return wi, wo
+           "draw_polar_lobe", "draw_lobe_planes", "draw_lobe_comparison", "log_radius",
+           "log_floor", "setup_polar", "plane_name", "lobe_peak"]
 
 
 def log_radius(values, floor):
@@ -63,18 +34,11 @@ def log_radius(values, floor):
     return np.log10(np.maximum(np.asarray(values, dtype=np.float64), floor) / floor)
 
 
-def _log_floor(peak, decades):
+def log_floor(peak, decades):
     """The power of 10 at least ``decades`` below ``peak`` (1e-12 for a zero peak)."""
     if not peak > 0:
         return 1e-12
     return 10.0 ** np.floor(np.log10(peak) - decades)
-
-
-def _finite_max(values) -> float:
-    """The largest finite value (0 when there is none)."""
-    v = np.asarray(values, dtype=np.float64)
-    v = v[np.isfinite(v)]
-    return float(v.max()) if v.size else 0.0
 
 
 def _radius(value, scale, floor) -> float:
@@ -101,17 +65,13 @@ def lobe_peak(brdfs, theta_i_deg, planes_deg, *, quantity="luminance", resolutio
     float
         f_r in 1/sr (times cos theta_o when ``cosine``); 0 when nothing is positive.
     """
-    thetas = np.atleast_1d(check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999))
-    planes = np.atleast_1d(check_angle("planes_deg", planes_deg, -360.0, 360.0))
-    if int(resolution) < 3:
-        raise ValueError(f"resolution must be at least 3; got {resolution}")
+    check_quantity(quantity)
     many = brdfs.values() if isinstance(brdfs, dict) else [brdfs]
-    theta_o = np.linspace(-90.0, 90.0, int(resolution))
-    return max(_finite_max(_plane_curve(b, ti, theta_o, phi, quantity, cosine))
-               for b in many for ti in thetas for phi in planes)
+    return max(compute_lobes(b, theta_i_deg, planes_deg, resolution=resolution,
+                             cosine=cosine).peak(quantity) for b in many)
 
 
-def _setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
+def setup_polar(ax, scale, floor, rmax, label="f_r (1/sr)"):
     """Half-disc polar axes (theta_o from -90 to 90 degrees, the normal up) with radial ticks
     in 8 pt: decades 10^k on a log scale (every other one when more than five), and the
     radial axis labelled ``label`` under the disc."""
@@ -196,28 +156,58 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
         (f_r in 1/sr, its log radius, or f_r / its peak), and gid
         "lobe theta_i=<deg> <channel>".
     """
-    _check_scale(scale)
-    brdf = as_brdf(brdf)
-    thetas = np.atleast_1d(check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999))
+    _check_draw(scale, decades, normalize, quantity)
     check_angle("phi_deg", phi_deg, -360.0, 360.0)
-    if int(resolution) < 3:
-        raise ValueError(f"resolution must be at least 3; got {resolution}")
+    if ax is not None:                          # a wrong projection refused before work
+        new_axes(ax, projection="polar")
+    view = compute_lobes(brdf, theta_i_deg, (phi_deg,), resolution=resolution, cosine=cosine)
+    return draw_polar_lobe(view, phi_deg, quantity=quantity, scale=scale, decades=decades,
+                           colour=colour, normalize=normalize, legend=legend, peak=peak,
+                           ax=ax, filename=filename, title=title)
+
+
+def _check_draw(scale, decades, normalize, quantity):
+    _check_scale(scale)
+    check_quantity(quantity)
     if not decades > 0:
         raise ValueError(f"decades must be positive; got {decades}")
     if normalize and scale == "log":
         raise ValueError("normalize applies to the linear scale only; got scale='log'")
+
+
+def draw_polar_lobe(view: LobeView, phi_deg=None, *, quantity="luminance", scale="linear",
+                    decades=4.0, colour=None, normalize=False, legend=True, peak=None, ax=None,
+                    filename=None, title=None):
+    """Draw the curves of one plane of a :class:`analysis.views.LobeView`, one per incidence
+    (:func:`plot_polar_lobe` computes the view and calls this).
+
+    Parameters
+    ----------
+    view : analysis.views.LobeView
+    phi_deg : float, optional
+        The plane drawn, one of ``view.planes_deg`` (default its first).
+    quantity, scale, decades, colour, normalize, legend, peak, ax, filename, title
+        As in :func:`plot_polar_lobe`.
+
+    Returns
+    -------
+    (fig, ax)
+        As :func:`plot_polar_lobe`.
+    """
+    _check_draw(scale, decades, normalize, quantity)
+    phi_deg = view.planes_deg[0] if phi_deg is None else phi_deg
     fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
-    theta_o = np.linspace(-90.0, 90.0, int(resolution))
-    curves = [_plane_curve(brdf, ti, theta_o, phi_deg, quantity, cosine) for ti in thetas]
-    own = max(_finite_max(c) for c in curves)
-    floor = _log_floor(own if peak is None else peak, decades)
+    thetas, theta_o = view.theta_i_deg, view.theta_o_deg
+    curves = view.curves(phi_deg, quantity)
+    own = max(finite_max(c) for c in curves)
+    floor = log_floor(own if peak is None else peak, decades)
     rmax = _draw_lobes(ax, thetas, theta_o, curves, quantity_styles(quantity, colour), colour,
                        floor if scale == "log" else None, normalize)
     if peak is not None and not normalize:
         rmax = max(rmax, _radius(peak, scale, floor))
-    label = "f_r cos θo" if cosine else "f_r"
-    _setup_polar(ax, scale, floor, rmax,
-                 f"{label} / its peak (per curve)" if normalize else f"{label} (1/sr)")
+    label = view.label
+    setup_polar(ax, scale, floor, rmax, f"{label} / its peak (per curve)" if normalize
+                 else f"{label} ({view.unit})")
     for ti in thetas:  # incident directions as arrows from the centre
         ax.annotate("", xy=(np.radians(-ti), rmax * 1.0), xytext=(0, 0),
                     arrowprops=dict(arrowstyle="<-", color="0.5", lw=0.8))
@@ -227,17 +217,6 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
     if legend:
         legend_outside(ax, "below", ncol=min(3, len(ax.get_lines())))
     return finish(fig, ax, filename)
-
-
-def _plane_curve(brdf, theta_i_deg, theta_o, phi_deg, quantity, cosine) -> np.ndarray:
-    """f_r (1/sr), reduced to ``quantity``, over signed ``theta_o`` (degrees) in the plane
-    ``phi_deg`` for one incidence; times cos(theta_o) when ``cosine``."""
-    wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
-    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    if cosine:
-        f = f * (np.cos(np.radians(theta_o))[:, None] if f.ndim == 2
-                 else np.cos(np.radians(theta_o)))
-    return f
 
 
 def _draw_lobes(ax, thetas, theta_o, curves, styles, colour, floor, normalize=False) -> float:
@@ -287,7 +266,32 @@ def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0,
     (fig, axes)
         axes is a list of PolarAxes, one per plane.
     """
-    planes = list(np.atleast_1d(planes_deg))
+    view = compute_lobes(brdf, theta_i_deg, planes_deg,
+                         resolution=kwargs.pop("resolution", 181),
+                         cosine=kwargs.pop("cosine", False))
+    return draw_lobe_planes(view, fig=fig, filename=filename, **kwargs)
+
+
+def draw_lobe_planes(view: LobeView, *, fig=None, filename=None, **kwargs):
+    """Draw every plane of a :class:`analysis.views.LobeView` side by side, a panel each
+    (:func:`plot_lobe_planes` computes the view and calls this).
+
+    Parameters
+    ----------
+    view : analysis.views.LobeView
+    fig, filename
+        As in :func:`plot_lobe_planes`.
+    **kwargs
+        Passed to :func:`draw_polar_lobe` (quantity, scale, decades, normalize, colour);
+        ``peak`` defaults to the view's (:meth:`analysis.views.LobeView.peak`), so that the
+        panels share their radial limit and, on a log scale, their decades.
+
+    Returns
+    -------
+    (fig, axes)
+        axes is a list of PolarAxes, one per plane.
+    """
+    planes = view.planes_deg
     if fig is None:
         fig = Figure(figsize=(4.2 * len(planes), 2.9), layout="constrained")
     else:
@@ -295,12 +299,9 @@ def plot_lobe_planes(brdf, theta_i_deg=(0.0, 30.0, 60.0), planes_deg=(0.0, 45.0,
     axes = [fig.add_subplot(1, len(planes), n + 1, projection="polar")
             for n in range(len(planes))]
     if not kwargs.get("normalize") and "peak" not in kwargs:      # one set of decades
-        kwargs["peak"] = lobe_peak(brdf, theta_i_deg, planes,
-                                   quantity=kwargs.get("quantity", "luminance"),
-                                   resolution=kwargs.get("resolution", 181),
-                                   cosine=kwargs.get("cosine", False))
+        kwargs["peak"] = view.peak(check_quantity(kwargs.get("quantity", "luminance")))
     for ax, phi in zip(axes, planes):
-        plot_polar_lobe(brdf, theta_i_deg, phi, ax=ax, legend=False,
+        draw_polar_lobe(view, phi, ax=ax, legend=False,
                         title=f"plane φ = {float(phi):g}° ({plane_name(phi)})", **kwargs)
     if not kwargs.get("normalize"):
         handles, labels = axes[0].get_legend_handles_labels()
@@ -345,26 +346,40 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
         One Line2D per BRDF with gid "lobe <name>".
     """
     _check_scale(scale)
-    check_angle("theta_i_deg", theta_i_deg, 0.0, 89.999)
-    fig, ax = new_axes(ax, projection="polar", figsize=(5.6, 3.7))
-    theta_o = np.linspace(-90.0, 90.0, int(resolution))
-    wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
     if check_quantity(quantity) == "rgb":
         raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b'; got 'rgb'")
-    data = {name: reduce_quantity(eval_brdf(b, wi, wo), quantity)
-            for name, b in dict(brdfs).items()}
-    own = max((_finite_max(v) for v in data.values()), default=0.0)
-    floor = _log_floor(own if peak is None else peak, decades)
+    if ax is not None:                          # a wrong projection refused before work
+        new_axes(ax, projection="polar")
+    views = {name: compute_lobes(b, theta_i_deg, phi_deg, resolution=resolution)
+             for name, b in dict(brdfs).items()}
+    return draw_lobe_comparison(views, theta_i_deg, phi_deg, scale=scale, decades=decades,
+                                quantity=quantity, legend=legend, peak=peak, ax=ax,
+                                filename=filename, title=title)
+
+
+def draw_lobe_comparison(views, theta_i_deg, phi_deg, *, scale="log", decades=4.0,
+                         quantity="luminance", legend=True, peak=None, ax=None, filename=None,
+                         title=None):
+    """Draw the curve at ``theta_i_deg`` in the plane ``phi_deg`` (degrees) of each
+    :class:`analysis.views.LobeView` of ``views`` (name -> view, the name the curve's
+    label); the other arguments and the result as :func:`plot_lobe_comparison`."""
+    _check_scale(scale)
+    if check_quantity(quantity) == "rgb":
+        raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b'; got 'rgb'")
+    fig, ax = new_axes(ax, projection="polar", figsize=(5.6, 3.7))
+    data = {name: v.curve(phi_deg, theta_i_deg, quantity) for name, v in views.items()}
+    own = max((finite_max(v) for v in data.values()), default=0.0)
+    floor = log_floor(own if peak is None else peak, decades)
     rmax = 0.0 if peak is None else _radius(peak, scale, floor)
     styles = series_styles(data)
     for name, y in data.items():
         r = log_radius(y, floor) if scale == "log" else y
         rmax = max(rmax, float(np.nanmax(r)))
         st = styles[name]
-        line, = ax.plot(np.radians(theta_o), r, color=st["color"], ls=st["ls"], lw=1.5,
-                        label=name)
+        line, = ax.plot(np.radians(views[name].theta_o_deg), r, color=st["color"],
+                        ls=st["ls"], lw=1.5, label=name)
         line.set_gid(f"lobe {name}")
-    _setup_polar(ax, scale, floor, rmax, f"{_what(quantity)} f_r (1/sr)")
+    setup_polar(ax, scale, floor, rmax, f"{_what(quantity)} f_r (1/sr)")
     ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {float(phi_deg):g}° "
                  f"({plane_name(phi_deg)})", fontsize=FONT["title"])
     if legend:

@@ -10,46 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from brdf import terms
-from reports._plotting import (FONT, PALETTE, eval_brdf, finish, legend_outside, new_axes,
-                               series_style)
-from reports.colour import luminance
-from reports.plot_lobes import _log_floor, _setup_polar, log_radius, plane_directions
+from analysis.views import MaskingLobesView, compute_masking_lobes, masking_terms
+from reports._plotting import FONT, PALETTE, finish, legend_outside, new_axes, series_style
+from reports.plot_lobes import log_floor, setup_polar, log_radius
 
-__all__ = ["plot_masking_lobes", "plot_masking_terms", "masking_terms"]
-
-
-def masking_terms(angle_deg, pair_with_deg=0.0):
-    """M (= P) of one direction, u, and the paired weight, against an angle in degrees.
-
-    Parameters
-    ----------
-    angle_deg : array_like
-        Azimuth about the thread (phi for M, psi for P) in degrees.
-    pair_with_deg : float
-        The other direction's angle in degrees, for the paired weight.
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        "M": max(cos(angle), 0); "u": u(angle); "pair": pair weight of (angle, pair_with) with
-        difference angle - pair_with, from :func:`brdf.terms.u` and
-        :func:`brdf.terms.pair_weight`.
-
-    Examples
-    --------
-    >>> t = masking_terms([0.0, 20.0, 90.0])
-    >>> np.round(t["u"], 4).tolist()
-    [1.0, 0.6065, 0.0]
-    """
-    x = np.radians(np.asarray(angle_deg, dtype=np.float64))
-    other = np.radians(float(pair_with_deg))
-    m = np.maximum(np.cos(x), 0.0)
-    m_other = np.maximum(np.cos(other), 0.0) * np.ones_like(x)
-    delta = np.angle(np.exp(1j * (x - other)))  # wrap into (-pi, pi]
-    u = np.asarray(terms.u(x), dtype=np.float64)
-    pair = np.asarray(terms.pair_weight(m, m_other, delta), dtype=np.float64)
-    return {"M": m, "u": u, "pair": pair}
+__all__ = ["plot_masking_lobes", "plot_masking_terms", "masking_terms", "draw_masking_lobes"]
 
 
 def plot_masking_terms(pair_with_deg=(0.0, 30.0, 60.0), *, resolution=361, ax=None,
@@ -123,19 +88,21 @@ def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", d
     ValueError
         If the BRDF has no ``replace`` accepting ``masking``.
     """
-    replace = getattr(brdf, "replace", None)
-    if replace is None:
-        raise ValueError(f"brdf must have .replace(masking=...) for masking views; "
-                         f"got {type(brdf).__name__}")
-    on = replace(masking=True)
-    off = replace(masking=False)
+    view = compute_masking_lobes(brdf, theta_i_deg, phi_deg, resolution=resolution)
+    return draw_masking_lobes(view, theta_i_deg, phi_deg, scale=scale, decades=decades,
+                              legend=legend, ax=ax, filename=filename, title=title)
+
+
+def draw_masking_lobes(view: MaskingLobesView, theta_i_deg, phi_deg, *, scale="linear",
+                       decades=4.0, legend=True, ax=None, filename=None, title=None):
+    """Draw one panel (incidence and plane, degrees) of a
+    :class:`analysis.views.MaskingLobesView`; the other arguments and the result as
+    :func:`plot_masking_lobes`, which computes the view and calls this."""
     fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
-    theta_o = np.linspace(-90.0, 90.0, int(resolution))
-    wi, wo = plane_directions(theta_i_deg, theta_o, phi_deg)
-    curves = {"masking on": luminance(eval_brdf(on, wi, wo)),
-              "masking off": luminance(eval_brdf(off, wi, wo))}
+    curves = view.curves(phi_deg, theta_i_deg)
+    theta_o = view.on.theta_o_deg
     peak = max(float(np.nanmax(c)) for c in curves.values())
-    floor = _log_floor(peak, decades)
+    floor = log_floor(peak, decades)
     rmax = 0.0
     for n, (name, y) in enumerate(curves.items()):
         r = log_radius(y, floor) if scale == "log" else y
@@ -144,7 +111,7 @@ def plot_masking_lobes(brdf, theta_i_deg=60.0, phi_deg=0.0, *, scale="linear", d
         line, = ax.plot(np.radians(theta_o), r, color=st["color"], ls=st["ls"], lw=1.5,
                         label=name)
         line.set_gid(name)
-    _setup_polar(ax, scale, floor, rmax, "luminance f_r (1/sr)")
+    setup_polar(ax, scale, floor, rmax, "luminance f_r (1/sr)")
     if legend:
         legend_outside(ax, "below", ncol=2)
     ax.set_title(title or f"θi = {float(theta_i_deg):g}°, plane φ = {float(phi_deg):g}°",

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.reciprocity import relative_asymmetry
-from brdf.frames import from_angles
-from reports._plotting import FONT, eval_brdf, finish, new_axes
-from reports.colour import luminance
+from analysis.views import ReciprocityView, compute_reciprocity
+from reports._plotting import FONT, finish, new_axes
 
-__all__ = ["reciprocity_map", "plot_reciprocity_map"]
+__all__ = ["reciprocity_map", "plot_reciprocity_map", "draw_reciprocity_map"]
 
 
 def reciprocity_map(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45, quantity="luminance"):
@@ -35,24 +33,8 @@ def reciprocity_map(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45, quantit
         f(wo, wi) (unitless, 0 where both are 0, NaN where one is not finite), rows theta_i,
         columns theta_o.
     """
-    if quantity not in ("luminance", "rgb"):
-        raise ValueError(f"quantity must be 'luminance' or 'rgb'; got {quantity!r}")
-    n = int(resolution)
-    if n < 1:
-        raise ValueError(f"resolution must be at least 1; got {resolution}")
-    theta = (np.arange(n) + 0.5) * 90.0 / n
-    TI, TO = np.meshgrid(np.radians(theta), np.radians(theta), indexing="ij")
-    wi = from_angles(TI, np.radians(phi_i_deg))
-    wo = from_angles(TO, np.radians(phi_o_deg))
-    a = eval_brdf(brdf, wi, wo)
-    b = eval_brdf(brdf, wo, wi)
-    if quantity == "luminance":
-        a, b = luminance(a), luminance(b)
-    err = relative_asymmetry(a, b)
-    err[(a == 0) & (b == 0)] = 0.0          # both zero: drawn as reciprocal
-    if quantity == "rgb":
-        err = err.max(axis=-1)
-    return theta, err
+    view = compute_reciprocity(brdf, phi_i_deg, phi_o_deg, resolution, quantity)
+    return view.theta_deg, view.error
 
 
 def plot_reciprocity_map(brdf=None, phi_i_deg=180.0, phi_o_deg=0.0, *, theta_deg=None,
@@ -72,7 +54,7 @@ def plot_reciprocity_map(brdf=None, phi_i_deg=180.0, phi_o_deg=0.0, *, theta_deg
     if error is None:
         if brdf is None:
             raise ValueError("plot_reciprocity_map needs brdf or theta_deg and error")
-        theta_deg, error = reciprocity_map(brdf, phi_i_deg, phi_o_deg, resolution, quantity)
+        view = compute_reciprocity(brdf, phi_i_deg, phi_o_deg, resolution, quantity)
     else:
         error = np.asarray(error, dtype=np.float64)
         if error.ndim != 2 or error.shape[0] != error.shape[1]:
@@ -80,7 +62,16 @@ def plot_reciprocity_map(brdf=None, phi_i_deg=180.0, phi_o_deg=0.0, *, theta_deg
         if theta_deg is None:
             n = error.shape[0]
             theta_deg = (np.arange(n) + 0.5) * 90.0 / n
-    theta_deg = np.asarray(theta_deg, dtype=np.float64)
+        view = ReciprocityView(np.asarray(theta_deg, dtype=np.float64), error, phi_i_deg,
+                               phi_o_deg, quantity)
+    return draw_reciprocity_map(view, ax=ax, filename=filename, title=title)
+
+
+def draw_reciprocity_map(view: ReciprocityView, *, ax=None, filename=None, title=None):
+    """Draw a :class:`analysis.views.ReciprocityView` (:func:`plot_reciprocity_map` computes
+    or wraps one and calls this); the arguments and the result as its."""
+    theta_deg, error = view.theta_deg, view.error
+    phi_i_deg, phi_o_deg = view.phi_i_deg, view.phi_o_deg
     step = theta_deg[1] - theta_deg[0] if theta_deg.size > 1 else 90.0
     lo, hi = theta_deg[0] - step / 2, theta_deg[-1] + step / 2
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
@@ -93,9 +84,8 @@ def plot_reciprocity_map(brdf=None, phi_i_deg=180.0, phi_o_deg=0.0, *, theta_deg
     ax.set_xlabel("θo (degrees)", fontsize=FONT["label"])
     ax.set_ylabel("θi (degrees)", fontsize=FONT["label"])
     ax.tick_params(labelsize=FONT["small"])
-    finite = error[np.isfinite(error)]
-    stats = (f"median {np.median(finite):.3g}, max {np.max(finite):.3g}" if finite.size
-             else "no data")
+    found = view.finite_stats()
+    stats = f"median {found[0]:.3g}, max {found[1]:.3g}" if found else "no data"
     ax.set_title(title or f"reciprocity error, φi = {phi_i_deg:g}°, φo = {phi_o_deg:g}°\n"
                  f"({stats})", fontsize=FONT["title"])
     return finish(fig, ax, filename)

@@ -15,27 +15,14 @@ import matplotlib
 import matplotlib.colors as mcolors
 import numpy as np
 
-from brdf.frames import from_angles
-from reports._plotting import (FONT, check_angle, check_quantity, eval_brdf, finish,
-                               half_diff_to_io, legend_outside, log_range, new_axes,
-                               quantity_styles, reduce_quantity, shade_zero)
-from reports.colour import line_colour, luminance
+from analysis.views import (SliceImageView, SliceView, compute_slice_image,
+                            compute_slice_theta_d, compute_slice_theta_h, compute_slice_theta_o)
+from reports._plotting import (FONT, check_quantity, finish, legend_outside, log_range,
+                               new_axes, quantity_styles, shade_zero)
+from reports.colour import line_colour
 
 __all__ = ["plot_slice_theta_o", "plot_slice_theta_h", "plot_slice_theta_d",
-           "plot_slice_image", "slice_image"]
-
-
-def _check_max(theta_max_deg):
-    v = float(theta_max_deg)
-    if not 0.0 < v <= 90.0:
-        raise ValueError(f"theta_max_deg must be in (0, 90] degrees; got {theta_max_deg!r}")
-    return v
-
-
-def _check_res(resolution, least=2):
-    if int(resolution) < least:
-        raise ValueError(f"resolution must be at least {least}; got {resolution}")
-    return int(resolution)
+           "plot_slice_image", "slice_image", "draw_slice", "draw_slice_image"]
 
 
 def _draw(ax, x_deg, values, quantity, colour, log, gid, decades=6.0, label=None,
@@ -107,18 +94,10 @@ def plot_slice_theta_o(brdf, theta_i_deg=30.0, phi_i_deg=180.0, phi_o_deg=0.0, *
         Lines have x = theta_o in degrees and y = f_r in 1/sr; gid "theta_o <channel>".
     """
     check_quantity(quantity)
-    check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
-    n = _check_res(resolution)
-    fig, ax = new_axes(ax)
-    x = np.linspace(0.0, _check_max(theta_max_deg), n)
-    wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
-    wo = from_angles(np.radians(x), np.radians(phi_o_deg))
-    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_o", label=label, style=style)
-    ax.set_xlabel("θo (degrees)", fontsize=FONT["label"])
-    ax.set_title(title or f"θi = {theta_i_deg:g}°, φi = {phi_i_deg:g}°, φo = {phi_o_deg:g}°",
-                 fontsize=FONT["title"])
-    return finish(fig, ax, filename)
+    view = compute_slice_theta_o(brdf, theta_i_deg, phi_i_deg, phi_o_deg,
+                                resolution=resolution, theta_max_deg=theta_max_deg)
+    return draw_slice(view, quantity=quantity, colour=line_colour(brdf), log=log, ax=ax,
+                      filename=filename, title=title, label=label, style=style)
 
 
 def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
@@ -132,18 +111,10 @@ def plot_slice_theta_h(brdf, theta_d_deg=10.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
         Lines have x = theta_h in degrees and y = f_r in 1/sr; gid "theta_h <channel>".
     """
     check_quantity(quantity)
-    check_angle("theta_d_deg", theta_d_deg, 0.0, 90.0)
-    n = _check_res(resolution)
-    fig, ax = new_axes(ax)
-    x = np.linspace(0.0, _check_max(theta_max_deg), n)
-    wi, wo = half_diff_to_io(np.radians(x), np.radians(theta_d_deg), np.radians(phi_d_deg),
-                             np.radians(phi_h_deg))
-    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_h", label=label, style=style)
-    ax.set_xlabel("θh (degrees)", fontsize=FONT["label"])
-    ax.set_title(title or f"θd = {theta_d_deg:g}°, φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°",
-                 fontsize=FONT["title"])
-    return finish(fig, ax, filename)
+    view = compute_slice_theta_h(brdf, theta_d_deg, phi_d_deg, phi_h_deg,
+                                resolution=resolution, theta_max_deg=theta_max_deg)
+    return draw_slice(view, quantity=quantity, colour=line_colour(brdf), log=log, ax=ax,
+                      filename=filename, title=title, label=label, style=style)
 
 
 def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
@@ -157,18 +128,27 @@ def plot_slice_theta_d(brdf, theta_h_deg=0.0, phi_d_deg=90.0, phi_h_deg=0.0, *,
         Lines have x = theta_d in degrees and y = f_r in 1/sr; gid "theta_d <channel>".
     """
     check_quantity(quantity)
-    check_angle("theta_h_deg", theta_h_deg, 0.0, 90.0)
-    n = _check_res(resolution)
+    view = compute_slice_theta_d(brdf, theta_h_deg, phi_d_deg, phi_h_deg,
+                                resolution=resolution, theta_max_deg=theta_max_deg)
+    return draw_slice(view, quantity=quantity, colour=line_colour(brdf), log=log, ax=ax,
+                      filename=filename, title=title, label=label, style=style)
+
+
+def draw_slice(view: SliceView, *, quantity="rgb", colour=None, log=True, ax=None,
+               filename=None, title=None, label=None, style=None):
+    """Draw a :class:`analysis.views.SliceView` (the ``plot_slice_*`` functions compute
+    one and call this); ``colour`` is the luminance curve's (default black), the other
+    arguments and the result as :func:`plot_slice_theta_o`'s."""
+    check_quantity(quantity)
     fig, ax = new_axes(ax)
-    x = np.linspace(0.0, _check_max(theta_max_deg), n)
-    wi, wo = half_diff_to_io(np.radians(theta_h_deg), np.radians(x), np.radians(phi_d_deg),
-                             np.radians(phi_h_deg))
-    f = reduce_quantity(eval_brdf(brdf, wi, wo), quantity)
-    _draw(ax, x, f, quantity, line_colour(brdf), log, "theta_d", label=label, style=style)
-    ax.set_xlabel("θd (degrees)", fontsize=FONT["label"])
-    ax.set_title(title or f"θh = {theta_h_deg:g}°, φd = {phi_d_deg:g}°, φh = {phi_h_deg:g}°",
-                 fontsize=FONT["title"])
+    _draw(ax, view.x_deg, view.values(quantity), quantity, colour, log, view.axis,
+          label=label, style=style)
+    ax.set_xlabel(f"{_SYMBOL[view.axis]} (degrees)", fontsize=FONT["label"])
+    ax.set_title(title or view.caption, fontsize=FONT["title"])
     return finish(fig, ax, filename)
+
+
+_SYMBOL = {"theta_o": "θo", "theta_h": "θh", "theta_d": "θd"}
 
 
 def slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, resolution=90):
@@ -189,11 +169,8 @@ def slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, resolution=90):
     image : numpy.ndarray, shape (resolution, resolution)
         Luminance f_r in 1/sr, rows = theta_d, columns = theta_h.
     """
-    n = _check_res(resolution, 1)
-    theta = (np.arange(n) + 0.5) * 90.0 / n
-    TD, TH = np.meshgrid(np.radians(theta), np.radians(theta), indexing="ij")
-    wi, wo = half_diff_to_io(TH, TD, np.radians(phi_d_deg), np.radians(phi_h_deg))
-    return theta, luminance(eval_brdf(brdf, wi, wo))
+    view = compute_slice_image(brdf, phi_d_deg, phi_h_deg, resolution)
+    return view.theta_deg, view.image
 
 
 def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4.0,
@@ -217,7 +194,15 @@ def plot_slice_image(brdf, phi_d_deg=90.0, phi_h_deg=0.0, *, log=True, decades=4
         ``ax.images[0].get_array()`` is the luminance image in 1/sr (rows theta_d from 0 at
         the bottom, columns theta_h), as :func:`slice_image` returns it.
     """
-    theta, img = slice_image(brdf, phi_d_deg, phi_h_deg, resolution)
+    return draw_slice_image(compute_slice_image(brdf, phi_d_deg, phi_h_deg, resolution),
+                            log=log, decades=decades, ax=ax, filename=filename, title=title)
+
+
+def draw_slice_image(view: SliceImageView, *, log=True, decades=4.0, ax=None, filename=None,
+                     title=None):
+    """Draw a :class:`analysis.views.SliceImageView` (:func:`plot_slice_image` computes one
+    and calls this); the arguments and the result as :func:`plot_slice_image`'s."""
+    img, phi_d_deg, phi_h_deg = view.image, view.phi_d_deg, view.phi_h_deg
     fig, ax = new_axes(ax, figsize=(5.0, 4.2))
     peak = float(np.nanmax(img)) if np.any(img > 0) else 1.0
     norm = (mcolors.LogNorm(vmin=peak * 10.0 ** (-decades), vmax=peak, clip=False) if log

@@ -18,18 +18,20 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from analysis import albedo_curve
+from analysis.views import compute_lobes, compute_masking_lobes, compute_table_panel
 from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
-from reports.plot_fit import plot_table_models, table_panels, table_points
+from reports.plot_fit import draw_table_models, table_panels
 from reports.plot_hemisphere import plot_hemisphere
-from reports.plot_lobes import lobe_peak, plane_name, plot_lobe_comparison, plot_lobe_planes
-from reports.plot_masking import plot_masking_lobes
+from reports.plot_lobes import draw_lobe_comparison, plane_name, plot_lobe_planes
+from reports.plot_masking import draw_masking_lobes
 from reports.plot_reciprocity import plot_reciprocity_map
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)
 
 __all__ = ["VIEW_FUNCTIONS", "lobes_view", "slices_view", "hemisphere_view", "masking_view",
-           "albedo_view", "reciprocity_view", "table_view", "table_view_data", "MAX_WIDTH_IN"]
+           "albedo_view", "reciprocity_view", "table_view", "table_view_data", "table_view_panels",
+           "MAX_WIDTH_IN"]
 
 
 def _grid(nrows, ncols, panel, polar=False):
@@ -69,11 +71,13 @@ def lobes_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",
     if scale == "normalized":
         raise ValueError("--scale normalized draws one fabric only; give log or linear")
     fig, axes = _grid(len(theta_i), len(planes), (4.2, 2.7), polar=True)
-    peak = lobe_peak(fabrics, theta_i, planes, quantity=quantity, resolution=res)
+    views = {name: compute_lobes(fab, theta_i, planes, resolution=res)
+             for name, fab in fabrics.items()}
+    peak = max(v.peak(quantity) for v in views.values())
     for row, ti in zip(axes, theta_i):
         for ax, phi in zip(row, planes):     # one peak: the same decades in every panel
-            plot_lobe_comparison(fabrics, ti, phi, scale=scale, resolution=res,
-                                 quantity=quantity, legend=False, peak=peak, ax=ax)
+            draw_lobe_comparison(views, ti, phi, scale=scale, quantity=quantity,
+                                 legend=False, peak=peak, ax=ax)
     _figure_legend(fig, axes[0][0], ncol=3)
     return fig
 
@@ -134,10 +138,12 @@ def masking_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log
     planes = planes or (0.0,)
     rows = [(name, fab, ti) for name, fab in fabrics.items() for ti in theta_i]
     fig, axes = _grid(len(rows), len(planes), (4.2, 2.9), polar=True)
+    views = {name: compute_masking_lobes(fab, theta_i, planes, resolution=resolution or 181)
+             for name, fab in fabrics.items()}
     for row, (name, fab, ti) in zip(axes, rows):
         for ax, phi in zip(row, planes):
-            plot_masking_lobes(fab, ti, phi, scale="log" if scale == "log" else "linear",
-                               resolution=resolution or 181, legend=False, ax=ax,
+            draw_masking_lobes(views[name], ti, phi, legend=False, ax=ax,
+                               scale="log" if scale == "log" else "linear",
                                title=f"{name}: θi = {ti:g}°, φ = {phi:g}° "
                                      f"({plane_name(phi)})")
     _figure_legend(fig, axes[0][0])
@@ -197,25 +203,27 @@ _TABLE_PANEL = (4.4, 3.4)
 
 
 def table_view(table, models, *, channel=None, theta_i=None, planes=None, scale="log",
-               resolution=None, source=None):
+               resolution=None, source=None, panels=None):
     """A measured table against models in the first plane: a panel per incidence (default:
     the table's first three in the plane) and per side the light was measured from, each
     model evaluated with the light there (:func:`reports.plot_fit.table_points`); points
     with error bars and a curve per model. Panels wrap into rows so that the figure is at
     most :data:`MAX_WIDTH_IN` wide. ``source`` names the table in the title (default its
-    ``meta["source"]`` when that is a short text)."""
+    ``meta["source"]`` when that is a short text). ``panels`` are the panels'
+    :class:`analysis.views.TablePanelView` when computed already (:func:`table_view_panels`,
+    whose numbers :func:`table_view_data` writes), else they are computed here."""
     phi = (planes or (0.0,))[0]
     quantity = channel or "luminance"
-    panels = table_panels(table, theta_i, phi)
+    if panels is None:
+        panels = table_view_panels(table, models, channel=channel, theta_i=theta_i,
+                                   planes=planes, resolution=resolution)
     ncols = max(1, min(len(panels), int(MAX_WIDTH_IN // _TABLE_PANEL[0])))
     nrows = -(-len(panels) // ncols)
     fig = Figure(figsize=(_TABLE_PANEL[0] * ncols, _TABLE_PANEL[1] * nrows),
                  layout="constrained")
     axes = [fig.add_subplot(nrows, ncols, k + 1) for k in range(len(panels))]
-    for k, (ax, (ti, light)) in enumerate(zip(axes, panels)):
-        plot_table_models(table, models, ti, phi, light_deg=light, quantity=quantity,
-                          log=scale == "log", resolution=resolution or 181, legend=False,
-                          ax=ax)
+    for k, (ax, panel) in enumerate(zip(axes, panels)):
+        draw_table_models(panel, log=scale == "log", legend=False, ax=ax)
         if k % ncols:
             ax.set_ylabel("")
         if k < len(panels) - ncols:
@@ -229,6 +237,17 @@ def table_view(table, models, *, channel=None, theta_i=None, planes=None, scale=
     return fig
 
 
+def table_view_panels(table, models, *, channel=None, theta_i=None, planes=None,
+                      resolution=None, curves=True) -> list:
+    """The panels :func:`table_view` draws, each a :class:`analysis.views.TablePanelView`
+    (every model evaluated once at the measured points and, with ``curves``, once along the
+    plane at ``resolution`` angles, default 181)."""
+    phi = (planes or (0.0,))[0]
+    return [compute_table_panel(table, models, ti, phi, light, quantity=channel or "luminance",
+                                resolution=(resolution or 181) if curves else None)
+            for ti, light in table_panels(table, theta_i, phi)]
+
+
 def _table_name(table, source) -> str:
     """What the title calls a table: ``source``, else its meta's source when that is a
     short text, else "table"."""
@@ -239,22 +258,18 @@ def _table_name(table, source) -> str:
     return name if isinstance(name, str) and 0 < len(name) <= 60 else "table"
 
 
-def table_view_data(table, models, *, channel=None, theta_i=None, planes=None) -> list:
+def table_view_data(table, models, *, channel=None, theta_i=None, planes=None,
+                    panels=None) -> list:
     """What :func:`table_view` draws at the measured points, one row per point and curve:
     ``(curve, theta_i, phi_i, theta_o, phi_o, f_r)``, curve ``"measured"`` or a model's
     label, the angles of the measured point in degrees (phi in (-180, 180]), f_r in 1/sr
-    (the measured value, or the model's at that point's own directions)."""
-    phi = (planes or (0.0,))[0]
-    quantity = channel or "luminance"
+    (the measured value, or the model's at that point's own directions). ``panels`` are
+    those the figure drew (:func:`table_view_panels`), else the points are computed here."""
+    if panels is None:
+        panels = table_view_panels(table, models, channel=channel, theta_i=theta_i,
+                                   planes=planes, curves=False)
     angles = np.degrees(np.asarray(table.angles))
-    out = []
-    for ti, light in table_panels(table, theta_i, phi):
-        pts = table_points(table, models, ti, phi, light, quantity=quantity)
-        curves = {"measured": pts["measured"], **pts["models"]}
-        for name, values in curves.items():
-            for row, value in zip(pts["rows"], values):
-                out.append((name, *angles[row].tolist(), float(value)))
-    return out
+    return [row for panel in panels for row in panel.rows(angles)]
 
 
 #: View name -> figure builder (``table`` takes a table and models instead of fabrics).

@@ -395,3 +395,25 @@ def test_polar_lobe_takes_a_preset_name_and_names_anything_else():
         plots.plot_polar_lobe("velour")
     with pytest.raises(TypeError, match="brdf must be a preset name or a BRDF.*int"):
         plots.plot_polar_lobe(3)
+
+
+def test_lobe_figures_evaluate_each_curve_once():
+    """plot lobes of two fabrics and plot_lobe_planes: each curve evaluated once (the shared
+    radial limit read from the same curves), and the drawn line is the curve."""
+    from reports import plot_views
+
+    class Counted(Lambert):
+        pairs = 0
+
+        def eval(self, wi, wo):
+            type(self).pairs += wi.shape[0]
+            return super().eval(wi, wo)
+
+    plot_views.lobes_view({"a": Counted(), "b": Counted()}, resolution=7)
+    assert Counted.pairs == 2 * 9 * 7                  # 2 fabrics x 3 incidences x 3 planes
+    Counted.pairs = 0
+    fig, axes = plots.plot_lobe_planes(Counted(), (30.0,), (0.0, 90.0), scale="linear",
+                                       resolution=7)
+    assert Counted.pairs == 2 * 7
+    y = Lambert().eval(np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]))[0] @ W
+    assert np.allclose(axes[1].get_lines()[0].get_ydata()[1:-1], y)

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from reports._plotting import FONT, eval_brdf
-from reports.colour import luminance
-from reports.plot_hemisphere import hemisphere_image, plot_hemisphere
+from analysis.views import (HemisphereView, compute_hemisphere, compute_lobes,
+                            compute_masking_lobes)
+from reports._plotting import FONT
+from reports.plot_hemisphere import draw_hemisphere
 from reports.plot_lobe3d import plot_lobe_3d
-from reports.plot_lobes import plane_directions, plot_lobe_planes
-from reports.plot_masking import plot_masking_lobes
+from reports.plot_lobes import draw_lobe_planes
+from reports.plot_masking import draw_masking_lobes
 from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)
 from reports.report.markup import Markup, html, join
@@ -41,41 +42,27 @@ def can_unmask(fab) -> bool:
     return True
 
 
-def _lobes_csv(p: Page) -> Markup:
-    """f_r (1/sr) per channel and luminance in every plane and incidence, as lobes.csv."""
-    theta_o = np.linspace(-90.0, 90.0, p.q["lobe"])
-    cols, header = [theta_o], ["theta_o_deg"]
-    for phi in PLANES:
-        for ti in LOBE_THETAS:
-            wi, wo = plane_directions(ti, theta_o, phi)
-            f = eval_brdf(p.fabric, wi, wo)
-            for k, c in enumerate("rgb"):
-                cols.append(f[:, k])
-                header.append(f"f_{c}_phi{phi:g}_ti{ti:g}")
-            cols.append(luminance(f))
-            header.append(f"f_Y_phi{phi:g}_ti{ti:g}")
-    return p.csv("lobes.csv", header, np.stack(cols, axis=1))
-
-
 def section_lobes(p: Page) -> Section:
-    """Polar lobes in the warp, diagonal and weft planes, linear, log and per channel."""
-    fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale="linear", normalize=True,
-                              resolution=p.q["lobe"])
+    """Polar lobes in the warp, diagonal and weft planes, linear, log and per channel, and
+    their numbers as lobes.csv: one :class:`analysis.views.LobeView` (each curve evaluated
+    once) that every figure draws and the CSV writes."""
+    view = compute_lobes(p.fabric, LOBE_THETAS, PLANES, resolution=p.q["lobe"])
+    fig, _ = draw_lobe_planes(view, scale="linear", normalize=True)
     out = [p.figure(fig, "lobes_linear.png",
                     "Luminance f_r, linear, each curve divided by its own peak (the peaks, in "
                     "1/sr, are in the legends) so that every incidence shows, in the planes "
                     "φ = 0° (warp), 45° and 90° (weft), for θi = 0°, 30°, 60°.")]
-    fig, _ = plot_lobe_planes(p.fabric, LOBE_THETAS, PLANES, scale="log",
-                              resolution=p.q["lobe"])
+    fig, _ = draw_lobe_planes(view, scale="log")
     out.append(p.figure(fig, "lobes_log.png",
                         "Luminance f_r (1/sr, log, four decades below the peak) in the same "
                         "planes and incidences."))
-    fig, _ = plot_lobe_planes(p.fabric, (30.0, 60.0), PLANES, quantity="rgb", scale="linear",
-                              resolution=p.q["lobe"])
+    fig, _ = draw_lobe_planes(view.select(theta_i_deg=(30.0, 60.0)), quantity="rgb",
+                              scale="linear")
     out.append(p.figure(fig, "lobes_rgb.png", "f_r per channel (red, green, blue curves), "
                         "linear, θi = 30° (solid) and 60° (dashed)."))
-    link = _lobes_csv(p)
-    return Section(join(out) + html("<p>Data (f_r in 1/sr, signed θo in degrees): {}</p>", link))
+    link = p.csv("lobes.csv", *view.columns())
+    return Section(join(out) + html("<p>Data (f_r in 1/sr, signed θo in degrees): {}</p>",
+                                    link))
 
 
 def section_slices(p: Page) -> Section:
@@ -96,15 +83,13 @@ def section_slices(p: Page) -> Section:
     return Section(join(out))
 
 
-def _colour_and_lobe3d(p: Page) -> Markup:
-    """The sRGB colour of f_r(wo) at θi = 45° beside the 3-D lobe."""
-    img = hemisphere_image(p.fabric, 45.0, 0.0, p.q["hemi"])
-    peak = float(np.nanmax(luminance(img))) if np.any(np.isfinite(img)) else 0.0
+def _colour_and_lobe3d(p: Page, view: HemisphereView) -> Markup:
+    """The sRGB colour of f_r(wo) at θi = 45° (``view``) beside the 3-D lobe."""
+    peak = view.peak()
     exposure = float(np.log2(0.7 / peak)) if peak > 0 else 0.0
     fig, axes = new_figure(2, 1, figsize=(10.0, 4.2))
     fig.get_layout_engine().set(w_pad=0.25)   # room the 3-D axes' layout leaves out
-    plot_hemisphere(p.fabric, 45.0, 0.0, quantity="srgb", exposure=exposure,
-                    resolution=p.q["hemi"], ax=axes[0],
+    draw_hemisphere(view, quantity="srgb", exposure=exposure, ax=axes[0],
                     title=f"f_r(wo) colour, sRGB, exposure {exposure:+.1f} stops")
     plot_lobe_3d(p.fabric, 45.0, 0.0, resolution=p.q["lobe3d"], ax=replace_3d(fig, axes[1]))
     return p.figure(fig, "lobe3d.png", "Left: the colour of f_r(wo) (θi = 45°, φi = 0), "
@@ -114,17 +99,19 @@ def _colour_and_lobe3d(p: Page) -> Markup:
 
 
 def section_hemisphere(p: Page) -> Section:
-    """f_r over the viewing hemisphere for three lights, its colour, and the 3-D lobe."""
+    """f_r over the viewing hemisphere for three lights, its colour, and the 3-D lobe; the
+    light at 45° along the warp evaluated once for its luminance and its colour."""
+    views = [compute_hemisphere(p.fabric, ti, phi, p.q["hemi"])
+             for ti, phi in ((45.0, 0.0), (45.0, 90.0), (60.0, 45.0))]
     fig, axes = new_figure(3, 1, figsize=(15.0, 4.2))
-    plot_hemisphere(p.fabric, 45.0, 0.0, resolution=p.q["hemi"], ax=axes[0])
-    plot_hemisphere(p.fabric, 45.0, 90.0, resolution=p.q["hemi"], ax=axes[1])
-    plot_hemisphere(p.fabric, 60.0, 45.0, resolution=p.q["hemi"], ax=axes[2])
+    for ax, view in zip(axes, views):
+        draw_hemisphere(view, ax=ax)
     out = [p.figure(fig, "hemisphere.png", "Luminance f_r(wo) (1/sr, log colour scale) over "
                     "the viewing hemisphere, equal-area projection (+x warp, +y weft), for the "
                     "light at θi = 45° along the warp, 45° along the weft, and 60° at φ = 45°; "
                     "black: more than four decades below the peak; grey: f_r = 0 (where the "
                     "colour bar says so).")]
-    out.append(_colour_and_lobe3d(p))
+    out.append(_colour_and_lobe3d(p, views[0]))
     return Section(join(out))
 
 
@@ -138,6 +125,7 @@ def section_masking(p: Page) -> Section:
     """
     if not can_unmask(p.fabric):
         raise Unavailable("this BRDF has no replace(masking=...)")
+    view = compute_masking_lobes(p.fabric, (60.0, 80.0), PLANES, resolution=p.q["lobe"])
     out = []
     for ti, scale, stem, caption in (
             (60.0, "log", "masking_lobes.png", "Luminance f_r (1/sr, log) at θi = 60° with "
@@ -147,8 +135,7 @@ def section_masking(p: Page) -> Section:
              "θi = 80°.")):
         fig, axes = new_figure(3, 1, figsize=(12.6, 3.1), polar=True)
         for ax, phi in zip(axes, PLANES):
-            plot_masking_lobes(p.fabric, ti, phi, resolution=p.q["lobe"], ax=ax, scale=scale,
-                               legend=False)
+            draw_masking_lobes(view, ti, phi, ax=ax, scale=scale, legend=False)
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=FONT["small"],
                    frameon=False)

@@ -8,7 +8,8 @@ from typing import Any
 import numpy as np
 
 from analysis import reciprocity
-from reports.plot_reciprocity import plot_reciprocity_map, reciprocity_map
+from analysis.views import compute_reciprocity
+from reports.plot_reciprocity import draw_reciprocity_map
 from reports.report.markup import Markup, fmt, html, join, plain_json, table
 from reports.report.page import Page, new_figure
 from reports.report.settings import Section
@@ -47,10 +48,11 @@ def _maps(p: Page) -> tuple[dict, Markup]:
     maps = {}
     fig, axes = new_figure(2, 1, figsize=(10.0, 4.0))
     for ax, (pi, po, label) in zip(axes, MAP_PLANES):
-        theta, err = reciprocity_map(p.fabric, pi, po, p.q["recip"])
-        maps[label] = {"phi_i_deg": pi, "phi_o_deg": po, "theta_deg": theta, "error": err,
-                       "median": float(np.median(err)), "max": float(np.max(err))}
-        plot_reciprocity_map(theta_deg=theta, error=err, phi_i_deg=pi, phi_o_deg=po, ax=ax)
+        view = compute_reciprocity(p.fabric, pi, po, p.q["recip"])
+        err = view.error
+        maps[label] = {"phi_i_deg": pi, "phi_o_deg": po, "theta_deg": view.theta_deg,
+                       "error": err, "median": float(np.median(err)), "max": float(np.max(err))}
+        draw_reciprocity_map(view, ax=ax)
     return maps, p.figure(fig, "reciprocity.png", "Relative reciprocity error of the luminance "
                           "|f(wi,wo) − f(wo,wi)| / max over θi × θo, light and viewer on "
                           "opposite sides of the warp plane (left) and the weft plane (right).")

@@ -10,14 +10,23 @@ and, where a missing or invalid value may stand (CSV and ALTA values, never angl
 ``nan``, ``inf``, ``+inf``, ``-inf`` in any case, as spreadsheets and microcyl's writers
 produce them. Spaces and tabs around the number are the caller's to strip (CSV fields are
 stripped; ALTA fields are split on white space).
+
+Writers print float64 numbers with a number of significant digits, and float32 data (an
+OpenEXR table's channels) with the fewest digits that read back to the same float32
+(:func:`float32_shortest`), all numbers of a column at once.
 """
 
 from __future__ import annotations
 
 import re
 
-__all__ = ["NUMBER_FORM", "parse_number", "is_number"]
+import numpy as np
 
+__all__ = ["NUMBER_FORM", "DIGITS", "parse_number", "is_number", "round_significant",
+           "float32_shortest", "column_digits", "format_numbers"]
+
+#: Significant digits printed of float64 data by default (9 also give any float32 back).
+DIGITS = 9
 #: The accepted form in words, for error messages.
 NUMBER_FORM = "decimal digits such as 30, -1.5 or 2.5e-3"
 
@@ -59,3 +68,126 @@ def is_number(text: str, *, nonfinite: bool = False) -> bool:
     except ValueError:
         return False
     return True
+
+
+def round_significant(x, digits: int) -> np.ndarray:
+    """``x`` rounded to ``digits`` significant decimal digits: the float nearest to that
+    decimal, so that ``"%.{digits}g"`` prints it exactly; NaN where no such float is sure
+    (non-finite ``x``, or a power of ten beyond 1e22, which floats do not hold exactly).
+
+    Examples
+    --------
+    >>> round_significant([15.0000004, -0.123456, 0.0, 1234.5], 3).tolist()
+    [15.0, -0.123, 0.0, 1230.0]
+    """
+    x = np.asarray(x, dtype=np.float64)
+    out = np.full(x.shape, np.nan)
+    out[x == 0] = 0.0
+    ok = np.isfinite(x) & (x != 0)
+    v = x[ok]
+    e = np.floor(np.log10(np.abs(v)))
+    e += np.abs(v) >= 10.0 ** (e + 1)          # log10 rounded across a power of ten
+    e -= np.abs(v) < 10.0 ** e
+    k = digits - 1 - e
+    exact = np.abs(k) <= 22                     # 10**k is a float exactly
+    scale = 10.0 ** np.abs(np.where(exact, k, 0))
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = np.where(k >= 0, np.round(v * scale) / scale, np.round(v / scale) * scale)
+    out[ok] = np.where(exact, r, np.nan)
+    return out
+
+
+def float32_shortest(x, stored, convert=None, *, max_digits: int = 9, slack: int = 0):
+    """The fewest significant digits that give back each float32 value ``stored``.
+
+    Parameters
+    ----------
+    x : array_like
+        The numbers to print (float64), e.g. a float32 value widened, or converted to other
+        units (an angle stored in radians, printed in degrees).
+    stored : array_like
+        The float32 values that the printed numbers must read back to, same shape.
+    convert : callable, optional
+        From a printed number to the stored units (``np.radians``); identity by default.
+    max_digits : int
+        The most digits tried (at most 15).
+    slack : int
+        Also require the converted number moved by ``slack`` float64 ulps either way to
+        round to ``stored`` (a reader's own rounding after the conversion).
+
+    Returns
+    -------
+    r : ndarray
+        Each number rounded to its digits (``"%.{p}g" % r`` prints the decimal); ``x`` where
+        none is found.
+    p : ndarray of int
+        The digits, 0 where no count up to ``max_digits`` gives ``stored`` back (and for
+        non-finite ``x``).
+
+    Examples
+    --------
+    >>> x32 = np.float32([0.1, 1 / 3, 15.0])
+    >>> r, p = float32_shortest(x32.astype(float), x32)
+    >>> ["%.*g" % (d, v) for d, v in zip(p.tolist(), r.tolist())]
+    ['0.1', '0.33333334', '15']
+    """
+    x = np.asarray(x, dtype=np.float64)
+    stored = np.asarray(stored, dtype=np.float32)
+    r, p = x.copy(), np.zeros(x.shape, dtype=np.int64)
+    todo = np.flatnonzero(np.isfinite(x))
+    for digits in range(1, min(int(max_digits), 15) + 1):
+        if not todo.size:
+            break
+        cand = round_significant(x.flat[todo], digits)
+        y = cand if convert is None else np.asarray(convert(cand), dtype=np.float64)
+        ok = np.isfinite(cand) & _rounds_to(y, stored.flat[todo], slack)
+        r.flat[todo[ok]] = cand[ok]
+        p.flat[todo[ok]] = digits
+        todo = todo[~ok]
+    return r, p
+
+
+def _rounds_to(y, stored, slack):
+    """Whether float64 ``y`` (and ``y`` moved ``slack`` ulps either way) round to ``stored``."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        same = y.astype(np.float32) == stored
+        if slack:
+            step = slack * np.spacing(np.abs(y))
+            same &= ((y - step).astype(np.float32) == stored) \
+                & ((y + step).astype(np.float32) == stored)
+    return same
+
+
+def column_digits(x, digits: int | None = None):
+    """(numbers, digits) to print a column with :func:`format_numbers`: ``digits`` when
+    given; else, when every finite number is a float32 (a float32 column widened), each
+    with the fewest digits that give its float32 back (:func:`float32_shortest`), and
+    otherwise :data:`DIGITS`.
+
+    Examples
+    --------
+    >>> format_numbers(*column_digits(np.float32([0.1, 0.25, np.nan]).astype(float)))
+    ['0.1', '0.25', 'nan']
+    >>> format_numbers(*column_digits(np.array([0.1, 1 / 3])))
+    ['0.1', '0.333333333']
+    """
+    x = np.asarray(x, dtype=np.float64)
+    finite = x[np.isfinite(x)]
+    if digits is not None or not np.array_equal(finite, finite.astype(np.float32)):
+        return x, digits or DIGITS
+    r, p = float32_shortest(x, x.astype(np.float32), max_digits=DIGITS)
+    return r, np.where(p > 0, p, DIGITS)
+
+
+def format_numbers(x, digits) -> list[str]:
+    """Each number of ``x`` printed with ``"%.{digits}g"`` (``digits`` one count or one per
+    number); ``nan``, ``inf`` and ``-inf`` as such.
+
+    Examples
+    --------
+    >>> format_numbers([15.0, 0.125, float("nan"), -float("inf")], [2, 3, 9, 9])
+    ['15', '0.125', 'nan', '-inf']
+    """
+    x = np.asarray(x, dtype=np.float64).ravel()
+    p = np.broadcast_to(np.asarray(digits, dtype=np.int64), x.shape)
+    return list(map("%.*g".__mod__, zip(p.tolist(), x.tolist())))

@@ -15,7 +15,7 @@ from gonio.atomic import atomic_write
 from gonio.errors import FormatError, TableWarning
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
-from gonio.numtext import (DIGITS, column_digits, float32_shortest, format_numbers, is_number,
+from gonio.numtext import (column_digits, float32_column, format_numbers, is_number,
                            parse_number)
 from gonio.table import Table
 
@@ -110,13 +110,13 @@ def _columns(table: Table) -> tuple[list[str], np.ndarray]:
 
 
 def _angle_text(a: np.ndarray, digits: int | None, azimuth: bool):
-    """(degrees, digits) to print an angle column given in radians: when every angle is a
-    float32 (to a few float64 ulps: directions made from float32 angles and back), the
-    fewest digits that read back to that float32 (an azimuth stored as +pi comes back as
-    -pi + 2e-7 from its direction, and is written as 180); else ``digits``."""
-    deg = np.degrees(a)
+    """(degrees, digits) to print an angle column given in radians: ``digits`` when given;
+    else float32 angles (to 16 float64 ulps: directions made from float32 angles and back)
+    with the fewest digits that read back to that float32, as
+    :func:`gonio.numtext.float32_column` has it. An azimuth stored as float32 pi (above pi)
+    comes back from its direction as -pi + 2e-7, and is written as 180."""
     if digits is not None:
-        return deg, digits
+        return np.degrees(a), digits
 
     def near32(v):
         return np.abs(v - v.astype(np.float32)) <= 16 * np.spacing(np.abs(v))
@@ -125,12 +125,7 @@ def _angle_text(a: np.ndarray, digits: int | None, azimuth: bool):
         turned = np.where(a < 0, a + 2 * np.pi, a - 2 * np.pi)
         turn = ~near & (np.abs(a) > 3) & near32(turned)
         a, near = np.where(turn, turned, a), near | turn
-    if not near.all():
-        return deg, DIGITS
-    stored = a.astype(np.float32)
-    r, p = float32_shortest(np.degrees(stored.astype(np.float64)), stored, np.radians,
-                            max_digits=DIGITS, slack=8)
-    return np.where(p > 0, r, deg), np.where(p > 0, p, DIGITS)
+    return float32_column(np.degrees(a), a.astype(np.float32), near, np.radians, slack=8)
 
 
 def _parse_value(text: str) -> float:

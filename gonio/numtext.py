@@ -23,7 +23,7 @@ import re
 import numpy as np
 
 __all__ = ["NUMBER_FORM", "DIGITS", "parse_number", "is_number", "round_significant",
-           "float32_shortest", "column_digits", "format_numbers"]
+           "float32_shortest", "float32_column", "column_digits", "format_numbers"]
 
 #: Significant digits printed of float64 data by default (9 also give any float32 back).
 DIGITS = 9
@@ -121,15 +121,17 @@ def float32_shortest(x, stored, convert=None, *, max_digits: int = 9, slack: int
         Each number rounded to its digits (``"%.{p}g" % r`` prints the decimal); ``x`` where
         none is found.
     p : ndarray of int
-        The digits, 0 where no count up to ``max_digits`` gives ``stored`` back (and for
+        The digits to print, ``"%.{p}g" % r``: the fewest significant ones, or as many as
+        the number has before its decimal point up to ``max_digits`` (``30``, not
+        ``3e+01``); 0 where no count up to ``max_digits`` gives ``stored`` back (and for
         non-finite ``x``).
 
     Examples
     --------
-    >>> x32 = np.float32([0.1, 1 / 3, 15.0])
+    >>> x32 = np.float32([0.1, 1 / 3, 15.0, 3000.0])
     >>> r, p = float32_shortest(x32.astype(float), x32)
     >>> ["%.*g" % (d, v) for d, v in zip(p.tolist(), r.tolist())]
-    ['0.1', '0.33333334', '15']
+    ['0.1', '0.33333334', '15', '3000']
     """
     x = np.asarray(x, dtype=np.float64)
     stored = np.asarray(stored, dtype=np.float32)
@@ -144,7 +146,10 @@ def float32_shortest(x, stored, convert=None, *, max_digits: int = 9, slack: int
         r.flat[todo[ok]] = cand[ok]
         p.flat[todo[ok]] = digits
         todo = todo[~ok]
-    return r, p
+    whole = np.zeros(x.shape, dtype=np.int64)       # digits before the decimal point
+    big = (p > 0) & (np.abs(r) >= 1)
+    whole[big] = np.floor(np.log10(np.abs(r[big]))).astype(np.int64) + 1
+    return r, np.where((whole > p) & (whole <= max_digits), whole, p)
 
 
 def _rounds_to(y, stored, slack):
@@ -160,9 +165,8 @@ def _rounds_to(y, stored, slack):
 
 def column_digits(x, digits: int | None = None):
     """(numbers, digits) to print a column with :func:`format_numbers`: ``digits`` when
-    given; else, when every finite number is a float32 (a float32 column widened), each
-    with the fewest digits that give its float32 back (:func:`float32_shortest`), and
-    otherwise :data:`DIGITS`.
+    given; else as :func:`float32_column` has it, the float32 values being those that are
+    floats32 exactly.
 
     Examples
     --------
@@ -172,11 +176,31 @@ def column_digits(x, digits: int | None = None):
     ['0.1', '0.333333333']
     """
     x = np.asarray(x, dtype=np.float64)
-    finite = x[np.isfinite(x)]
-    if digits is not None or not np.array_equal(finite, finite.astype(np.float32)):
-        return x, digits or DIGITS
-    r, p = float32_shortest(x, x.astype(np.float32), max_digits=DIGITS)
-    return r, np.where(p > 0, p, DIGITS)
+    if digits is not None:
+        return x, digits
+    with np.errstate(over="ignore"):
+        x32 = x.astype(np.float32)
+    return float32_column(x, x32, x32 == x)
+
+
+def float32_column(x, stored, is32, convert=None, *, slack: int = 0):
+    """(numbers, digits) to print a column of float64 numbers ``x``, of which those where
+    ``is32`` stand for the float32 values ``stored`` (through ``convert`` as in
+    :func:`float32_shortest`).
+
+    When at least half of the nonzero numbers are float32 (float32 data, as an OpenEXR
+    table's channels), each of those is printed with the fewest digits that give its
+    float32 back, and every other with :data:`DIGITS`; otherwise (float64 data, where a
+    float32 turns up by chance alone) all with :data:`DIGITS`.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    is32 = np.asarray(is32, dtype=bool)
+    nonzero = np.isfinite(x) & (x != 0)
+    if 2 * np.count_nonzero(is32 & nonzero) < np.count_nonzero(nonzero):
+        return x, DIGITS
+    r, p = float32_shortest(x, stored, convert, max_digits=DIGITS, slack=slack)
+    use = is32 & (p > 0)
+    return np.where(use, r, x), np.where(use, p, DIGITS)
 
 
 def format_numbers(x, digits) -> list[str]:

@@ -70,10 +70,11 @@ def is_number(text: str, *, nonfinite: bool = False) -> bool:
     return True
 
 
-def round_significant(x, digits: int) -> np.ndarray:
-    """``x`` rounded to ``digits`` significant decimal digits: the float nearest to that
-    decimal, so that ``"%.{digits}g"`` prints it exactly; NaN where no such float is sure
-    (non-finite ``x``, or a power of ten beyond 1e22, which floats do not hold exactly).
+def round_significant(x, digits) -> np.ndarray:
+    """``x`` rounded to ``digits`` significant decimal digits (one count, or one per number):
+    the float nearest to that decimal, so that ``"%.{digits}g"`` prints it exactly; NaN where
+    no such float is sure (non-finite ``x``, or a power of ten beyond 1e22, which floats do
+    not hold exactly).
 
     Examples
     --------
@@ -81,20 +82,28 @@ def round_significant(x, digits: int) -> np.ndarray:
     [15.0, -0.123, 0.0, 1230.0]
     """
     x = np.asarray(x, dtype=np.float64)
-    out = np.full(x.shape, np.nan)
-    out[x == 0] = 0.0
-    ok = np.isfinite(x) & (x != 0)
-    v = x[ok]
-    e = np.floor(np.log10(np.abs(v)))
-    e += np.abs(v) >= 10.0 ** (e + 1)          # log10 rounded across a power of ten
-    e -= np.abs(v) < 10.0 ** e
+    return _round(x, _exponent(x), digits)
+
+
+def _exponent(x: np.ndarray) -> np.ndarray:
+    """floor(log10(|x|)) exactly (log10 may round across a power of ten); 0 for 0."""
+    a = np.abs(x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e = np.floor(np.log10(np.where((a > 0) & np.isfinite(a), a, 1.0)))
+    e += a >= 10.0 ** (e + 1)
+    e -= a < 10.0 ** e
+    return np.where(a > 0, e, 0.0)
+
+
+def _round(x: np.ndarray, e: np.ndarray, digits) -> np.ndarray:
+    """``x`` (with exponents ``e``) rounded to ``digits`` significant digits, as
+    :func:`round_significant`."""
     k = digits - 1 - e
     exact = np.abs(k) <= 22                     # 10**k is a float exactly
     scale = 10.0 ** np.abs(np.where(exact, k, 0))
     with np.errstate(over="ignore", invalid="ignore"):
-        r = np.where(k >= 0, np.round(v * scale) / scale, np.round(v / scale) * scale)
-    out[ok] = np.where(exact, r, np.nan)
-    return out
+        r = np.where(k >= 0, np.round(x * scale) / scale, np.round(x / scale) * scale)
+    return np.where(exact & np.isfinite(x), r, np.nan)
 
 
 def float32_shortest(x, stored, convert=None, *, max_digits: int = 9, slack: int = 0):
@@ -126,6 +135,14 @@ def float32_shortest(x, stored, convert=None, *, max_digits: int = 9, slack: int
         ``3e+01``); 0 where no count up to ``max_digits`` gives ``stored`` back (and for
         non-finite ``x``).
 
+    Notes
+    -----
+    The count is found by bisection between 1 and ``max_digits`` (four vectorized passes
+    for 9), each count checked on the number printed: whatever the count, the printed
+    number gives ``stored`` back. Bisection assumes that a count that works makes every
+    larger one work, true but for rare numbers, which then get a digit or two more than
+    the fewest.
+
     Examples
     --------
     >>> x32 = np.float32([0.1, 1 / 3, 15.0, 3000.0])
@@ -135,20 +152,30 @@ def float32_shortest(x, stored, convert=None, *, max_digits: int = 9, slack: int
     """
     x = np.asarray(x, dtype=np.float64)
     stored = np.asarray(stored, dtype=np.float32)
+    top = min(int(max_digits), 15)
     r, p = x.copy(), np.zeros(x.shape, dtype=np.int64)
-    todo = np.flatnonzero(np.isfinite(x))
-    for digits in range(1, min(int(max_digits), 15) + 1):
-        if not todo.size:
-            break
-        cand = round_significant(x.flat[todo], digits)
+    idx = np.flatnonzero(np.isfinite(x))
+    v, s = x.ravel()[idx], stored.ravel()[idx]
+    e = _exponent(v)
+
+    def works(sel, digits):
+        cand = _round(v[sel], e[sel], digits)
         y = cand if convert is None else np.asarray(convert(cand), dtype=np.float64)
-        ok = np.isfinite(cand) & _rounds_to(y, stored.flat[todo], slack)
-        r.flat[todo[ok]] = cand[ok]
-        p.flat[todo[ok]] = digits
-        todo = todo[~ok]
-    whole = np.zeros(x.shape, dtype=np.int64)       # digits before the decimal point
-    big = (p > 0) & (np.abs(r) >= 1)
-    whole[big] = np.floor(np.log10(np.abs(r[big]))).astype(np.int64) + 1
+        return cand, np.isfinite(cand) & _rounds_to(y, s[sel], slack)
+
+    best, good = works(slice(None), top)
+    lo, hi = np.zeros(v.shape, dtype=np.int64), np.full(v.shape, top, dtype=np.int64)
+    while True:
+        sel = np.flatnonzero(good & (hi - lo > 1))
+        if not sel.size:
+            break
+        mid = (lo[sel] + hi[sel]) // 2
+        cand, ok = works(sel, mid)
+        hi[sel[ok]], best[sel[ok]] = mid[ok], cand[ok]
+        lo[sel[~ok]] = mid[~ok]
+    r.flat[idx[good]] = best[good]
+    p.flat[idx[good]] = hi[good]
+    whole = np.where(p > 0, _exponent(r) + 1, 0).astype(np.int64)   # digits before the point
     return r, np.where((whole > p) & (whole <= max_digits), whole, p)
 
 

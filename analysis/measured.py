@@ -49,7 +49,7 @@ from analysis.folderlock import output_lock
 from analysis.measuredjson import load_measured_json
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
-from gonio import atomic_write, plain
+from gonio import atomic_write, meta_text, plain
 from gonio.curet import read_curet
 from gonio.io import read
 from gonio.rgl import load_rgl
@@ -290,7 +290,7 @@ def _entry(n: str, table, row: dict, out: Path) -> dict:
     """The ``measured.json`` entry of dataset ``n`` from its batch row and results."""
     d = MEASURED[n]
     entry = {"title": d.title, "preset": d.preset,
-             "source": str(table.meta.get("source", "")), "pairs": len(table),
+             "source": meta_text(table.meta.get("source", "")), "pairs": len(table),
              "free": list(d.free), "ties": list(d.ties), "converged": False,
              "reason": row.get("error") or row.get("reason", ""),
              "steps": row.get("steps", 0), "wall_s": row.get("wall_s"),

@@ -7,10 +7,10 @@ Naming: ``read_*`` returns a :class:`Table`, ``load_*`` an evaluable BRDF (``eva
 from gonio.alta import read_alta, write_alta
 from gonio.atomic import atomic_write
 from gonio.progress import progress_bar
-from gonio.jsonplain import plain
+from gonio.jsonplain import json_line, meta_text, plain
 from gonio.csvtable import read_csv, write_csv
 from gonio.curet import load_curet, read_curet
-from gonio.errors import FormatError
+from gonio.errors import FormatError, TableWarning
 from gonio.exr import read_exr, write_exr
 from gonio.geometry import Geometry
 from gonio.layouts import full_grid, pairs, pairs_from_angles, plane, rusinkiewicz
@@ -24,10 +24,10 @@ from gonio.rgl import RGLBRDF, load_rgl
 from gonio.table import Table
 
 __all__ = [
-    "Table", "FormatError", "read", "write", "load_rgl", "load_merl", "read_curet",
+    "Table", "FormatError", "TableWarning", "read", "write", "load_rgl", "load_merl", "read_curet",
     "read_merl", "load_curet",
     "read_exr", "write_exr", "read_csv", "write_csv", "read_alta", "write_alta",
-    "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "progress_bar",
+    "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "json_line", "meta_text", "progress_bar",
     "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",
     "pairs", "pairs_from_angles", "from_spec",
 ]

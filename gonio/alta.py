@@ -22,6 +22,7 @@ from gonio.alta_params import DIMENSION, WRITABLE, from_params, phi_h, to_params
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing
+from gonio.jsonplain import json_line
 from gonio.numtext import parse_number
 from gonio.table import Table
 
@@ -247,8 +248,11 @@ def write_alta(table: Table, path, param: str | None = None, digits: int = 17) -
 
     Notes
     -----
-    With sigma, the header has ``#VS 2`` and each row ends with (sigma, sigma) per channel,
-    R G B: the distances below and above the value, as ALTA reads them since 2017.
+    The first line is the comment ``# source: JSON``, ``table.meta["source"]`` as JSON (a
+    text in quotes, the object of what was measured); :func:`read_alta` keeps it, as every
+    comment, in ``meta["comments"]``. With sigma, the header has ``#VS 2`` and each row
+    ends with (sigma, sigma) per channel, R G B: the distances below and above the value,
+    as ALTA reads them since 2017.
     """
     digits = validate.integer("digits", digits, lo=1)
     if not isinstance(table, Table):
@@ -273,7 +277,7 @@ def write_alta(table: Table, path, param: str | None = None, digits: int = 17) -
     body = np.concatenate(cols, axis=1)
     fmt = f"%.{digits}g"
     with atomic_write(path, "w") as f:
-        f.write("# " + " ".join(str(table.meta.get("source", "microcyl table")).split()) + "\n")
+        f.write(f"# source: {json_line(table.meta.get('source', 'microcyl table'))}\n")
         f.write(f"# {int((~keep).sum())} rows with a missing value or sigma left out\n")
         f.write(f"#DIM {DIMENSION[param]} 3\n#PARAM_IN {param}\n#PARAM_OUT RGB_COLOR\n")
         if table.sigma is not None:

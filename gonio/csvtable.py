@@ -5,20 +5,22 @@ from __future__ import annotations
 import dataclasses
 import json
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from brdf import validate
 from gonio.atomic import atomic_write
-from gonio.errors import FormatError
+from gonio.errors import FormatError, TableWarning
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
-from gonio.numtext import is_number, parse_number
+from gonio.numtext import (column_digits, float32_column, format_numbers, is_number,
+                           parse_number)
 from gonio.table import Table
 
-__all__ = ["read_csv", "write_csv", "read_rows", "parse_columns", "CsvRows", "ANGLES",
-           "ANGLE_RANGES"]
+__all__ = ["read_csv", "write_csv", "read_rows", "parse_columns", "delimiter", "CsvRows",
+           "looks_like_radians", "ANGLES", "ANGLE_RANGES", "DELIMITERS"]
 
 ANGLES = ("theta_i", "phi_i", "theta_o", "phi_o")
 #: Accepted angles in degrees: theta is a polar angle (beyond 90 below the horizon, where
@@ -27,17 +29,24 @@ ANGLE_RANGES = {"theta": (0.0, 180.0), "phi": (-360.0, 360.0)}
 _KEY = re.compile(r"^([A-Za-z_][\w.\-]*)\s*:\s?(.*)$")
 _VALUE_SETS = (("r", "g", "b"), ("value",))
 _SIGMA_SETS = (("sigma_r", "sigma_g", "sigma_b"), ("sigma",))
+#: The delimiters of a CSV file (found in its header line), and their names in messages.
+DELIMITERS = {",": "comma", ";": "semicolon", "\t": "tab"}
+_WRITE_ROWS = 65536     # rows formatted at a time (their strings held in memory)
 
 
-def write_csv(table: Table, path, digits: int = 9) -> None:
+def write_csv(table: Table, path, digits: int | None = None) -> None:
     """Write a table as CSV (atomically).
 
     Parameters
     ----------
     table : Table
     path : str or os.PathLike
-    digits : int
-        Significant digits printed for every number (angles in degrees, f_r in 1/sr).
+    digits : int, optional
+        Significant digits printed for every number (angles in degrees, f_r in 1/sr). By
+        default 9, except for float32 data: a column whose every value is a float32 (an
+        OpenEXR table's channels; for angles, radians within a few float64 ulps of a
+        float32) is written with the fewest digits that read back to the same float32
+        (``15``, not ``15.0000004``; :func:`gonio.numtext.float32_shortest`).
 
     Raises
     ------
@@ -59,26 +68,18 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
     >>> print(p.read_text().splitlines()[-2:])
     ['theta_i,phi_i,theta_o,phi_o,value', '0,0,36.8698976,0,0.25']
     """
-    digits = validate.integer("digits", digits, lo=1)
+    if digits is not None:
+        digits = validate.integer("digits", digits, lo=1)
     if not isinstance(table, Table):
         raise TypeError(f"write_csv: table must be a gonio.Table; got {type(table).__name__}")
     if len(table) == 0:
         raise ValueError("write_csv: table is empty (0 rows); a CSV table holds at least one "
                          "row, as read_csv requires")
-    fmt = f"%.{digits}g"
-    grey = bool(np.array_equal(table.values[:, 0], table.values[:, 1], equal_nan=True)
-                and np.array_equal(table.values[:, 0], table.values[:, 2], equal_nan=True)
-                and (table.sigma is None
-                     or (np.array_equal(table.sigma[:, 0], table.sigma[:, 1], equal_nan=True)
-                         and np.array_equal(table.sigma[:, 0], table.sigma[:, 2],
-                                            equal_nan=True))))
-    cols = list(ANGLES) + (["value"] if grey else ["r", "g", "b"])
-    data = [np.degrees(table.angles)]
-    data.append(table.values[:, :1] if grey else table.values)
-    if table.sigma is not None:
-        cols += ["sigma"] if grey else ["sigma_r", "sigma_g", "sigma_b"]
-        data.append(table.sigma[:, :1] if grey else table.sigma)
-    data = np.concatenate(data, axis=1)
+    cols, data = _columns(table)
+    angles = table.angles
+    fields = [_angle_text(angles[:, k], digits, name.startswith("phi"))
+              for k, name in enumerate(ANGLES)]
+    fields += [column_digits(data[:, k], digits) for k in range(data.shape[1])]
     with atomic_write(path, "w") as f:
         f.write("# microcyl BRDF table. Angles in degrees, f_r in 1/sr, "
                 "comment lines start with #\n")
@@ -86,10 +87,45 @@ def write_csv(table: Table, path, digits: int = 9) -> None:
             if _KEY.match(f"{key}: x"):
                 f.write(f"# {key}: {json.dumps(plain(value))}\n")
         f.write(",".join(cols) + "\n")
-        for row in data:
-            f.write(",".join(fmt % x if np.isfinite(x) else ("nan" if np.isnan(x) else
-                                                              ("inf" if x > 0 else "-inf"))
-                             for x in row) + "\n")
+        for a in range(0, len(table), _WRITE_ROWS):
+            rows = zip(*(format_numbers(x[a:a + _WRITE_ROWS],
+                                        p[a:a + _WRITE_ROWS] if np.ndim(p) else p)
+                         for x, p in fields))
+            f.write("\n".join(map(",".join, rows)) + "\n")
+
+
+def _columns(table: Table) -> tuple[list[str], np.ndarray]:
+    """The column names (angles first) and the (n, 1..6) values and sigma to write: one
+    ``value`` (and ``sigma``) column for a grey table, else r, g, b (and sigma_r, ...)."""
+    def same(a):
+        return bool(np.array_equal(a[:, 0], a[:, 1], equal_nan=True)
+                    and np.array_equal(a[:, 0], a[:, 2], equal_nan=True))
+    grey = same(table.values) and (table.sigma is None or same(table.sigma))
+    cols = list(ANGLES) + (["value"] if grey else ["r", "g", "b"])
+    data = [table.values[:, :1] if grey else table.values]
+    if table.sigma is not None:
+        cols += ["sigma"] if grey else ["sigma_r", "sigma_g", "sigma_b"]
+        data.append(table.sigma[:, :1] if grey else table.sigma)
+    return cols, np.concatenate(data, axis=1)
+
+
+def _angle_text(a: np.ndarray, digits: int | None, azimuth: bool):
+    """(degrees, digits) to print an angle column given in radians: ``digits`` when given;
+    else float32 angles (to 16 float64 ulps: directions made from float32 angles and back)
+    with the fewest digits that read back to that float32, as
+    :func:`gonio.numtext.float32_column` has it. An azimuth stored as float32 pi (above pi)
+    comes back from its direction as -pi + 2e-7, and is written as 180."""
+    if digits is not None:
+        return np.degrees(a), digits
+
+    def near32(v):
+        return np.abs(v - v.astype(np.float32)) <= 16 * np.spacing(np.abs(v))
+    near = near32(a)
+    if azimuth:
+        turned = np.where(a < 0, a + 2 * np.pi, a - 2 * np.pi)
+        turn = ~near & (np.abs(a) > 3) & near32(turned)
+        a, near = np.where(turn, turned, a), near | turn
+    return float32_column(np.degrees(a), a.astype(np.float32), near, np.radians, slack=8)
 
 
 def _parse_value(text: str) -> float:
@@ -106,7 +142,7 @@ class CsvRows:
     meta : dict
         The ``# key: value`` comments (JSON values decoded when they parse).
     header : list of str or None
-        The first non-comment row (column names), None if there is none.
+        The first non-comment row (column names, in lower case), None if there is none.
     header_line : int
         Its line number (0 without a header).
     rows : list of (int, list of str)
@@ -123,13 +159,16 @@ def read_rows(path) -> CsvRows:
     r"""Split a CSV file into comments, header and data rows (the layer under :func:`read_csv`
     and the ``pairs:FILE.csv`` geometry reader).
 
+    The columns are separated by commas, semicolons or tabs, whichever the header line holds
+    (:func:`delimiter`); column names are read in any case (``R,G,B`` is ``r,g,b``).
+
     Raises
     ------
     OSError
         The file cannot be read.
     FormatError
-        Not UTF-8 text, or a data row with another number of fields than the header (its
-        line number is given).
+        Not UTF-8 text, a header without a known delimiter, or a data row with another
+        number of fields than the header (its line number is given).
 
     Examples
     --------
@@ -146,7 +185,7 @@ def read_rows(path) -> CsvRows:
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}
-    header, header_line, rows = None, 0, []
+    header, header_line, rows, sep = None, 0, [], ","
     for lineno, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped:
@@ -163,15 +202,58 @@ def read_rows(path) -> CsvRows:
                     raise FormatError(path, f"line {lineno}: metadata {key!r} is nested too "
                                             f"deeply") from None
             continue
-        fields = [c.strip() for c in stripped.split(",")]
         if header is None:
-            header, header_line = fields, lineno
+            sep = delimiter(path, lineno, stripped)
+            header, header_line = [c.strip().lower() for c in stripped.split(sep)], lineno
             continue
+        fields = [c.strip() for c in stripped.split(sep)]
         if len(fields) != len(header):
             raise FormatError(path, f"line {lineno}: expected {len(header)} columns "
-                                    f"({','.join(header)}), got {len(fields)}")
+                                    f"({','.join(header)}), got {len(fields)}"
+                                    + _other_delimiter(stripped, sep))
         rows.append((lineno, fields))
     return CsvRows(meta, header, header_line, rows)
+
+
+def delimiter(path, lineno: int, header: str) -> str:
+    """The delimiter of a CSV file, from its header line: the one of comma, semicolon and
+    tab that it holds (comma for a header of one name).
+
+    Raises
+    ------
+    FormatError
+        A header holding two of them, or none but another separator (a space, ``|``),
+        naming what was found.
+
+    Examples
+    --------
+    >>> delimiter("t.csv", 1, "theta_i;phi_i;theta_o;phi_o;value")
+    ';'
+    >>> delimiter("t.csv", 1, "theta_i|phi_i|theta_o|phi_o|value")
+    Traceback (most recent call last):
+    ...
+    gonio.errors.FormatError: t.csv: line 1: found '|' between the column names; expected \
+comma, semicolon or tab
+    """
+    found = [d for d in DELIMITERS if d in header]
+    if len(found) == 1:
+        return found[0]
+    if found:
+        raise FormatError(path, f"line {lineno}: the header holds both "
+                                + " and ".join(DELIMITERS[d] for d in found)
+                                + "; separate the columns by one of them")
+    other = re.search(r"[^\w.\-]+", header)
+    if other:
+        raise FormatError(path, f"line {lineno}: found {other.group()!r} between the column "
+                                "names; expected comma, semicolon or tab")
+    return ","
+
+
+def _other_delimiter(row: str, sep: str) -> str:
+    """A note for a row split into the wrong number of fields that holds another delimiter."""
+    other = [DELIMITERS[d] for d in DELIMITERS if d != sep and d in row]
+    return (f"; the header is split on {DELIMITERS[sep]}s, this row holds "
+            f"{' and '.join(other)}s" if other else "")
 
 
 def read_csv(path) -> Table:
@@ -229,6 +311,12 @@ def parse_columns(path, header, rows, columns=None) -> np.ndarray:
     ------
     FormatError
         Naming the file, the line and the column of the first bad field.
+
+    Warns
+    -----
+    TableWarning
+        When ``columns`` hold the four angles and every one of them lies within the range
+        it would have in radians, not all zero (:func:`looks_like_radians`).
     """
     columns = list(header if columns is None else columns)
     idx = [header.index(c) for c in columns]
@@ -242,8 +330,10 @@ def parse_columns(path, header, rows, columns=None) -> np.ndarray:
             except ValueError as exc:
                 if angle and is_number(x, nonfinite=True):
                     exc = f"angles must be finite numbers; got {x!r}"
-                raise FormatError(path, f"line {lineno}: {exc}, in column {columns[j]}") \
-                    from None
+                hint = (f"; a decimal comma? write {x.replace(',', '.')}"
+                        if re.fullmatch(r"[+-]?[0-9]+,[0-9]+", x) else "")
+                raise FormatError(path, f"line {lineno}: {exc}, in column {columns[j]}"
+                                        + hint) from None
     for j, name in enumerate(columns):
         if not is_angle[j]:
             continue
@@ -253,7 +343,35 @@ def parse_columns(path, header, rows, columns=None) -> np.ndarray:
             lineno, fields = rows[int(np.argmax(bad))]
             raise FormatError(path, f"line {lineno}: {name} = {fields[idx[j]]} is outside "
                                     f"[{lo:g}, {hi:g}] degrees")
+    if all(a in columns for a in ANGLES) and looks_like_radians(
+            out[:, [columns.index(a) for a in ANGLES]]):
+        warnings.warn(f"{path}: every angle is within the range of radians (theta at most "
+                      "pi, |phi| at most 2 pi); angles are read in degrees: were radians "
+                      "written?", TableWarning, stacklevel=2)
     return out
+
+
+def looks_like_radians(angles) -> bool:
+    """Whether (n, 4) angles theta_i, phi_i, theta_o, phi_o, read as degrees, look like
+    radians: every theta at most pi and every phi at most 2 pi in magnitude (1e-3 over for
+    rounding: ``3.1416``), and not all zero.
+
+    This holds for every table written in radians, including those whose azimuths run to
+    pi or 2 pi (a table with every angle at most pi/2 is the first of them), and for no
+    table of degrees that a gonioreflectometer measures: every direction within 3.2 deg of
+    the normal, within 6.3 deg of the warp.
+
+    Examples
+    --------
+    >>> looks_like_radians([[0.5236, 0, 0.5236, 3.1416]]), looks_like_radians([[30, 0, 30, 180]])
+    (True, False)
+    >>> looks_like_radians([[0, 0, 0, 0]])
+    False
+    """
+    a = np.abs(np.asarray(angles, dtype=np.float64))
+    if not a.size or not a.any():
+        return False
+    return bool(np.all(a[:, 0::2] <= np.pi + 1e-3) and np.all(a[:, 1::2] <= 2 * np.pi + 1e-3))
 
 
 def _check_header(path, lineno, header):

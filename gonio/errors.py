@@ -1,10 +1,10 @@
-"""Errors raised by the gonio readers."""
+"""Errors raised by the gonio readers, and the warning of a table that reads but looks wrong."""
 
 from __future__ import annotations
 
 import os
 
-__all__ = ["FormatError"]
+__all__ = ["FormatError", "TableWarning"]
 
 
 class FormatError(ValueError):
@@ -34,3 +34,11 @@ class FormatError(ValueError):
         self.path = os.fspath(path)
         self.problem = problem
         super().__init__(f"{self.path}: {problem}")
+
+
+class TableWarning(UserWarning):
+    """A table that reads but looks wrong (angles in radians where degrees are meant).
+
+    The message names the file and what looks wrong, on one line; ``microcyl`` prints it as
+    ``microcyl VERB: warning: MESSAGE``.
+    """

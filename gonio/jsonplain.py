@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import os
 
 import numpy as np
 
-__all__ = ["plain"]
+__all__ = ["plain", "json_line", "meta_text"]
 
 
 def plain(value, *, nonfinite: str = "keep", _depth: int = 0):
@@ -56,3 +57,31 @@ def plain(value, *, nonfinite: str = "keep", _depth: int = 0):
     if isinstance(value, os.PathLike):
         return os.fspath(value)
     return str(value)
+
+
+def json_line(value) -> str:
+    """``value`` as strict JSON on one line (NaN and infinities as null).
+
+    Examples
+    --------
+    >>> print(json_line({"name": "velvet", "snr": np.float64("nan"), "t": (1, 2)}))
+    {"name": "velvet", "snr": null, "t": [1, 2]}
+    """
+    return json.dumps(plain(value, nonfinite="null"), allow_nan=False)
+
+
+def meta_text(value) -> str:
+    """A table's metadata value as one line to print: a one-line text as it is, anything
+    else (a dict, a list, a number, a text with line breaks) as :func:`json_line`, never a
+    Python repr.
+
+    Examples
+    --------
+    >>> print(meta_text("MERL alum-bronze.binary"))
+    MERL alum-bronze.binary
+    >>> print(meta_text({"type": "Fabric", "name": "linen_plain"}))
+    {"type": "Fabric", "name": "linen_plain"}
+    """
+    if isinstance(value, str) and value.isprintable():
+        return value
+    return json_line(value)

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import OpenEXR
 
+from gonio.csvtable import DELIMITERS
 from gonio.memory import check_memory
 from gonio.merl import FILE_SIZE as MERL_FILE_SIZE
 from gonio.merl import SHAPE as MERL_SHAPE
@@ -69,18 +70,27 @@ def _lines_and_fields(path: Path, sep: str | None) -> tuple[int, int]:
             for line in complete:
                 s = line.strip().removeprefix(b"\xef\xbb\xbf").strip()
                 if s and not s.startswith(b"#"):
-                    fields = len(s.decode("utf-8", "replace").split(sep))
+                    fields = _fields(s.decode("utf-8", "replace"), sep)
                     break
     if pending.strip() and not fields:
-        fields = len(pending.decode("utf-8", "replace").split(sep))
+        fields = _fields(pending.decode("utf-8", "replace"), sep)
     if last not in (b"", b"\n"):
         lines += 1                  # a last line without its line end
     return lines, max(fields, 1)
 
 
-def text_estimate(path, sep: str | None = ",") -> Estimate:
+def _fields(line: str, sep) -> int:
+    """Fields of a line split on ``sep`` (None: white space; a tuple: the one of its
+    delimiters that gives the most)."""
+    if isinstance(sep, tuple):
+        return max(len(line.split(d)) for d in sep)
+    return len(line.split(sep))
+
+
+def text_estimate(path, sep: str | tuple | None = ",") -> Estimate:
     """The size of a text table: lines counted, fields from the first data or header line
-    split on ``sep`` (None: white space).
+    split on ``sep`` (None: white space; a tuple of delimiters: the one that gives the
+    most, as a CSV file's header says which it uses).
 
     Examples
     --------
@@ -161,7 +171,7 @@ def estimate_table(path, kind: str, **options) -> Estimate | None:
 
 def _estimate(path: Path, kind: str, **options) -> Estimate | None:
     if kind in ("csv", "alta"):
-        return text_estimate(path, "," if kind == "csv" else None)
+        return text_estimate(path, tuple(DELIMITERS) if kind == "csv" else None)
     if kind == "exr":
         return _exr_estimate(path)
     if kind == "merl":

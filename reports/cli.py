@@ -15,6 +15,9 @@ import importlib.metadata
 import logging
 import os
 import sys
+import warnings
+
+from gonio.errors import TableWarning
 
 __all__ = ["main", "build_parser", "COMMAND_MODULES"]
 
@@ -80,6 +83,24 @@ def _configure_logging(args) -> None:
                  else logging.WARNING if getattr(args, "log_quiet", False) else logging.INFO)
 
 
+def _run(args):
+    """``args.func(args)``, each table's warning (:class:`gonio.TableWarning`: radians where
+    degrees are meant) printed as one line ``microcyl VERB: warning: MESSAGE`` through the
+    ``microcyl`` logger (shown with -q too); other warnings as Python shows them."""
+    log = logging.getLogger("microcyl")
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if not issubclass(category, TableWarning):
+                return shown(message, category, filename, lineno, file, line)
+            text = " ".join(str(message).split())
+            log.warning(f"microcyl {args.command}: warning: {text}")
+
+        warnings.showwarning = show
+        return args.func(args)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit status.
 
@@ -98,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     _configure_logging(args)
     try:
-        status = args.func(args)
+        status = _run(args)
         sys.stdout.flush()                # a closed pipe surfaces here, not at exit
     except BrokenPipeError:               # `microcyl fabrics | head`: the reader left
         devnull = os.open(os.devnull, os.O_WRONLY)

@@ -62,8 +62,10 @@ def run_convert(args):
 
 
 def table_facts(table) -> dict:
-    """What a table holds, as plain data (``microcyl info --json``): angles in degrees over
-    the rows with data, value ranges per channel (f_r in the table's units), missing counts."""
+    """What a table holds, as plain data (``microcyl info --json``): its source as the
+    table's metadata has it (a text, or the JSON object of what was measured), angles in
+    degrees over the rows with data, value ranges per channel (f_r in the table's units),
+    missing counts."""
     ang = np.degrees(table.angles)
     valid = table.valid
     data = valid.any(axis=1)          # a MERL file lists its empty bins below the horizon too
@@ -73,7 +75,7 @@ def table_facts(table) -> dict:
         v = table.values[valid[:, c], c]
         values[name] = [float(v.min()), float(v.max())] if v.size else None
     return {
-        "source": str(table.meta.get("source", "unknown")),
+        "source": gonio.plain(table.meta.get("source", "unknown"), nonfinite="null"),
         "format": str(table.meta.get("file_format", "unknown")),
         "rows": len(table), "units": str(table.meta.get("units", "1/sr")),
         "angles_deg": {name: [float(sel[:, k].min()), float(sel[:, k].max())]
@@ -94,7 +96,8 @@ def describe(table) -> str:
     """A few lines on what a table holds (used by ``microcyl info``)."""
     f = table_facts(table)
     note = "" if f["angles_over"] == "all rows" else " (rows with data)"
-    lines = [f"source: {f['source']}", f"format: {f['format']}", f"rows: {f['rows']}",
+    lines = [f"source: {gonio.meta_text(f['source'])}", f"format: {f['format']}",
+             f"rows: {f['rows']}",
              f"units: {f['units']}"]
     lines += [f"{k}: {lo:.4g} .. {hi:.4g} deg{note}" for k, (lo, hi) in f["angles_deg"].items()]
     lines += [f"{k}: " + ("none valid" if r is None else f"{r[0]:.6g} .. {r[1]:.6g}")

@@ -216,6 +216,15 @@ def test_text_estimate_counts_lines_and_fields(tmp_path):
     assert text_estimate(tmp_path / "e.csv").rows == 0
 
 
+@pytest.mark.parametrize("sep", [",", ";", "\t"])
+def test_csv_fields_are_counted_on_the_delimiter_of_the_header(tmp_path, sep):
+    """A semicolon or tab file's fields counted as the reader splits them (a semicolon file
+    was one field a line)."""
+    p = tmp_path / "t.csv"
+    p.write_text(_csv(tmp_path / "t.csv", 3).read_text().replace(",", sep))
+    assert estimate_table(p, "csv").basis == "5 lines of 5 fields"
+
+
 def test_a_million_rows_are_counted_in_well_under_a_second(tmp_path):
     p = _csv(tmp_path / "big.csv", 1_000_000)
     t0 = time.perf_counter()

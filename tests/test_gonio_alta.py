@@ -1,5 +1,7 @@
 """ALTA 1-D slices: the MERL pink-felt back-scatter slice, round trip, bad files."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -250,6 +252,24 @@ def test_strict_numbers_and_coordinate_ranges(tmp_path, text, pattern):
     with pytest.raises(gonio.FormatError, match="bad.alta: " + pattern):
         gonio.read_alta(p)
 
+
+
+def test_header_source_is_json_and_old_headers_still_read(tmp_path):
+    """The source comes first as ``# source: JSON`` (it was the Python repr of a measured
+    table's dict, ``# {'type': ...}``); files with the old first line still read."""
+    source = {"type": "Fabric", "name": "linen_plain", "note": "it's \"quoted\"",
+              "snr": float("nan")}
+    t = gonio.Table([[0, 0, 1.0], [0.6, 0, 0.8]], [[0.6, 0, 0.8]] * 2,
+                    [[0.1, 0.2, 0.1], [0.2, 0.3, 0.4]], meta={"source": source})
+    gonio.write(t, tmp_path / "t.alta")
+    first = (tmp_path / "t.alta").read_text().splitlines()[0]
+    assert first.startswith("# source: {")
+    assert json.loads(first.removeprefix("# source: ")) == dict(source, snr=None)
+    back = gonio.read(tmp_path / "t.alta")
+    assert back.meta["comments"][0] == first[2:] and len(back) == 2
+    old = tmp_path / "old.alta"
+    old.write_text("# {'type': 'Fabric', 'name': 'velvet'}\n" + SPH + "0.5 0 0.5 3 0.1 0.2 0.3\n")
+    assert gonio.read(old).meta["comments"][0] == "{'type': 'Fabric', 'name': 'velvet'}"
 
 def test_values_may_be_nan_or_inf_and_byte_order_mark(tmp_path):
     p = tmp_path / "t.alta"

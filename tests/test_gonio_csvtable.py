@@ -1,9 +1,13 @@
-"""CSV tables: round trip to printed precision, grey files, bad rows with line numbers."""
+"""CSV tables: round trip to printed precision, grey files, bad rows with line numbers, names
+in any case, delimiters, radians mistaken for degrees, float32 data."""
+
+import warnings
 
 import numpy as np
 import pytest
 
 import gonio
+from gonio.exr import from_angles
 from tests._gonio_helpers import random_table
 
 
@@ -116,6 +120,164 @@ def test_byte_order_mark_is_read(tmp_path):
         t = gonio.read_csv(p)
         assert len(t) == 1 and t.values[0].tolist() == [1, 2, 3]
     assert t.meta["source"] == "sheet"
+
+
+# Tables as people write them (issue 27): names in any case, semicolons and tabs, radians
+# mistaken for degrees, float32 data written with the digits it holds.
+
+RGB = "theta_i,phi_i,theta_o,phi_o,r,g,b,sigma_r,sigma_g,sigma_b"
+GREY = "theta_i,phi_i,theta_o,phi_o,value,sigma"
+ROWS = {RGB: ["30,0,45,180,0.1,0.2,0.3,0.01,0.02,0.03", "60,90,20,-90,0.4,0.5,0.6,0.04,0.05,0.06"],
+        GREY: ["30,0,45,180,0.1,0.01", "60,90,20,-90,0.4,0.04"]}
+
+
+def _check_hand_table(t, grey=False):
+    """The two rows of ROWS, read: angles in degrees, values and sigma as written."""
+    np.testing.assert_allclose(np.degrees(t.angles), [[30, 0, 45, 180], [60, 90, 20, -90]],
+                               atol=1e-9)
+    values = [[0.1] * 3, [0.4] * 3] if grey else [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]]
+    np.testing.assert_allclose(t.values, values, rtol=1e-15)
+    np.testing.assert_allclose(t.sigma, np.asarray(values) / 10, rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", RGB.split(",") + ["value", "sigma"])
+@pytest.mark.parametrize("case", [str.upper, str.title])
+def test_every_column_name_is_read_in_any_case(tmp_path, name, case):
+    """``R,G,B`` is ``r,g,b``: each name the reader knows, in upper and title case."""
+    header = GREY if name in ("value", "sigma") else RGB
+    names = [case(c) if c == name else c for c in header.split(",")]
+    assert case(name) != name
+    p = tmp_path / "t.csv"
+    p.write_text(",".join(names) + "\n" + "\n".join(ROWS[header]) + "\n")
+    _check_hand_table(gonio.read(p), grey=header == GREY)
+
+
+@pytest.mark.parametrize("sep", [";", "\t", ", "])
+def test_semicolon_and_tab_delimiters_are_found_in_the_header(tmp_path, sep):
+    p = tmp_path / "t.csv"
+    p.write_text("# source: \"sheet\"\n" + "\n".join([RGB.upper()] + ROWS[RGB]).replace(",", sep)
+                 + "\n")
+    t = gonio.read(p)
+    _check_hand_table(t)
+    assert t.meta["source"] == "sheet"
+
+
+@pytest.mark.parametrize("text, pattern", [
+    ("theta_i|phi_i|theta_o|phi_o|value\n30|0|30|0|0.1\n",
+     r"line 1: found '\|' between the column names; expected comma, semicolon or tab"),
+    ("# c\ntheta_i phi_i theta_o phi_o value\n30 0 30 0 0.1\n",
+     r"line 2: found ' ' between the column names; expected comma, semicolon or tab"),
+    ("theta_i,phi_i;theta_o,phi_o,value\n30,0,30,0,0.1\n",
+     r"line 1: the header holds both comma and semicolon"),
+    ("theta_i;phi_i;theta_o;phi_o;value\n30;0;30;0;0.1\n30,0,30,0,0.1\n",
+     r"line 3: expected 5 columns .*got 1; the header is split on semicolons, this row "
+     r"holds commas"),
+    ("theta_i;phi_i;theta_o;phi_o;value\n30;0;30;0;0,1\n",
+     r"line 2: '0,1' is not a number .*, in column value; a decimal comma\? write 0.1"),
+])
+def test_an_unknown_delimiter_is_named(tmp_path, text, pattern):
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(gonio.FormatError, match="bad.csv: " + pattern):
+        gonio.read(p)
+
+
+RADIANS = ("theta_i,phi_i,theta_o,phi_o,value\n0.5236,0,0.7854,3.1416,0.1\n"
+           "1.0472,1.5708,0.3491,-1.5708,0.2\n")
+
+
+def test_angles_in_radians_are_read_as_degrees_with_a_warning(tmp_path):
+    """Every theta at most pi and every phi at most 2 pi: radians, most likely. The table is
+    still read in degrees (the warning changes no number); a pairs file warns the same."""
+    p = tmp_path / "rad.csv"
+    p.write_text(RADIANS)
+    with pytest.warns(gonio.TableWarning, match=r"rad\.csv: every angle is within the range "
+                                                r"of radians.*read in degrees"):
+        t = gonio.read(p)
+    np.testing.assert_allclose(np.degrees(t.angles[0]), [0.5236, 0, 0.7854, 3.1416], atol=1e-9)
+    with pytest.warns(gonio.TableWarning, match=r"rad\.csv"):
+        gonio.from_spec(f"pairs:{p}")
+
+
+@pytest.mark.parametrize("rows", [
+    "30,0,45,180,0.1",                     # degrees
+    "3,0,3,180,0.1",                       # near the normal, but an azimuth of 180
+    "0,0,0,0,0.1",                         # all zero: the same in any unit
+    "1.5,0,3.2,0,0.1",                     # theta_o above pi
+    "1.5,0,1.5,6.3,0.1",                   # phi_o above 2 pi
+])
+def test_tables_in_degrees_do_not_warn(tmp_path, rows):
+    p = tmp_path / "deg.csv"
+    p.write_text("theta_i,phi_i,theta_o,phi_o,value\n" + rows + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gonio.TableWarning)
+        gonio.read(p)
+
+
+def _exr_table(tmp_path, deg, values, sigma=None):
+    """A table of angles (degrees) and values written to OpenEXR (float32) and read back."""
+    a = np.radians(np.asarray(deg, dtype=np.float64))
+    t = gonio.Table(from_angles(a[:, 0], a[:, 1]), from_angles(a[:, 2], a[:, 3]), values,
+                    sigma, {"source": "float32"})
+    gonio.write(t, tmp_path / "t.exr")
+    return gonio.read(tmp_path / "t.exr")
+
+
+def _angles32(t):
+    """A table's angles as float32, an azimuth of float32 pi (above pi, so made -pi + 2e-7
+    by its direction) turned back to +pi."""
+    a = t.angles
+    a[:, 1::2] = np.where(a[:, 1::2] < -np.pi + 1e-6, a[:, 1::2] + 2 * np.pi, a[:, 1::2])
+    return a.astype(np.float32)
+
+
+def test_float32_data_is_written_with_the_digits_it_holds(tmp_path):
+    """EXR -> CSV: ``15``, not ``15.0000004`` (float32 widened and printed to 9 digits), and
+    the CSV read back gives the same float32 angles and values."""
+    deg = [[15, 0, 30, 180], [45, 90, 60, -90], [0, 0, 75, 135], [10, -45, 20.5, 10]]
+    values = [[0.1, 0.2, 0.3], [1.5, 0.7, 1e-5], [3.3, 2, 1], [0.25, 0.125, 1e3]]
+    exr = _exr_table(tmp_path, deg, values)
+    gonio.write(exr, tmp_path / "t.csv")
+    rows = [ln for ln in (tmp_path / "t.csv").read_text().splitlines()
+            if not ln.startswith("#")]
+    assert rows == ["theta_i,phi_i,theta_o,phi_o,r,g,b", "15,0,30,180,0.1,0.2,0.3",
+                    "45,90,60,-90,1.5,0.7,1e-05", "0,0,75,135,3.3,2,1",
+                    "10,-45,20.5,10,0.25,0.125,1000"]
+    back = gonio.read(tmp_path / "t.csv")
+    assert np.array_equal(_angles32(back), _angles32(exr))
+    assert np.array_equal(back.values.astype(np.float32), exr.values.astype(np.float32))
+    # digits given: as many as asked for
+    gonio.write(exr, tmp_path / "d.csv", digits=9)
+    assert "\n15.0000004,0,30.0000008,-179.999995,0.100000001," in \
+        (tmp_path / "d.csv").read_text()
+
+
+def test_random_float32_tables_round_trip_exactly(tmp_path):
+    """20000 random float32 angles and values (sigma too) through EXR and CSV: every float32
+    comes back, no number printed with more than 9 digits."""
+    rng = np.random.default_rng(27)
+    n = 20_000
+    deg = np.column_stack([rng.uniform(0, 89, n), rng.uniform(-180, 180, n),
+                           rng.uniform(0, 89, n), rng.uniform(-180, 180, n)])
+    values = rng.lognormal(-2, 3, (n, 3))
+    exr = _exr_table(tmp_path, deg, values, values / 7)
+    gonio.write(exr, tmp_path / "t.csv")
+    back = gonio.read(tmp_path / "t.csv")
+    assert np.array_equal(_angles32(back), _angles32(exr))
+    assert np.array_equal(back.values.astype(np.float32), exr.values.astype(np.float32))
+    assert np.array_equal(back.sigma.astype(np.float32), exr.sigma.astype(np.float32))
+    text = (tmp_path / "t.csv").read_text().splitlines()[3:]
+    digits = [len(f.split("e")[0].replace("-", "").replace(".", "").lstrip("0"))
+              for row in text[:2000] for f in row.split(",")]
+    assert max(digits) <= 9
+
+
+def test_float64_data_keeps_nine_digits(tmp_path):
+    """A float64 table (measured, computed) is written to 9 digits as before."""
+    t = gonio.Table([[0, 0, 1.0]], [[0.6, 0, 0.8]], [[1 / 3, 0.1, 2 / 3]])
+    gonio.write(t, tmp_path / "t.csv")
+    assert (tmp_path / "t.csv").read_text().splitlines()[-1] == \
+        "0,0,36.8698976,0,0.333333333,0.1,0.666666667"
 
 
 def test_empty_table_is_refused_before_writing(tmp_path):

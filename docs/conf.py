@@ -42,7 +42,8 @@ extensions = [
 
 exclude_patterns = ["_build", "**/GALLERY_HEADER.rst", "tutorials_src", "gallery_src"]
 templates_path = []
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["microcyl.css"]
 
 html_theme = "pydata_sphinx_theme"
 html_title = "microcyl"

@@ -48,8 +48,8 @@ table
 # ``microcyl fit linen.csv --fabric linen_plain --free eta1,kd1,gamma_s1,gamma_v1 --suggest``
 # computes the Fisher information of the table about each candidate at the preset's values,
 # before any sampling, and suggests a free set.
-main(["fit", str(work / "linen.csv"), "--fabric", "linen_plain",
-      "--free", "eta1,kd1,gamma_s1,gamma_v1", "--suggest"])
+status = main(["fit", str(work / "linen.csv"), "--fabric", "linen_plain",
+               "--free", "eta1,kd1,gamma_s1,gamma_v1", "--suggest"])
 
 # %%
 # The fit

@@ -45,6 +45,9 @@ templates_path = []
 html_static_path = ["_static"]
 html_css_files = ["microcyl.css"]
 
+# "--free" stays two hyphens (no en dashes), quotes stay straight
+smartquotes = False
+
 html_theme = "pydata_sphinx_theme"
 html_title = "microcyl"
 html_theme_options = {

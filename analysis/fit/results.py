@@ -149,8 +149,8 @@ class FitResult:
             f"<tr><th>{html.escape(str(n))}</th>" + "".join(
                 f"<td>{html.escape(_num(self.summary.get(n, {}).get(c, '')))}</td>"
                 for c in cols) + "</tr>" for n in self.names)
-        verdict = html.escape(f"{'converged' if self.converged else 'not converged'}: "
-                              f"{self.reason}")
+        verdict = html.escape(self.reason or ("converged" if self.converged
+                                              else "not converged"))
         warns = "".join(f"<li>{html.escape(str(w.get('message', w)))}</li>" if
                         isinstance(w, dict) else f"<li>{html.escape(str(w))}</li>"
                         for w in self.warnings)

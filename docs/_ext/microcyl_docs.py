@@ -84,9 +84,13 @@ def _options_rst(parser: argparse.ArgumentParser, program: str) -> list[str]:
                 extra.append("one of " + ", ".join(map(str, action.choices)))
             if action.required and action.option_strings:
                 extra.append("required")
+            default = action.default
+            if (action.option_strings and action.nargs != 0 and default is not None
+                    and default is not argparse.SUPPRESS and "default" not in text):
+                extra.append(f"default {default}")
             body = " ".join(p for p in (rst_text(text), rst_text("; ".join(extra)) and
                                         f"({rst_text('; '.join(extra))})") if p)
-            lines += ["   " + (body or "(no description)"), ""]
+            lines += ["   " + body, ""] if body else []
     return lines
 
 
@@ -102,7 +106,8 @@ def write_cli_pages(out: Path) -> list[str]:
     index = [_title("Every verb and option"), "",
              "Generated from the command line's own parsers when these pages are built, so it",
              "says what the installed ``microcyl`` accepts. ``microcyl VERB --help`` prints the",
-             "same.", "", "::", "", *("   " + line for line in parser.format_usage().splitlines()),
+             "same.", "", ".. code-block:: text", "",
+             *("   " + line for line in parser.format_usage().splitlines()),
              "", *_options_rst(parser, "microcyl"), _title("Verbs", "-"), "",
              ".. list-table::", "   :widths: 20 80", ""]
     for verb in verbs:
@@ -111,11 +116,13 @@ def write_cli_pages(out: Path) -> list[str]:
     (out / "index.rst").write_text("\n".join(index))
     for verb, p in sub.choices.items():
         page = [f".. _cli-{verb}:", "", _title(f"microcyl {verb}"), "",
-                rst_text(p.description or helps.get(verb) or ""), "", "::", "",
+                rst_text(p.description or helps.get(verb) or ""), "",
+                ".. code-block:: text", "",
                 *("   " + line for line in p.format_usage().splitlines()), ""]
         page += _options_rst(p, f"microcyl-{verb}")
         if p.epilog:
-            page += ["", "::", "", *("   " + line for line in p.epilog.splitlines()), ""]
+            page += ["", ".. code-block:: text", "",
+                     *("   " + line for line in p.epilog.splitlines()), ""]
         (out / f"{verb}.rst").write_text("\n".join(page))
     return verbs
 

@@ -17,7 +17,8 @@ from reports.cli import main
 out = Path(os.environ.get("MICROCYL_DOCS_WORK", ".")) / "gallery"
 out.mkdir(parents=True, exist_ok=True)
 png = out / "hemisphere.png"
-assert main(["plot", "hemisphere", "polyester_satin_charmeuse", "--dpi", "100", "-o", str(png)]) == 0
+assert main(["plot", "hemisphere", "polyester_satin_charmeuse", "--dpi", "100",
+             "-o", str(png)]) == 0
 
 # %%
 # The figure as written (``--dpi``, ``--size`` and PDF or SVG output are options):

@@ -17,6 +17,7 @@ import importlib
 import inspect
 import pkgutil
 import re
+import sys
 from pathlib import Path
 
 #: Packages whose ``__all__`` the API reference documents, in order; every module below
@@ -160,11 +161,32 @@ def _directive(obj) -> str:
     return "autodata"
 
 
+def attr_doc(module: str, name: str, obj) -> list[str]:
+    """The ``#:`` comment that documents ``name`` where it is defined: in ``module`` or any
+    loaded module of the same top-level package holding the same object under that name."""
+    from sphinx.pycode import ModuleAnalyzer
+
+    top = module.split(".")[0]
+    candidates = [module] + sorted(m for m in list(sys.modules)
+                                   if m == top or m.startswith(top + "."))
+    for modname in candidates:
+        mod = sys.modules.get(modname)
+        if mod is None or getattr(mod, name, None) is not obj:
+            continue
+        try:
+            docs = ModuleAnalyzer.for_module(modname).find_attr_docs()
+        except Exception:          # a module without source (a C extension): no comment
+            continue
+        if ("", name) in docs:
+            return [line for line in docs[("", name)]]
+    return []
+
+
 def write_api_pages(out: Path) -> list[str]:
     """One page a module; returns the module names."""
     out.mkdir(parents=True, exist_ok=True)
     modules = api_modules()
-    seen: dict[int, str] = {}
+    seen: dict = {}
     for name in modules:
         mod = importlib.import_module(name)
         public = list(getattr(mod, "__all__", ()))
@@ -174,20 +196,32 @@ def write_api_pages(out: Path) -> list[str]:
         if submods:
             page += ["Modules: " + ", ".join(f":mod:`{getattr(mod, n).__name__}`"
                                              for n in submods), ""]
-        if objs:
+        data = [n for n in objs if _directive(getattr(mod, n)) == "autodata"]
+        code = [n for n in objs if n not in data]
+        if code:
             page += [".. autosummary::", "   :nosignatures:", "",
-                     *(f"   {n}" for n in objs), ""]
-        for n in objs:
+                     *(f"   {n}" for n in code), ""]
+        if data:
+            page += ["Constants: " + ", ".join(f":data:`{name}.{n}`" for n in data), ""]
+        for n in code + data:
             obj = getattr(mod, n)
             kind = _directive(obj)
-            page.append(f".. {kind}:: {name}.{n}")
             key = id(obj)
             dup = key in seen or f"{name}.{n}" in modules
+            if kind == "autodata":
+                key = (n, id(obj))        # a small int is one object under many names
+                page += [f".. py:data:: {n}", f"   :module: {name}"]
+                if key in seen:
+                    page.append("   :no-index:")
+                page += ["", *("   " + _escape_bars(line) for line in attr_doc(name, n, obj))]
+                if key in seen:
+                    page += ["", f"   The same object as :data:`{seen[key]}`."]
+                seen.setdefault(key, f"{name}.{n}")
+                page.append("")
+                continue
+            page.append(f".. {kind}:: {name}.{n}")
             if kind == "autoclass" and key not in seen:
                 page.append("   :members:")
-            if kind == "autodata":
-                page.append("   :no-value:")
-                dup = dup or isinstance(obj, (int, float, str, tuple, bool))
             if dup:
                 page.append("   :no-index:")
             if key in seen:

@@ -4,7 +4,9 @@ its docstring filter leaves literal text alone. The site itself is built by `mak
 
 import argparse
 import importlib
+import re
 import sys
+import textwrap
 from pathlib import Path
 
 import pytest
@@ -81,3 +83,23 @@ def test_bars_kept_in_doctests_literal_blocks_and_math():
     microcyl_docs.escape_docstring_bars(None, "function", "f", None, {}, lines)
     assert lines[0] == ">>> print(1 | 2)" and lines[5] == "    |x|" and lines[9] == "    |y|"
     assert lines[-1] == r"after \|z\|"
+
+
+def _python_blocks():
+    """The ``.. code-block:: python`` blocks of the hand-written pages, dedented."""
+    blocks = []
+    for page in sorted(DOCS.glob("*.rst")) + sorted((DOCS / "guide").glob("*.rst")):
+        for m in re.finditer(r"\.\. code-block:: python\n\n((?:   .*\n|\n)+)", page.read_text()):
+            blocks.append(pytest.param(textwrap.dedent(m.group(1)),
+                                       id=f"{page.stem}-{m.start()}"))
+    return blocks
+
+
+@pytest.mark.parametrize("code", _python_blocks())
+def test_page_examples_run(code, tmp_path, monkeypatch):
+    """The pages' Python examples run as written (the fit of getting_started is the README's,
+    tested by test_readme, and gallery/plot_09 runs it at every docs build)."""
+    if "fit_fabric" in code:
+        pytest.skip("the README's fit, run by test_readme and the gallery")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "docs example", "exec"), {})

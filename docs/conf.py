@@ -45,6 +45,8 @@ templates_path = []
 html_static_path = ["_static"]
 html_css_files = ["microcyl.css"]
 
+# literal blocks (::) are mostly commands: no highlighting unless a block names its language
+highlight_language = "text"
 # "--free" stays two hyphens (no en dashes), quotes stay straight
 smartquotes = False
 

@@ -34,7 +34,7 @@ $(DOCS_STAMP): $(STAMP)
 	touch $(DOCS_STAMP)
 
 docs: $(DOCS_STAMP)
-	rm -rf docs/_build docs/_generated docs/tutorials docs/gallery
+	rm -rf docs/_build docs/_generated docs/tutorials docs/gallery docs/sg_execution_times.rst
 	$(PY) -m sphinx -b html -W --keep-going -q docs docs/_build/html
 
 clean:

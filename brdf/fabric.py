@@ -11,6 +11,7 @@ from brdf.options import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, FabricOptio
 from brdf.plan import FabricPlan
 from brdf.prepared import Prepared
 from brdf.thread import Thread
+from brdf.thread import html_table as thread_html_table
 
 __all__ = ["Fabric", "Prepared", "OPTIONS", "TRANSMISSION_METHODS", "GAP_METHODS"]
 
@@ -117,10 +118,24 @@ class Fabric:
                 "options": self.options}
 
     def __repr__(self) -> str:
-        label = f"{self.name!r}, " if self.name else ""
+        """``Fabric(name=..., threads=(Thread(...), Thread(...)), option=...)``: the threads'
+        parameters and the options that differ from :data:`OPTIONS` (valid Python).
+
+        Examples
+        --------
+        >>> import brdf
+        >>> brdf.fabric("velvet").replace(masking=False)  # doctest: +ELLIPSIS
+        Fabric(name='velvet', threads=(Thread(eta=1.46, ...), Thread(eta=1.46, ...)), masking=False)
+        """
+        label = f"name={self.name!r}, " if self.name else ""
         changed = {k: v for k, v in self.options.items() if v != OPTIONS[k]}
         extra = "".join(f", {k}={v!r}" for k, v in changed.items())
-        return f"Fabric({label}{len(self._threads)} threads{extra})"
+        return f"Fabric({label}threads=({', '.join(map(repr, self._threads))}){extra})"
+
+    def _repr_html_(self) -> str:
+        """The threads' parameter table and the options, for Jupyter."""
+        opts = ", ".join(f"{k}={v!r}" for k, v in self.options.items())
+        return thread_html_table(self._threads, f"Fabric {self.name or ''} ({opts})")
 
     # -- evaluation --------------------------------------------------------------------
     def eval(self, wi, wo) -> np.ndarray:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 
 import numpy as np
 
@@ -61,6 +62,47 @@ class Thread:
         """Parameters as a JSON-ready dict (degrees for gamma and offsets)."""
         return {f.name: (list(v) if isinstance(v := getattr(self, f.name), tuple) else v)
                 for f in dataclasses.fields(self)}
+
+    def __repr__(self) -> str:
+        """``Thread(eta=1.46, albedo=(...), ...)``, numbers to 4 significant digits.
+
+        Examples
+        --------
+        >>> Thread(1.46, (0.06, 0.24, 0.3), 0.3, 12, 24, 0.33, (-25, 25), (1,))
+        Thread(eta=1.46, albedo=(0.06, 0.24, 0.3), kd=0.3, gamma_s=12, gamma_v=24, area=0.33,
+               offsets=(-25, 25), lengths=(1,))
+        """
+        return "Thread(" + ", ".join(f"{k}={_short(v)}" for k, v in self._fields()) + ")"
+
+    def _repr_html_(self) -> str:
+        """A one-row parameter table for Jupyter (units in the header)."""
+        return html_table([self])
+
+    def _fields(self):
+        return [(f.name, getattr(self, f.name)) for f in dataclasses.fields(self)]
+
+
+def _short(value) -> str:
+    """A number to 4 significant digits, or a tuple of them (one-tuples keep their comma)."""
+    if isinstance(value, tuple):
+        inner = ", ".join(_short(v) for v in value)
+        return f"({inner},)" if len(value) == 1 else f"({inner})"
+    return f"{value:.4g}" if isinstance(value, float) else repr(value)
+
+
+def html_table(threads, caption: str = "") -> str:
+    """The threads' parameters as an HTML table (one row a thread, units in the header),
+    every value escaped; what ``_repr_html_`` of a Thread or Fabric shows."""
+    names = [f.name for f in dataclasses.fields(Thread)]
+    unit = {n: "" if schema.THREAD[n].unit == "1" else f" ({schema.THREAD[n].unit})"
+            for n in names}
+    head = "".join(f"<th>{html.escape(n + unit[n])}</th>" for n in names)
+    rows = "".join(
+        f"<tr><th>{j}</th>" + "".join(f"<td>{html.escape(_short(getattr(t, n)))}</td>"
+                                      for n in names) + "</tr>"
+        for j, t in enumerate(threads, 1))
+    cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
+    return f"<table>{cap}<thead><tr><th>thread</th>{head}</tr></thead><tbody>{rows}</tbody></table>"
 
 
 Thread.__doc__ = Thread.__doc__.replace("{parameter_table}", "\n".join(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 from collections.abc import Mapping
 from typing import Any
 
@@ -104,3 +105,71 @@ class Table:
     def replace(self, **changes) -> "Table":
         """Return a copy with the given fields replaced."""
         return dataclasses.replace(self, **changes)
+
+    def describe(self) -> dict:
+        """What the table holds, in words and numbers: pairs, channels (``"RGB"`` or
+        ``"grey"``: three equal channels), sigma, valid values, the angle ranges in degrees
+        (theta_i, phi_i, theta_o, phi_o: min and max) and the source named in ``meta``.
+
+        Examples
+        --------
+        >>> t = Table([[0, 0, 1.0], [1, 0, 1]], [[0, 0, 1.0], [0, 1, 1]], [0.1, 0.2])
+        >>> d = t.describe()
+        >>> d["pairs"], d["channels"], d["sigma"], d["theta_o"]
+        (2, 'grey', False, (0.0, 45.0))
+        """
+        finite = np.isfinite(self.values)
+        grey = bool(np.all((self.values[:, 0] == self.values[:, 1])
+                           & (self.values[:, 1] == self.values[:, 2]) | ~finite.all(axis=1)))
+        out = {"pairs": len(self), "channels": "grey" if grey else "RGB",
+               "sigma": self.sigma is not None, "valid": int(self.valid.sum()),
+               "values": int(self.values.size)}
+        if len(self):
+            deg = np.degrees(self.angles)
+            for k, name in enumerate(("theta_i", "phi_i", "theta_o", "phi_o")):
+                out[name] = (round(float(deg[:, k].min()), 4) + 0.0,
+                             round(float(deg[:, k].max()), 4) + 0.0)
+        out["source"] = _source(self.meta.get("source"))
+        return out
+
+    def __repr__(self) -> str:
+        """``Table(n pairs, RGB|grey, sigma yes|no, theta_i lo..hi, ... deg, source '...')``.
+
+        Examples
+        --------
+        >>> Table([[0, 0, 1.0]], [[1, 0, 1.0]], [[0.1, 0.2, 0.3]], meta={"source": "hand"})
+        Table(1 pairs, RGB, sigma no, theta_i 0..0, phi_i 0..0, theta_o 45..45, phi_o 0..0 deg,
+              source 'hand')
+        """
+        d = self.describe()
+        parts = [f"{d['pairs']} pairs", d["channels"], f"sigma {'yes' if d['sigma'] else 'no'}"]
+        if d["valid"] < d["values"]:
+            parts.append(f"{d['values'] - d['valid']} of {d['values']} values invalid")
+        if len(self):
+            parts.append(", ".join(f"{k} {_g(d[k][0])}..{_g(d[k][1])}" for k in
+                                   ("theta_i", "phi_i", "theta_o", "phi_o")) + " deg")
+        if d["source"]:
+            src = d["source"] if len(d["source"]) <= 60 else d["source"][:57] + "..."
+            parts.append(f"source {src!r}")
+        return f"Table({', '.join(parts)})"
+
+    def _repr_html_(self) -> str:
+        """A small table of :meth:`describe` for Jupyter, every value escaped."""
+        rows = "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>"
+                       for k, v in self.describe().items())
+        return f"<table><caption>gonio.Table</caption><tbody>{rows}</tbody></table>"
+
+
+def _g(x: float) -> str:
+    return f"{x:.4g}"
+
+
+def _source(source) -> str | None:
+    """``meta["source"]`` in a few words: the text, or what simulated the table (a dict such
+    as gonio.measure writes: its type and name)."""
+    if isinstance(source, str):
+        return source
+    if isinstance(source, Mapping) and isinstance(source.get("type"), str):
+        name = source.get("name")
+        return f"simulated {source['type']}" + (f" {name}" if isinstance(name, str) else "")
+    return None

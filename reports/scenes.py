@@ -24,9 +24,10 @@ Named scenes (:data:`SCENES`, built by :func:`make_scene`):
     around the cylinder (the azimuthal direction), so ``n x warp`` runs along the axis.
     Caps: warp tangential (around the axis, concentric circles), so ``n x warp`` is radial
     (inward on the top cap); at the exact centre the warp falls back to +x.
-The curtain and the cylinder are also lit by a dim sky (:class:`reports.envlight.
-EnvironmentLight`, sampled with the fabric's importance sampling and MIS), so their shadows
-are not black; the sphere and the patch have the key light alone.
+
+The curtain and the cylinder are also lit by a dim sky
+(:class:`reports.envlight.EnvironmentLight`, sampled with the fabric's importance sampling
+and MIS), so their shadows are not black; the sphere and the patch have the key light alone.
 
 ``sphere``
     The lit sphere of Disney's BRDF Explorer: a unit sphere on black, lit by one point

@@ -29,6 +29,7 @@ in each parameter's natural unit.
 from __future__ import annotations
 
 import dataclasses
+import html
 import json
 from pathlib import Path
 
@@ -134,6 +135,38 @@ class FitResult:
         """Residuals at the posterior median (:func:`analysis.fit.quality.residuals`)."""
         return residuals(self)
 
+    def __repr__(self) -> str:
+        """The verdict, steps and each parameter's median and 95% interval (not the chains).
+
+        ``FitResult(converged, 350 steps x 4 ensembles x 32 walkers, kd1=0.302 [0.29, 0.31],
+        ..., 1 warning)``.
+        """
+        head = ("converged" if self.converged else "not converged") + \
+            f", {self.steps} steps x {self.ensembles} ensembles x {self.walkers} walkers"
+        params = ", ".join(f"{n}={_num(s['median'])} [{_num(s['lo95'])}, {_num(s['hi95'])}]"
+                           for n, s in ((n, self.summary.get(n, {})) for n in self.names)
+                           if {"median", "lo95", "hi95"} <= set(s))
+        tail = f", {len(self.warnings)} warning{'s' * (len(self.warnings) != 1)}" \
+            if self.warnings else ""
+        return f"FitResult({head}, {params}{tail})"
+
+    def _repr_html_(self) -> str:
+        """The parameter table (median, 68% and 95% intervals, unit, tau, R-hat) for
+        Jupyter, with the verdict and the warnings; every value escaped."""
+        cols = ("median", "lo68", "hi68", "lo95", "hi95", "unit", "tau", "rhat")
+        head = "".join(f"<th>{c}</th>" for c in ("parameter",) + cols)
+        rows = "".join(
+            f"<tr><th>{html.escape(str(n))}</th>" + "".join(
+                f"<td>{html.escape(_num(self.summary.get(n, {}).get(c, '')))}</td>"
+                for c in cols) + "</tr>" for n in self.names)
+        verdict = html.escape(self.reason or ("converged" if self.converged
+                                              else "not converged"))
+        warns = "".join(f"<li>{html.escape(str(w.get('message', w)))}</li>" if
+                        isinstance(w, dict) else f"<li>{html.escape(str(w))}</li>"
+                        for w in self.warnings)
+        return (f"<table><caption>FitResult ({verdict})</caption><thead><tr>{head}</tr></thead>"
+                f"<tbody>{rows}</tbody></table>" + (f"<ul>{warns}</ul>" if warns else ""))
+
     def to_json(self) -> dict:
         """The ``results.json`` document (see the module notes)."""
         quality = dict(self.quality)
@@ -161,6 +194,11 @@ class FitResult:
             "quality": quality, "plots": dict(self.plots),
             "loo": None if self.loo is None else self.loo.summary()}
         return plain(doc)
+
+
+def _num(value) -> str:
+    """A summary entry for display: a number to 4 significant digits, text as it is."""
+    return f"{value:.4g}" if isinstance(value, (int, float, np.floating)) else str(value)
 
 
 def summarize(spec, diag) -> dict:

@@ -8,12 +8,13 @@ of two threads, the paper's six presets, and every variant; importance sampling 
 from brdf import directions, frames, sampling, schema, terms
 from brdf.curve import MAX_TANGENT_SAMPLES, SAMPLING_METHODS, TangentCurve
 from brdf.fabric import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, Fabric, Prepared
-from brdf.presets import PRESETS, fabric, preset_threads
+from brdf.presets import PRESETS, check_preset, fabric, preset_threads
 from brdf.protocols import BRDF, SampledBRDF, ThreadedBRDF
 from brdf.thread import Thread
 
 __all__ = [
     "Thread", "TangentCurve", "Fabric", "Prepared", "fabric", "preset_threads", "PRESETS",
+    "check_preset",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
     "MAX_TANGENT_SAMPLES", "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
 ]

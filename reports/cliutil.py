@@ -98,9 +98,11 @@ def add_fabric_argument(parser: argparse.ArgumentParser, *, tables: bool = False
 def fabric_argument(args: argparse.Namespace) -> str:
     """The FABRIC given, positional or ``--fabric`` (exactly one)."""
     given = [v for v in (args.fabric, args.fabric_option) if v is not None]
-    if len(given) != 1:
-        raise ValueError("give FABRIC once, positional or as --fabric"
-                         + (f"; got {' and '.join(map(repr, given))}" if given else ""))
+    if not given:
+        raise ValueError(f"FABRIC is required (positional or --fabric): {sources.accepted()}")
+    if len(given) > 1:
+        raise ValueError(f"FABRIC given twice ({' and '.join(map(repr, given))}): give it "
+                         f"once, positional or as --fabric")
     return given[0]
 
 

@@ -171,6 +171,7 @@ def test_export_and_measure_of_each_source(sources, tmp_path):
         assert (tmp_path / f"{kind}.csv").is_file()
 
 
+@pytest.mark.slow      # two report pages with their renders: about 20 s on an idle 2-core machine
 def test_report_of_a_fit_and_an_xml(sources, tmp_path):
     out = tmp_path / "rep"
     r = microcyl("report", "--fabric", sources["fit"], "--fabric", sources["xml"],
@@ -249,7 +250,10 @@ def test_plot_table_takes_the_preset_as_fabric(tmp_path):
 
 def test_fabric_given_twice_is_refused(tmp_path):
     r = microcyl("eval", "velvet", "--fabric", "silk_shot", "--wi", "0,0", "--wo", "0,0")
-    assert r.returncode == 1 and "give FABRIC once" in r.stderr
+    assert r.returncode == 1 and "FABRIC given twice ('velvet' and 'silk_shot')" in r.stderr
+    r = microcyl("eval", "--wi", "0,0", "--wo", "0,0")
+    assert r.returncode == 1 and "FABRIC is required (positional or --fabric): a preset" \
+        in r.stderr
 
 
 @pytest.mark.parametrize("argv, message", [

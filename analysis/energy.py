@@ -25,8 +25,7 @@ import numpy as np
 from analysis.albedo import albedo_hemispherical, run_tasks
 from analysis.furnace import (FURNACE_SCAN, MODES, SCAN_PHI, SCAN_THETA, directions_grid,
                               max_info, white_furnace)
-from analysis.variants import VARIANTS, check_names
-from brdf.presets import fabric as preset_fabric
+from analysis.variants import VARIANTS, check_names, fabric_of, label_of
 from gonio.progress import progress_bar
 
 __all__ = [
@@ -108,10 +107,10 @@ def _curves(presets, variants, modes, th, ph, tol, min_level, workers, tick) -> 
     keys, tasks = [], []
     for p, v, m in itertools.product(presets, variants, modes):
         keys.append((p, v, m))
-        tasks.append((preset_fabric(p, **VARIANTS[v]), dirs,
+        tasks.append((fabric_of(p, v), dirs,
                       {"swap": MODES[m], "tol": tol, "min_level": min_level}))
     res = run_tasks(tasks, workers, progress=tick)
-    return [_curve(p, v, m, th, ph, val.reshape(th.size, ph.size, 3),
+    return [_curve(label_of(p), v, m, th, ph, val.reshape(th.size, ph.size, 3),
                    err.reshape(th.size, ph.size, 3))
             for (p, v, m), (val, err, _) in zip(keys, res)]
 
@@ -120,9 +119,9 @@ def _hemispherical(presets, tol, min_level, workers, tick) -> list[dict]:
     """The hemispherical-hemispherical albedo of each preset (default variant)."""
     hemi = []
     for p in presets:
-        h = albedo_hemispherical(preset_fabric(p), n_theta=6, n_phi=8, tol=tol,
+        h = albedo_hemispherical(fabric_of(p), n_theta=6, n_phi=8, tol=tol,
                                  min_level=min_level, workers=workers)
-        hemi.append({"preset": p, "variant": "default", **h.to_dict()})
+        hemi.append({"preset": label_of(p), "variant": "default", **h.to_dict()})
         if tick:
             tick(_HEMI_TICKS)
     return hemi
@@ -141,7 +140,8 @@ def _settings(th, ph, modes, variants, presets, tol, furnace, scan, scan_theta_d
     """The settings of :class:`EnergyReport`."""
     return {
         "theta_deg": th.tolist(), "phi_deg": ph.tolist(), "modes": list(modes),
-        "variants": {v: VARIANTS[v] for v in variants}, "presets": list(presets), "tol": tol,
+        "variants": {v: VARIANTS[v] for v in variants},
+        "presets": [label_of(p) for p in presets], "tol": tol,
         "furnace_scan": {k: list(v) for k, v in scan.items()} if furnace else None,
         "scan_theta_deg": list(scan_theta_deg), "scan_phi_deg": list(scan_phi_deg),
         "definitions": dict(_DEFINITIONS),
@@ -157,8 +157,9 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
 
     Parameters
     ----------
-    presets : sequence of str, optional
-        Preset names (default: all of ``brdf.PRESETS``).
+    presets : sequence of str or brdf.Fabric, optional
+        Preset names (default: all of ``brdf.PRESETS``), or fabrics named by their ``name``
+        (a fit's, a file's: :func:`analysis.variants.label_of`).
     variants : sequence of str, optional
         Keys of :data:`VARIANTS` (default: all).
     theta_deg, phi_deg : sequence of float

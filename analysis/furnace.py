@@ -14,9 +14,8 @@ from typing import Any
 import numpy as np
 
 from analysis.albedo import run_tasks
-from analysis.variants import VARIANTS
+from analysis.variants import VARIANTS, fabric_of, label_of
 from brdf.presets import PRESETS
-from brdf.presets import fabric as preset_fabric
 
 __all__ = ["MODES", "FURNACE_SCAN", "SCAN_THETA", "SCAN_PHI", "white_furnace",
            "directions_grid", "max_info"]
@@ -94,7 +93,7 @@ def _white(threads):
 
 def _configurations(name: str, scan: dict, variant: str):
     """(configuration, fabric) of the white preset ``name`` and of each scanned value."""
-    base = preset_fabric(name, **VARIANTS[variant])
+    base = fabric_of(name, variant)
     white = _white(base.threads)
     entries = [("none", None)] + [(k, v) for k, vals in scan.items() for v in vals]
     for param, val in entries:
@@ -104,7 +103,8 @@ def _configurations(name: str, scan: dict, variant: str):
             threads = tuple(t.replace(gamma_s=val, gamma_v=2 * val) for t in white)
         else:
             threads = tuple(t.replace(**{param: val}) for t in white)
-        yield ({"curves": name, "parameter": param, "value": val, "variant": variant},
+        yield ({"curves": label_of(name), "parameter": param, "value": val,
+                "variant": variant},
                base.replace(threads=threads))
 
 
@@ -115,7 +115,7 @@ def white_furnace(presets=None, *, scan=None, variant: str = "default", theta_de
 
     Parameters
     ----------
-    presets : sequence of str, optional
+    presets : sequence of str or brdf.Fabric, optional
         Presets whose tangent curves, areas and other parameters are the starting points
         (default: all six).
     scan : dict, optional

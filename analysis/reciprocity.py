@@ -23,10 +23,9 @@ from typing import Any
 import numpy as np
 
 from analysis.colour import luminance
-from analysis.variants import VARIANTS, check_names
+from analysis.variants import VARIANTS, check_names, fabric_of, label_of
 from brdf import validate
 from brdf.frames import to_angles
-from brdf.presets import fabric as preset_fabric
 from brdf.protocols import BRDF
 from gonio.geometry import Geometry
 from gonio.rgl import load_rgl
@@ -296,6 +295,14 @@ def _report_row(name, variant, source, b, pairs, geometry, channel, n_worst) -> 
     return row
 
 
+def _measured(felt) -> tuple[str, object]:
+    """A measured contrast's name and BRDF: an RGL file (named by its stem) or a
+    (name, BRDF) pair."""
+    if isinstance(felt, tuple):
+        return str(felt[0]), felt[1]
+    return Path(felt).stem, load_rgl(felt)
+
+
 def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
                        geometry=None, felts=(), channel="luminance",
                        n_worst: int = 5) -> ReciprocityReport:
@@ -303,8 +310,9 @@ def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
 
     Parameters
     ----------
-    presets : sequence of str, optional
-        Preset names (default: all of ``brdf.PRESETS``).
+    presets : sequence of str or brdf.Fabric, optional
+        Preset names (default: all of ``brdf.PRESETS``), or fabrics named by their ``name``
+        (a fit's, a file's: :func:`analysis.variants.label_of`).
     variants : sequence of str, optional
         Keys of :data:`analysis.variants.VARIANTS` (default: all), so the report shows which
         term (gap, transmission, masking, reweighting) changes the asymmetry.
@@ -314,8 +322,9 @@ def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
         Seed of the random pairs (the same pairs for every BRDF).
     geometry : gonio.Geometry, optional
         A gonio geometry examined as well (e.g. ``gonio.full_grid(10)``).
-    felts : sequence of str or os.PathLike, optional
-        RGL tensor files (``gonio.load_rgl``), reported as measured contrasts.
+    felts : sequence of str, os.PathLike or (name, BRDF) pairs, optional
+        RGL tensor files (``gonio.load_rgl``) or measured BRDFs (a MERL table's
+        ``gonio.load_merl``), reported as measured contrasts.
     channel : str, default "luminance"
         See :func:`reciprocity`.
     n_worst : int, default 5
@@ -334,15 +343,16 @@ def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
     t0 = time.perf_counter()
     presets, variants = check_names(presets, variants)
     pairs = random_pairs(n, seed)
-    rows = [_report_row(p, v, "model", preset_fabric(p, **VARIANTS[v]), pairs, geometry,
+    rows = [_report_row(label_of(p), v, "model", fabric_of(p, v), pairs, geometry,
                         channel, n_worst) for p in presets for v in variants]
-    rows += [_report_row(Path(path).stem, None, "measured", load_rgl(path), pairs, geometry,
-                         channel, n_worst) for path in felts]
+    measured = [_measured(felt) for felt in felts]
+    rows += [_report_row(name, None, "measured", b, pairs, geometry, channel, n_worst)
+             for name, b in measured]
     settings = {"n": int(n), "seed": seed if isinstance(seed, int) else None,
-                "channel": channel, "presets": list(presets),
+                "channel": channel, "presets": [label_of(p) for p in presets],
                 "variants": {v: VARIANTS[v] for v in variants},
                 "geometry": geometry.kind if isinstance(geometry, Geometry) else None,
-                "felts": [str(f) for f in felts],
+                "felts": [f[0] if isinstance(f, tuple) else str(f) for f in felts],
                 "metric": "|f(wi,wo) - f(wo,wi)| / max(f(wi,wo), f(wo,wi)); pairs with "
                           "both 0 excluded and counted (n_zero)"}
     return ReciprocityReport(settings=settings, rows=rows, seconds=time.perf_counter() - t0)

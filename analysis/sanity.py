@@ -19,7 +19,7 @@ import numpy as np
 
 from brdf.fabric import Fabric
 from brdf.frames import from_angles, to_angles
-from brdf.presets import PRESETS
+from brdf.presets import check_preset
 from brdf.presets import fabric as preset_fabric
 from brdf.protocols import BRDF
 
@@ -246,9 +246,7 @@ def sanity_scan(obj, *, parameters: bool | None = None, n_examples: int = 3) -> 
     True
     """
     if isinstance(obj, str):
-        if obj not in PRESETS:
-            raise ValueError(f"unknown fabric {obj!r}; presets: {', '.join(PRESETS)}")
-        obj = preset_fabric(obj)
+        obj = preset_fabric(check_preset(obj))
     if not isinstance(obj, BRDF):
         raise ValueError(f"need a BRDF with eval(wi, wo); got {type(obj).__name__}")
     parameters = isinstance(obj, Fabric) if parameters is None else bool(parameters)

@@ -7,9 +7,11 @@ term changes the result.
 
 from __future__ import annotations
 
-from brdf.presets import PRESETS
+from brdf.fabric import Fabric
+from brdf.presets import PRESETS, check_preset
+from brdf.presets import fabric as preset_fabric
 
-__all__ = ["VARIANTS", "check_names"]
+__all__ = ["VARIANTS", "check_names", "fabric_of", "label_of"]
 
 #: Model variants examined, by name: options passed to ``brdf.fabric``.
 VARIANTS = {
@@ -26,8 +28,9 @@ def check_names(presets=None, variants=None) -> tuple[tuple[str, ...], tuple[str
 
     Parameters
     ----------
-    presets : sequence of str, optional
-        Keys of ``brdf.PRESETS`` (default all).
+    presets : sequence of str or brdf.Fabric, optional
+        Keys of ``brdf.PRESETS`` (default all), or fabrics (a fit's, a file's) named by their
+        ``name`` (:func:`label_of`).
     variants : sequence of str, optional
         Keys of :data:`VARIANTS` (default all).
 
@@ -50,9 +53,27 @@ def check_names(presets=None, variants=None) -> tuple[tuple[str, ...], tuple[str
     presets = tuple(PRESETS if presets is None else presets)
     variants = tuple(VARIANTS if variants is None else variants)
     for p in presets:
-        if p not in PRESETS:
-            raise ValueError(f"unknown fabric {p!r}; presets: {', '.join(PRESETS)}")
+        if not isinstance(p, Fabric):
+            check_preset(p)
     for v in variants:
         if v not in VARIANTS:
             raise ValueError(f"unknown variant {v!r}; variants: {', '.join(VARIANTS)}")
     return presets, variants
+
+
+def fabric_of(preset, variant: str = "default") -> Fabric:
+    """The fabric of ``preset`` (a preset's name or a :class:`brdf.Fabric`) in ``variant``
+    (a key of :data:`VARIANTS`: its options replace the fabric's).
+
+    Examples
+    --------
+    >>> fabric_of("velvet", "masking_off").options["masking"]
+    False
+    """
+    base = preset if isinstance(preset, Fabric) else preset_fabric(check_preset(preset))
+    return base.replace(**VARIANTS[variant]) if VARIANTS[variant] else base
+
+
+def label_of(preset) -> str:
+    """What reports call ``preset``: its name (a preset's, or the fabric's ``name``)."""
+    return preset.name if isinstance(preset, Fabric) else str(preset)

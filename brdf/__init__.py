@@ -42,13 +42,14 @@ from brdf.options import (GAP_METHODS, MAX_TANGENT_SAMPLES, OPTIONS, SAMPLING_ME
                           TRANSMISSION_METHODS, FabricOptions, Gap, TangentSampling,
                           Transmission)
 from brdf.plan import FabricPlan, ThreadPlan
-from brdf.presets import PRESETS, fabric, preset_threads
+from brdf.presets import PRESETS, check_preset, fabric, preset_threads
 from brdf.protocols import BRDF, SampledBRDF, ThreadedBRDF
 from brdf.thread import Thread
 
 __all__ = [
     "Thread", "TangentCurve", "Fabric", "FabricPlan", "ThreadPlan", "FabricOptions",
     "Transmission", "Gap", "TangentSampling", "Prepared", "fabric", "preset_threads", "PRESETS",
+    "check_preset",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
     "MAX_TANGENT_SAMPLES", "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
 ]

@@ -5,7 +5,7 @@ from __future__ import annotations
 from brdf.fabric import Fabric
 from brdf.thread import Thread
 
-__all__ = ["PRESETS", "fabric", "preset_threads"]
+__all__ = ["PRESETS", "fabric", "preset_threads", "check_preset"]
 
 
 def _scaled(scale, rgb):
@@ -49,17 +49,37 @@ _TABLE = {
 PRESETS = tuple(_TABLE)
 
 
+def check_preset(name) -> str:
+    """``name`` when it names a preset of :data:`PRESETS`: the one check of a preset's name.
+
+    Raises
+    ------
+    ValueError
+        Unknown name; the message lists the valid ones.
+
+    Examples
+    --------
+    >>> check_preset("velvet")
+    'velvet'
+    >>> check_preset("denim")
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown fabric 'denim'; valid presets are linen_plain, silk_crepe_de_chine, polyester_satin_charmeuse, polyester_satin_charmeuse_back, silk_shot, velvet
+    """
+    if not isinstance(name, str) or name not in _TABLE:
+        raise ValueError(f"unknown fabric {name!r}; valid presets are {', '.join(PRESETS)}")
+    return name
+
+
 def preset_threads(name: str) -> tuple[Thread, Thread]:
     """The two threads (warp, weft) of a preset.
 
     Raises
     ------
     ValueError
-        Unknown name; the message lists the valid ones.
+        Unknown name; the message lists the valid ones (:func:`check_preset`).
     """
-    if name not in _TABLE:
-        raise ValueError(f"unknown fabric {name!r}; valid presets are {', '.join(PRESETS)}")
-    return _TABLE[name]
+    return _TABLE[check_preset(name)]
 
 
 def fabric(name: str, **options) -> Fabric:

@@ -38,7 +38,26 @@ COMMAND_MODULES = (
 
 
 class _Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose usage errors are one line and exit status 2."""
+    """An ArgumentParser whose usage errors are one line and exit status 2, that never takes
+    an abbreviation for an option (``--out`` is not ``--output``), and whose verbs take
+    options and inputs in any order (``fit-batch a.dat --sample 3 b.csv``: argparse's
+    intermixed parsing; ``intermixed=False`` for the top level, whose verbs are a
+    sub-parser)."""
+
+    def __init__(self, *args, intermixed: bool = True, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+        self.intermixed = intermixed
+        self._mixing = False
+
+    def parse_known_args(self, args=None, namespace=None):  # noqa: D401 - argparse API
+        if not self.intermixed or self._mixing:
+            return super().parse_known_args(args, namespace)
+        self._mixing = True          # parse_known_intermixed_args calls back here
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._mixing = False
 
     def error(self, message):  # noqa: D401 - argparse API
         self.exit(2, f"microcyl {self.prog.split(' ', 1)[-1]}: error: {message}\n"
@@ -55,7 +74,7 @@ def _version() -> str:
 def build_parser() -> argparse.ArgumentParser:
     """Return the full ``microcyl`` parser with every registered verb."""
     parser = _Parser(
-        prog="microcyl",
+        prog="microcyl", intermixed=False,
         description="Measure and analyse the microcylinder cloth BRDF "
                     "(Sadeghi et al., ACM TOG 2013).",
     )
@@ -74,13 +93,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _configure_logging(args) -> None:
     """Diagnostics ("wrote FILE", what a verb is about to do) go through the ``microcyl``
-    logger to stderr: INFO by default, DEBUG with -v, WARNING with -q. Results go to stdout."""
+    logger to stderr: INFO by default, DEBUG with -v, WARNING with -q (``microcyl -q VERB``
+    or a long verb's own ``VERB -q``). Results go to stdout."""
     log = logging.getLogger("microcyl")
     log.handlers[:] = [logging.StreamHandler(sys.stderr)]
     log.handlers[0].setFormatter(logging.Formatter("%(message)s"))
     log.propagate = False
+    quiet = getattr(args, "log_quiet", False) or getattr(args, "quiet", False)
     log.setLevel(logging.DEBUG if getattr(args, "log_verbose", False)
-                 else logging.WARNING if getattr(args, "log_quiet", False) else logging.INFO)
+                 else logging.WARNING if quiet else logging.INFO)
 
 
 def _run(args):

@@ -1,5 +1,5 @@
-"""Pieces shared by the command-line verbs: fabric options and sources, angle pairs, atomic
-writes."""
+"""Pieces shared by the command-line verbs: fabric options and the FABRIC argument (resolved by
+:func:`analysis.sources.resolve`), the progress and message flags, angle pairs, output checks."""
 
 from __future__ import annotations
 
@@ -13,14 +13,15 @@ import brdf
 import gonio
 import gonio.io
 import gonio.tablesize
-import gonio.rgl
-from gonio.statefields import load_json
+from analysis import sources
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
-__all__ = ["add_fabric_options", "fabric_from_args", "fabric_source", "parse_angle_pair", "check_writable_dir",
+__all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabric_argument",
+           "fabric_argument", "source_from_args", "add_quiet_options", "progress",
+           "check_output_suffix", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
            "table_estimate",
@@ -41,23 +42,104 @@ def _on_off(value: str) -> bool:
     raise argparse.ArgumentTypeError(f"expected on or off, got {value!r}")
 
 
-def add_fabric_options(parser: argparse.ArgumentParser) -> None:
-    """Add the model's variant flags (MODEL.md toggles) to a sub-command parser."""
-    g = parser.add_argument_group("model variants")
-    g.add_argument("--masking", type=_on_off, default=True, metavar="on|off",
-                   help="shadowing and masking M (default on)")
-    g.add_argument("--reweighting", type=_on_off, default=True, metavar="on|off",
-                   help="reweighting by visible length P and Q (default on)")
-    g.add_argument("--tangent-samples", type=int, default=32, metavar="N",
-                   help="samples per tangent curve (default 32)")
-    g.add_argument("--tangent-sampling", default="midpoint",
-                   choices=brdf.SAMPLING_METHODS, help="tangent curve rule (default midpoint)")
-    g.add_argument("--transmission", default="half_angle", choices=brdf.TRANSMISSION_METHODS,
-                   help="F_T variant (default half_angle)")
-    g.add_argument("--gap", default="incident", choices=brdf.GAP_METHODS,
-                   help="gap term c_gap of Q (default incident)")
-    g.add_argument("--rotation", type=float, default=0.0, metavar="DEG",
-                   help="fabric rotation about the normal, degrees (default 0)")
+def add_fabric_options(parser: argparse.ArgumentParser, rotation: bool = True) -> None:
+    """Add the model's variant flags (MODEL.md toggles) to a sub-command parser. Only the
+    flags given change a fabric (:func:`fabric_options`): a fit's or a file's own options
+    stay otherwise. ``rotation=False`` leaves ``--rotation`` to the verb (``measure``'s
+    turns the stage)."""
+    g = parser.add_argument_group("model variants (default: the source's own, else the "
+                                  "model's)")
+    g.add_argument("--masking", type=_on_off, default=None, metavar="on|off",
+                   help="shadowing and masking M (model default on)")
+    g.add_argument("--reweighting", type=_on_off, default=None, metavar="on|off",
+                   help="reweighting by visible length P and Q (model default on)")
+    g.add_argument("--tangent-samples", type=int, default=None, metavar="N",
+                   help="samples per tangent curve (model default 32)")
+    g.add_argument("--tangent-sampling", default=None,
+                   choices=brdf.SAMPLING_METHODS, help="tangent curve rule (model default midpoint)")
+    g.add_argument("--transmission", default=None, choices=brdf.TRANSMISSION_METHODS,
+                   help="F_T variant (model default half_angle)")
+    g.add_argument("--gap", default=None, choices=brdf.GAP_METHODS,
+                   help="gap term c_gap of Q (model default incident)")
+    if rotation:
+        g.add_argument("--rotation", type=float, default=None, metavar="DEG",
+                       help="fabric rotation about the normal, degrees (model default 0)")
+
+
+def fabric_options(args: argparse.Namespace) -> dict:
+    """The variant options given by :func:`add_fabric_options`'s flags (rotation in
+    radians), each checked; the flags not given are left out."""
+    opts = {}
+    for name in ("masking", "reweighting", "tangent_samples", "tangent_sampling",
+                 "transmission", "gap"):
+        value = getattr(args, name, None)
+        if value is not None:
+            opts[name] = value
+    if "tangent_samples" in opts:
+        check_tangent_samples(opts["tangent_samples"])
+    rot = getattr(args, "rotation", None) if getattr(args, "fabric_rotation", True) else None
+    if rot is not None:
+        if not math.isfinite(rot):
+            raise ValueError(f"--rotation must be a finite angle in degrees; got {rot}")
+        opts["rotation"] = math.radians(rot)
+    return opts
+
+
+def add_fabric_argument(parser: argparse.ArgumentParser, *, tables: bool = False,
+                        extra: str = "") -> None:
+    """Add the FABRIC argument: positional, or as ``--fabric`` (one of the two); what it
+    accepts is :func:`analysis.sources.accepted`."""
+    text = sources.accepted(tables) + extra
+    parser.add_argument("fabric", nargs="?", default=None, metavar="FABRIC", help=text)
+    parser.add_argument("--fabric", dest="fabric_option", default=None, metavar="FABRIC",
+                        help="FABRIC given as an option")
+
+
+def fabric_argument(args: argparse.Namespace) -> str:
+    """The FABRIC given, positional or ``--fabric`` (exactly one)."""
+    given = [v for v in (args.fabric, args.fabric_option) if v is not None]
+    if not given:
+        raise ValueError(f"FABRIC is required (positional or --fabric): {sources.accepted()}")
+    if len(given) > 1:
+        raise ValueError(f"FABRIC given twice ({' and '.join(map(repr, given))}): give it "
+                         f"once, positional or as --fabric")
+    return given[0]
+
+
+def source_from_args(text: str, args: argparse.Namespace, what: str = "FABRIC",
+                     tables: bool = False) -> sources.Source:
+    """:func:`analysis.sources.resolve` of ``text`` with the variant flags given
+    (:func:`fabric_options`) applied."""
+    return sources.resolve(text, what=what, tables=tables, options=fabric_options(args))
+
+
+def add_quiet_options(parser: argparse.ArgumentParser) -> None:
+    """Add the flags of every long verb: ``--no-progress`` (no progress bar) and
+    ``-q/--quiet`` (no progress bar and no messages on stderr; warnings and errors still)."""
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bar (shown on stderr otherwise, terminal or not)")
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="no progress bar and no messages on stderr (warnings and "
+                             "errors still)")
+
+
+def progress(args: argparse.Namespace) -> bool:
+    """Whether a progress bar is shown: neither ``--no-progress`` nor ``-q`` given."""
+    return not (getattr(args, "no_progress", False) or getattr(args, "quiet", False))
+
+
+def check_output_suffix(path, suffixes, option: str = "-o") -> Path:
+    """``path`` when it ends in one of ``suffixes`` and its folder exists (before any
+    work); a ValueError or OSError naming ``option`` otherwise."""
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise ValueError(f"{option} {str(path)!r}: must end in {', '.join(suffixes)}")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise OSError(f"{option} {str(path)!r}: output folder {str(parent)!r} does not exist")
+    if path.is_dir():
+        raise OSError(f"{option} {str(path)!r}: is a folder")
+    return path
 
 
 def add_fit_options(p: argparse.ArgumentParser) -> None:
@@ -179,66 +261,8 @@ def read_table(path, **options):
 
 
 def fabric_from_args(name: str, args: argparse.Namespace) -> brdf.Fabric:
-    """The preset ``name`` with the variant flags of ``add_fabric_options``."""
-    check_tangent_samples(args.tangent_samples)
-    return brdf.fabric(name, masking=args.masking, reweighting=args.reweighting,
-                       tangent_samples=args.tangent_samples,
-                       tangent_sampling=args.tangent_sampling,
-                       transmission=args.transmission, gap=args.gap,
-                       rotation=math.radians(args.rotation))
-
-
-def fabric_source(text: str, what: str = "FABRIC") -> brdf.Fabric:
-    """The fabric that a FABRIC argument names: a preset, a fit, or an exported dictionary.
-
-    Parameters
-    ----------
-    text : str
-        A name in :data:`brdf.PRESETS`; a `microcyl fit` output folder (its posterior
-        medians, :func:`analysis.fit.median_fabric`: the fabric that ``microcyl export``
-        writes, without the fit's overall ``scale``, which only calibrates relative tables);
-        or a ``.json`` file of the Mitsuba plugin's dictionary (``microcyl export``'s, or one
-        written by hand: :func:`reports.mitsuba.fabric_from_dict`).
-    what : str
-        The argument's name in error messages.
-
-    Raises
-    ------
-    ValueError
-        One line naming the argument and the value: an unknown preset and no such file or
-        folder, a folder that is no fit, an unreadable or invalid dictionary.
-
-    Examples
-    --------
-    >>> fabric_source("velvet").name
-    'velvet'
-    """
-    if text in brdf.PRESETS:
-        return brdf.fabric(text)
-    path = Path(text)
-    if path.is_dir():
-        from analysis.fit.medians import median_fabric
-        try:
-            return median_fabric(path).fabric
-        except ValueError as exc:
-            raise ValueError(f"{what} {text!r}: not a fit folder: {exc}") from None
-    if path.is_file() and path.suffix.lower() == ".json":
-        from reports.mitsuba import fabric_from_dict    # needs no Mitsuba
-        try:
-            doc = load_json(path, "fabric dictionary")   # invalid or nested: one line
-        except ValueError as exc:
-            raise ValueError(f"{what} {text!r}: unreadable JSON "
-                             f"({str(exc).removeprefix(f'{path}: ')})") from None
-        if not isinstance(doc, dict) or doc.get("type", "microcylinder") != "microcylinder":
-            kind = doc.get("type") if isinstance(doc, dict) else type(doc).__name__
-            raise ValueError(f"{what} {text!r}: must hold a microcylinder plugin dictionary "
-                             f"(a JSON object of type 'microcylinder'); got {kind!r}")
-        try:
-            return fabric_from_dict(doc)
-        except (ValueError, TypeError) as exc:
-            raise ValueError(f"{what} {text!r}: {exc}") from None
-    raise ValueError(f"{what} {text!r}: not a preset ({', '.join(brdf.PRESETS)}), a fit "
-                     f"folder or a .json dictionary of `microcyl export`")
+    """The preset ``name`` (:func:`brdf.check_preset`) with the variant flags given."""
+    return brdf.fabric(brdf.check_preset(name), **fabric_options(args))
 
 
 def parse_angle_pair(text: str) -> tuple[float, float]:

@@ -42,7 +42,7 @@ def register(sub):
                    help="outgoing-direction step for RGL .bsdf inputs (default the reader's)")
     cliutil.add_cluster_options(p)
     p.add_argument("--no-plots", action="store_true", help="skip each fit's plots")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    cliutil.add_quiet_options(p)
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     cliutil.add_fabric_options(p)
     p.set_defaults(func=run)
@@ -52,9 +52,7 @@ def run(args) -> int:
     """Check everything, run the batch, print the counts; exit 1 when a table failed."""
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be >= 1; got {args.workers}")
-    if args.fabric not in brdf.PRESETS:
-        raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
-                         f"{', '.join(brdf.PRESETS)}")
+    brdf.check_preset(args.fabric)
     plots = None
     if not args.no_plots:
         # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
@@ -70,7 +68,7 @@ def run(args) -> int:
         plots=plots)
     log.info(f"fit-batch: {len(jobs)} tables into {out}")
     summary = run_batch(jobs, out, workers=args.workers, scheduler=args.scheduler,
-                        progress=not args.no_progress, notify=log.info)
+                        progress=cliutil.progress(args), notify=log.info)
     page = write_batch_page(out)
     c = summary.counts()
     print(f"{c.get('converged', 0)} converged, {c.get('not_converged', 0)} not converged, "

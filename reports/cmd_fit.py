@@ -44,7 +44,7 @@ def register(sub):
     p.add_argument("--sample", type=int, default=None, metavar="N",
                    help="CUReT sample number (for abrdf.dat)")
     p.add_argument("--no-plots", action="store_true", help="skip the plots")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    cliutil.add_quiet_options(p)
     p.add_argument("--suggest", action="store_true",
                    help="sample nothing: print what the table can tell of each candidate "
                         "parameter (the --free given, else the default set plus albedo1 and "
@@ -73,9 +73,7 @@ def _check_size(args, spec) -> None:
 
 def run(args) -> int:
     """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
-    if args.fabric not in brdf.PRESETS:
-        raise ValueError(f"unknown fabric {args.fabric!r}; valid presets are "
-                         f"{', '.join(brdf.PRESETS)}")
+    brdf.check_preset(args.fabric)
     fit_kw = cliutil.fit_kwargs(args)
     if args.suggest:
         return _suggest(args, fit_kw)
@@ -91,7 +89,7 @@ def run(args) -> int:
         # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
         from reports.fitplots import write_fit_plots as plots
     result = fit_fabric(
-        table, fab, spec, out, plots=plots, progress=not args.no_progress, **fit_kw,
+        table, fab, spec, out, plots=plots, progress=cliutil.progress(args), **fit_kw,
         notify=lambda line: print(line, file=sys.stderr, flush=True),
         config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
     print(format_summary(result))

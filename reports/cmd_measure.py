@@ -11,12 +11,11 @@ Angles on the command line are in degrees (cone half-angles, ``--rotation``, geo
 from __future__ import annotations
 
 import argparse
+import logging
 import math
-import sys
-from pathlib import Path
 
-import brdf
 import gonio
+import gonio.io
 from analysis.budget import (MEASURE_BYTES_PER_PAIR, check_memory, format_bytes,
                              format_seconds, spec_pairs)
 from analysis.folderlock import output_lock
@@ -28,20 +27,20 @@ from reports import cliutil
 
 __all__ = ["register", "run"]
 
-_ON_OFF = {"on": True, "off": False}
+log = logging.getLogger("microcyl")
 
 
 def register(sub):
     """Add the ``measure`` verb to the ``microcyl`` sub-parsers."""
     p = sub.add_parser(
         "measure", help="measure a fabric on a geometry through a virtual instrument",
-        description="Measure a preset fabric on a geometry through a virtual "
+        description="Measure a fabric on a geometry through a virtual "
                     "gonioreflectometer (finite source and detector cones, noise) and write "
                     "the table (format from the output suffix: .exr, .csv, .binary).",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("fabric", metavar="FABRIC", help="preset name (microcyl fabrics lists them)")
+    cliutil.add_fabric_argument(p)
     p.add_argument("-o", "--output", required=True, metavar="FILE",
-                   help="output table (.exr, .csv or .binary)")
+                   help=f"output table ({', '.join(gonio.io.WRITE_SUFFIXES)})")
     g = p.add_argument_group("geometry")
     g.add_argument("--geometry", default="full:10", metavar="SPEC",
                    help=f"default full:10; one of {SPEC_HELP}")
@@ -65,40 +64,9 @@ def register(sub):
     i.add_argument("--cone-azimuths", type=int, default=6, metavar="N",
                    help="cone quadrature azimuths per ring (default 6)")
     i.add_argument("--seed", type=int, default=None, help="seed of the noise")
-    p.add_argument("--no-progress", action="store_true",
-                   help="no progress bar (shown on stderr otherwise, terminal or not)")
-    f = p.add_argument_group("fabric variant (defaults: the model's)")
-    f.add_argument("--masking", choices=_ON_OFF, default=None)
-    f.add_argument("--reweighting", choices=_ON_OFF, default=None)
-    f.add_argument("--tangent-samples", type=int, default=None, metavar="N")
-    f.add_argument("--tangent-sampling", choices=("midpoint", "control_points"), default=None)
-    f.add_argument("--transmission", choices=("half_angle", "longitudinal"), default=None)
-    f.add_argument("--gap", choices=("incident", "outgoing"), default=None)
-    p.set_defaults(func=run)
-
-
-def _fabric_options(args) -> dict:
-    """The fabric keyword arguments the user set (the others keep the model's defaults)."""
-    opts = {}
-    for name in ("masking", "reweighting"):
-        v = getattr(args, name)
-        if v is not None:
-            opts[name] = _ON_OFF[v]
-    if args.tangent_samples is not None:
-        cliutil.check_tangent_samples(args.tangent_samples)
-        opts["tangent_samples"] = args.tangent_samples
-    for name in ("tangent_sampling", "transmission", "gap"):
-        v = getattr(args, name)
-        if v is not None:
-            opts[name] = v
-    return opts
-
-
-def _make_fabric(name: str, options: dict):
-    """``brdf.fabric(name, **options)``, with a one-line error for an unknown name."""
-    if name not in brdf.PRESETS:
-        raise ValueError(f"unknown fabric {name!r}; valid names: {', '.join(brdf.PRESETS)}")
-    return brdf.fabric(name, **options)
+    cliutil.add_quiet_options(p)
+    cliutil.add_fabric_options(p, rotation=False)
+    p.set_defaults(func=run, fabric_rotation=False)     # --rotation turns the stage
 
 
 #: The instrument's parameters and their options, longest name first (messages name them).
@@ -144,31 +112,30 @@ def _check_size(args, instrument, fabric) -> None:
     points = instrument.n_source * instrument.n_detector      # no quadrature built
     seconds = n * points * SECONDS_PER_EVALUATION * fabric.options["tangent_samples"] / 32
     if seconds > 5:
-        print(f"measure: {what} x {points} cone points: about {format_bytes(nbytes)} of "
-              f"memory and {format_seconds(seconds)}", file=sys.stderr, flush=True)
+        log.info(f"measure: {what} x {points} cone points: about {format_bytes(nbytes)} of "
+                 f"memory and {format_seconds(seconds)}")
 
 
 def run(args) -> int:
     """Measure and write; every check on the input happens before the measurement."""
-    out = Path(args.output)
-    if not out.parent.is_dir():
-        raise OSError(2, "output folder does not exist", str(out.parent))
+    out = cliutil.check_output_suffix(args.output, gonio.io.WRITE_SUFFIXES)
     if not math.isfinite(args.rotation):
         raise ValueError(f"--rotation must be a finite angle in degrees; got {args.rotation}")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed must be a non-negative integer; got {args.seed}")
     instrument = _instrument(args)
-    fabric = _make_fabric(args.fabric, _fabric_options(args))
+    src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
+    fabric = src.brdf
     _check_size(args, instrument, fabric)
     geometry = from_spec(args.geometry, rotation=math.radians(args.rotation))
     table = measure(fabric, geometry, instrument, seed=args.seed,
-                    progress=not args.no_progress)
+                    progress=cliutil.progress(args))
     if "name" not in table.meta["source"]:
-        table.meta["source"]["name"] = args.fabric
+        table.meta["source"]["name"] = src.label
     with output_lock(out, "measure", inside=False):   # removes a killed run's temporaries
         gonio.write(table, out)
     bad = int((~table.valid).any(axis=1).sum())
     note = f", {bad} with a negative or missing value" if bad else ""
-    print(f"{args.fabric}: {len(table)} pairs on {geometry.spec} "
+    print(f"{src.label}: {len(table)} pairs on {geometry.spec} "
           f"(rotation {args.rotation:g} deg{note}) -> {out}")
     return 0

@@ -39,7 +39,7 @@ def register(sub):
     p.add_argument("--seed", type=int, default=0)
     cliutil.add_cluster_options(p)
     p.add_argument("--no-plots", action="store_true")
-    p.add_argument("--no-progress", action="store_true")
+    cliutil.add_quiet_options(p)
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     p.set_defaults(func=run)
 
@@ -54,7 +54,7 @@ def run(args) -> int:
     doc = fit_measured(args.names, out, data_dir=cliutil.data_dir(args.data),
                        seed=args.seed,
                        max_steps=args.max_steps, time_limit=args.time_limit,
-                       rgl_step=args.rgl_step, plots=plots, progress=not args.no_progress,
+                       rgl_step=args.rgl_step, plots=plots, progress=cliutil.progress(args),
                        echo=print, workers=args.workers, scheduler=args.scheduler)
     names = args.names or list(doc["datasets"])
     bad = [n for n in names if not doc["datasets"][n]["converged"]]

@@ -10,6 +10,7 @@ import numpy as np
 
 import brdf
 import gonio
+from analysis import sources
 from analysis.folderlock import output_lock
 from analysis.fit.results import read_results
 from reports import cliutil
@@ -28,11 +29,11 @@ def register(sub):
                    help="print the presets as JSON (scripts; gamma and offsets in degrees)")
     p.set_defaults(func=run_fabrics)
 
-    p = sub.add_parser("eval", help="evaluate f_r of a preset at one pair of directions",
-                       description="Print the RGB BRDF f_r (1/sr, no cosine) of a preset at "
+    p = sub.add_parser("eval", help="evaluate f_r of a fabric at one pair of directions",
+                       description="Print the RGB BRDF f_r (1/sr, no cosine) of FABRIC at "
                                    "one (wi, wo) pair given by polar angle and azimuth in "
                                    "degrees (azimuth from the warp, +x).")
-    p.add_argument("fabric", metavar="FABRIC", help=f"one of {', '.join(brdf.PRESETS)}")
+    cliutil.add_fabric_argument(p, tables=True)
     p.add_argument("--wi", type=cliutil.parse_angle_pair, required=True, metavar="THETA,PHI",
                    help="direction toward the light, degrees")
     p.add_argument("--wo", type=cliutil.parse_angle_pair, required=True, metavar="THETA,PHI",
@@ -47,8 +48,9 @@ def register(sub):
                                    "reciprocity, renders, fits) in DIR/index.html, with its "
                                    "data in DIR/summary.json; prints f_r at standard "
                                    "geometries.")
-    p.add_argument("--fabric", action="append", metavar="NAME", choices=brdf.PRESETS,
-                   help="limit to these presets (repeatable; default all)")
+    p.add_argument("--fabric", action="append", metavar="FABRIC",
+                   help="limit to these fabrics (repeatable; default every preset): "
+                        + sources.accepted())
     p.add_argument("-o", "--output", default="report", metavar="DIR",
                    help="output folder (default ./report); replaced whole by the next run")
     p.add_argument("--quality", choices=("default", "high", "fast"), default="default",
@@ -64,13 +66,8 @@ def register(sub):
     p.add_argument("--batch", default=None, metavar="DIR",
                    help="write the page of `microcyl fit-batch -o DIR` (DIR/index.html) "
                         "instead of the presets' report")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    cliutil.add_quiet_options(p)
     p.set_defaults(func=run_report)
-
-
-def _check_fabric(name: str) -> None:
-    if name not in brdf.PRESETS:
-        raise ValueError(f"unknown fabric {name!r}; valid presets are {', '.join(brdf.PRESETS)}")
 
 
 def format_fabrics_table(names=brdf.PRESETS) -> str:
@@ -109,15 +106,16 @@ def run_fabrics(args):
 
 
 def run_eval(args):
-    _check_fabric(args.fabric)
-    fab = cliutil.fabric_from_args(args.fabric, args)
+    name = cliutil.fabric_argument(args)
+    src = cliutil.source_from_args(name, args, tables=True)
     wi = brdf.directions.from_angles(*np.radians(args.wi))
     wo = brdf.directions.from_angles(*np.radians(args.wo))
-    f = fab.eval(wi, wo)
+    f = np.asarray(src.brdf.eval(wi, wo), dtype=np.float64).reshape(3)
     if args.json:
-        print(json.dumps({"fabric": args.fabric, "wi_deg": list(args.wi),
+        options = gonio.plain(src.brdf.options) if src.is_fabric else None
+        print(json.dumps({"fabric": name, "kind": src.kind, "wi_deg": list(args.wi),
                           "wo_deg": list(args.wo), "f_r": [float(x) for x in f],
-                          "unit": "1/sr", "options": gonio.plain(fab.options)}))
+                          "unit": "1/sr", "options": options}))
         return 0
     print(f"f_r [1/sr]  R {f[0]:.9g}  G {f[1]:.9g}  B {f[2]:.9g}")
     return 0
@@ -133,24 +131,27 @@ def run_report(args):
         with output_lock(Path(args.batch), "report"):    # the batch folder's own lock
             log.info(f"wrote the batch page {write_batch_page(args.batch)}")
         return 0
-    names = tuple(dict.fromkeys(args.fabric)) if args.fabric else brdf.PRESETS
+    chosen = sources.resolve_all(dict.fromkeys(args.fabric or brdf.PRESETS), what="--fabric")
+    names = tuple(s.label for s in chosen)
     fits = {}
     for item in args.fit or ():
         name, sep, path = item.partition("=")
-        if not sep or name not in brdf.PRESETS:
+        if not sep or name not in names:
             raise ValueError(f"--fit must be FABRIC=PATH/results.json with FABRIC one of "
-                             f"{', '.join(brdf.PRESETS)}; got {item!r}")
+                             f"{', '.join(names)}; got {item!r}")
         if not Path(path).is_file():
             raise ValueError(f"--fit {item!r}: no such file {path!r}")
         read_results(path)          # a damaged file: one line naming it and the field
         fits[name] = path
-    index = build_report(names, args.output, progress=not args.quiet, quality=args.quality,
+    fabrics = [s.label if s.kind == "preset" else (s.label, s.brdf) for s in chosen]
+    index = build_report(fabrics, args.output, progress=cliutil.progress(args),
+                         quality=args.quality,
                          fit_results=fits, measured=args.measured,
                          render_engine=args.render_engine)
     labels = [g[0] for g in STANDARD_GEOMETRIES]
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
-    for name in names:
-        vals = standard_values(brdf.fabric(name))
+    for name, src in zip(names, chosen):
+        vals = standard_values(src.brdf)
         lum = luminance(np.array(list(vals.values()), dtype=np.float64)).tolist()
         print(f"{name:31s} " + " ".join(f"{x:19.6g}" for x in lum))
     log.info(f"wrote {index} (data: {index.parent / 'summary.json'})")

@@ -13,6 +13,7 @@ import numpy as np
 import analysis.sanity
 import brdf
 import gonio
+from analysis import sources
 from analysis.energy import VARIANTS, EnergyReport, energy_report
 from analysis.reciprocity import reciprocity_report
 from gonio.atomic import atomic_write
@@ -25,13 +26,20 @@ FELTS = ("acrylic_felt_white_rgb.bsdf", "acrylic_felt_pink_rgb.bsdf",
          "acrylic_felt_purple_rgb.bsdf")
 
 
-def _presets(name: str) -> tuple[str, ...]:
-    if name == "all":
-        return tuple(brdf.PRESETS)
-    if name not in brdf.PRESETS:
-        raise ValueError(f"unknown fabric {name!r}; valid presets are "
-                         f"{', '.join(brdf.PRESETS)} (or all)")
-    return (name,)
+def _sources(args, tables: bool = False) -> list:
+    """The FABRIC argument (positional or --fabric) resolved: every preset for ``all``,
+    else the one source (:func:`analysis.sources.resolve`)."""
+    text = cliutil.fabric_argument(args)
+    if text == "all":
+        return [sources.resolve(name) for name in brdf.PRESETS]
+    return [cliutil.source_from_args(text, args, tables=tables)]
+
+
+def _presets(args) -> tuple:
+    """The fabrics of the FABRIC argument for :mod:`analysis.energy` and
+    :mod:`analysis.reciprocity`: a preset by its name, another fabric named by its label."""
+    return tuple(s.label if s.kind == "preset" else s.brdf.replace(name=s.label)
+                 for s in _sources(args))
 
 
 def _variants(text: str | None):
@@ -94,7 +102,7 @@ def register(sub):
                     "of f_r cos theta_i; reflectance: integral over wo of f_r cos theta_o), "
                     "with error bars, and a white-furnace scan (A = 1) over eta, k_d and gamma "
                     "that finds where the albedo exceeds 1.")
-    p.add_argument("fabric", metavar="FABRIC|all", help=f"one of {', '.join(brdf.PRESETS)}, or all")
+    cliutil.add_fabric_argument(p, extra=", or all (every preset)")
     p.add_argument("--variants", metavar="V1,V2",
                    help="variants (default all: default, masking_off, reweighting_off, "
                         "transmission_longitudinal, gap_outgoing)")
@@ -110,7 +118,7 @@ def register(sub):
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes (default: up to 2)")
     p.add_argument("--json", metavar="PATH", help="write the full results as JSON")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    cliutil.add_quiet_options(p)
     p.set_defaults(func=run_energy)
 
     p = sub.add_parser(
@@ -118,8 +126,9 @@ def register(sub):
         description="Relative reciprocity error |f(wi,wo) - f(wo,wi)| / max(...) on luminance, "
                     "over random pairs and a gonio full grid, per preset and variant; the RGL "
                     "acrylic felts are shown as a measured contrast.")
-    p.add_argument("fabric", metavar="FABRIC|all", help=f"one of {', '.join(brdf.PRESETS)}, or all")
-    p.add_argument("--variants", metavar="V1,V2", help="variants (default all)")
+    cliutil.add_fabric_argument(p, tables=True, extra=", or all (every preset)")
+    p.add_argument("--variants", metavar="V1,V2",
+                   help="variants (default all; a measured table is shown as it is)")
     p.add_argument("-n", type=int, default=20000, help="random pairs (default 20000)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random pairs (default 0)")
     p.add_argument("--grid-step", type=float, default=15.0, metavar="DEG",
@@ -138,7 +147,7 @@ def register(sub):
                     "retro and mirror pairs, along the threads, below the horizon) and at edge "
                     "parameter sets; report every NaN, infinite or negative value and every "
                     "RuntimeWarning. Exits 1 when one is found.")
-    p.add_argument("fabric", metavar="FABRIC|all", help=f"one of {', '.join(brdf.PRESETS)}, or all")
+    cliutil.add_fabric_argument(p, tables=True, extra=", or all (every preset)")
     p.add_argument("--json", metavar="PATH", help="write every check as JSON")
     p.set_defaults(func=run_sanity)
 
@@ -192,7 +201,7 @@ def format_energy(rep) -> str:
 
 def run_energy(args) -> int:
     """``microcyl energy``."""
-    presets = _presets(args.fabric)
+    presets = _presets(args)
     variants = _variants(args.variants)
     phi = _floats(args.phi, "--phi")
     if not (0 < args.theta_step <= 90):
@@ -206,7 +215,7 @@ def run_energy(args) -> int:
                    | {85.0, 89.0})
     rep = energy_report(presets, variants, theta_deg=theta, phi_deg=phi, tol=args.tol,
                         hemispherical=not args.no_hemispherical, furnace=not args.no_furnace,
-                        workers=args.workers, progress=not args.quiet)
+                        workers=args.workers, progress=cliutil.progress(args))
     doc = document(rep, energy_statements(rep))
     print(format_energy(doc))
     if target is not None:
@@ -253,7 +262,10 @@ def format_reciprocity(rep: dict) -> str:
 
 def run_reciprocity(args) -> int:
     """``microcyl reciprocity``."""
-    presets = _presets(args.fabric)
+    chosen = _sources(args, tables=True)
+    presets = tuple(s.label if s.kind == "preset" else s.brdf.replace(name=s.label)
+                    for s in chosen if s.is_fabric)
+    tables = [(s.label, s.brdf) for s in chosen if not s.is_fabric]
     variants = _variants(args.variants)
     if args.n < 1:
         raise ValueError(f"-n must be >= 1; got {args.n}")
@@ -271,7 +283,7 @@ def run_reciprocity(args) -> int:
             else:
                 notes.append(f"measured felt {path} not found: skipped")
     rep = reciprocity_report(presets, variants, n=args.n, seed=args.seed, geometry=geometry,
-                             felts=felts, channel=args.channel)
+                             felts=tables + felts, channel=args.channel)
     doc = document(rep, reciprocity_statements(rep))
     doc["notes"] = notes
     print(format_reciprocity(doc))
@@ -295,10 +307,11 @@ def format_sanity(name: str, result) -> list[str]:
 
 
 def run_sanity(args) -> int:
-    """``microcyl sanity``: :func:`analysis.sanity_scan` of each preset."""
-    presets = _presets(args.fabric)
+    """``microcyl sanity``: :func:`analysis.sanity_scan` of each fabric."""
+    chosen = _sources(args, tables=True)
     target = _check_json_target(args.json)
-    results = {name: analysis.sanity.sanity_scan(name) for name in presets}
+    results = {s.label: analysis.sanity.sanity_scan(s.label if s.kind == "preset" else s.brdf)
+               for s in chosen}
     for name, r in results.items():
         print("\n".join(format_sanity(name, r)))
     if target is not None:

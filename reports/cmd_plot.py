@@ -18,6 +18,7 @@ import numpy as np
 
 import brdf
 import gonio
+from analysis import sources
 from analysis.fit.medians import median_fabric
 from reports import cliutil
 
@@ -41,8 +42,11 @@ def register(sub):
                     "'table' a measured table (SOURCE) against presets (further SOURCEs, "
                     "--preset) and a fit (--fit DIR). The format comes from the suffix of FILE.")
     p.add_argument("view", choices=VIEWS, metavar="VIEW", help=", ".join(VIEWS))
-    p.add_argument("sources", nargs="+", metavar="FABRIC|TABLE",
-                   help="preset names; for 'table' a table file first")
+    p.add_argument("sources", nargs="*", metavar="FABRIC|TABLE",
+                   help="fabrics: " + sources.accepted() + "; for 'table' a table file "
+                        "first")
+    p.add_argument("--fabric", action="append", default=None, metavar="FABRIC",
+                   help="a FABRIC given as an option (repeatable): drawn as SOURCEs are")
     p.add_argument("-o", "--output", required=True, metavar="FILE",
                    help="output file: .png, .pdf or .svg")
     p.add_argument("--dpi", type=int, default=200, help="PNG resolution (default 200)")
@@ -116,6 +120,12 @@ def parse_planes(text: str) -> tuple[float, ...]:
     return tuple(out)
 
 
+def _fabric_texts(args) -> list[str]:
+    """The FABRICs named: SOURCEs (after the table of 'table'), then each --fabric."""
+    names = list(args.sources[1:] if args.view == "table" else args.sources)
+    return names + list(args.fabric or ())
+
+
 def _check(args) -> None:
     """Every option checked before any work."""
     suffix = Path(args.output).suffix.lower()
@@ -125,20 +135,22 @@ def _check(args) -> None:
         raise ValueError(f"--dpi must be in [10, 1200]; got {args.dpi}")
     if args.resolution is not None and not 3 <= args.resolution <= 2000:
         raise ValueError(f"--resolution must be in [3, 2000]; got {args.resolution}")
-    names = args.sources[1:] if args.view == "table" else args.sources
-    for name in list(names) + list(args.preset or ()):
-        if name not in brdf.PRESETS:
-            raise ValueError(f"unknown fabric {name!r}; valid presets are "
-                             f"{', '.join(brdf.PRESETS)}")
+    names = _fabric_texts(args)
+    for name in args.preset or ():
+        brdf.check_preset(name)
     if len(set(names)) != len(names):
         raise ValueError(f"a fabric is given twice: {', '.join(names)}")
+    if args.view == "table" and not args.sources:
+        raise ValueError("table: give the table file first (plot table TABLE [FABRIC...])")
+    if args.view != "table" and not names:
+        raise ValueError(f"{args.view}: give at least one FABRIC (positional or --fabric)")
     if args.view == "table" and not Path(args.sources[0]).is_file():
         raise ValueError(f"table: no such file {args.sources[0]!r}")
     if args.view != "table" and (args.fit or args.preset):
         raise ValueError("--fit and --preset apply to the 'table' view only")
-    if args.view == "table" and not (args.sources[1:] or args.preset or args.fit):
-        raise ValueError("table: give a preset (SOURCE or --preset) or --fit DIR to compare "
-                         "the table with")
+    if args.view == "table" and not (names or args.preset or args.fit):
+        raise ValueError("table: give a fabric (SOURCE, --fabric or --preset) or --fit DIR "
+                         "to compare the table with")
     if args.data is not None and args.view != "table":
         raise ValueError("--data applies to the 'table' view only")
     if args.data is not None and Path(args.data).suffix.lower() != ".csv":
@@ -168,8 +180,8 @@ def fitted_fabric(fit, preset=None) -> tuple[brdf.Fabric, str]:
     """The fabric of a fit's posterior medians and its preset
     (:func:`analysis.fit.median_fabric`); ``fit`` is a fit's folder or its ``results.json``,
     ``preset`` names the preset where ``fit_config.json`` does not."""
-    m = _medians(fit, preset)
-    return m.fabric, m.preset
+    src = sources.resolve(fit, what="--fit", preset=preset)
+    return src.brdf, src.preset
 
 
 def _medians(fit, preset):
@@ -192,8 +204,17 @@ def fitted_model(fit, preset=None):
     return m.model, f"fit ({m.preset}{scale})"
 
 
+def _models(args) -> dict:
+    """Label -> BRDF of the FABRICs named (and, for 'table', each --preset), with the
+    variant flags given; resolved before any drawing."""
+    texts = list(dict.fromkeys(_fabric_texts(args) + list(args.preset or ())))
+    return {s.label: s.brdf for s in sources.resolve_all(
+        texts, options=cliutil.fabric_options(args))}
+
+
 def run_plot(args):
     _check(args)
+    models = _models(args)
     # lazy: matplotlib and colour-science (~2 s), which `microcyl --help` and the other
     # verbs skip
     from reports import plot_views
@@ -202,8 +223,6 @@ def run_plot(args):
     opts = dict(channel=args.channel, theta_i=args.theta_i, planes=args.plane,
                 scale=args.scale, resolution=args.resolution)
     if args.view == "table":
-        models = {n: cliutil.fabric_from_args(n, args)
-                  for n in dict.fromkeys(list(args.sources[1:]) + list(args.preset or ()))}
         if args.fit:
             model, label = fitted_model(args.fit, (args.preset or [None])[0])
             models[label] = model
@@ -218,8 +237,7 @@ def run_plot(args):
             write_table_data(args.data, plot_views.table_view_data(table, models,
                                                                    panels=panels))
     else:
-        fabrics = {n: cliutil.fabric_from_args(n, args) for n in args.sources}
-        fig = plot_views.VIEW_FUNCTIONS[args.view](fabrics, **opts)
+        fig = plot_views.VIEW_FUNCTIONS[args.view](models, **opts)
     if args.size is not None:
         fig.set_size_inches(*args.size)
     path = save_figure(fig, args.output, dpi=args.dpi)

@@ -5,11 +5,12 @@
         [--transmission half_angle|longitudinal] [--gap incident|outgoing] [--rotation DEG]
         [--width 1280] [--height 720] [--spp 16] [--exposure 0] [--seed 0]
         [--light-radius R] [--workers N] [--engine builtin|mitsuba] [--variant V]
-        [--max-depth N] [--quiet] -o out.exr
+        [--max-depth N] [--no-progress] [-q] -o out.exr
 
-FABRIC is a preset, a ``microcyl fit`` output folder (the fabric of its posterior medians, as
-``microcyl export`` writes it) or such an exported ``.json`` dictionary
-(:func:`reports.cliutil.fabric_source`); the variant options given change it further.
+FABRIC (positional or ``--fabric``) is a preset, a ``microcyl fit`` output folder (the fabric
+of its posterior medians, as ``microcyl export`` writes it), such an exported ``.json`` or
+``.xml`` file, or a measured ``.bsdf`` or ``.binary`` table (built-in engine)
+(:func:`analysis.sources.resolve`); the variant options given change a fabric further.
 ``-o out.exr`` writes the float32 linear EXR and an sRGB PNG beside it (``out.png``);
 ``-o out.png`` writes the PNG only.  Every argument is checked (scene, fabric and its
 options, size, output folder, engine and variant) before rendering starts.
@@ -21,8 +22,8 @@ llvm_ad_rgb where LLVM works, else scalar_rgb).
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
-import sys
 from pathlib import Path
 
 import brdf
@@ -31,14 +32,7 @@ from reports.lights import PointLight
 
 __all__ = ["register", "run"]
 
-
-def _on_off(value):
-    v = value.lower()
-    if v in ("on", "true", "yes", "1"):
-        return True
-    if v in ("off", "false", "no", "0"):
-        return False
-    raise ValueError(f"{value!r} must be on or off")
+log = logging.getLogger("microcyl")
 
 
 def register(sub):
@@ -48,19 +42,8 @@ def register(sub):
         description="Render a scene of cloth shaded with the microcylinder BRDF to a float32 "
                     "OpenEXR (linear RGB) and an sRGB PNG.")
     p.add_argument("scene", metavar="SCENE", help="curtain, cylinder, sphere or patch")
-    p.add_argument("fabric", metavar="FABRIC",
-                   help="a preset name (see `microcyl fabrics`), a `microcyl fit` output "
-                        "folder (its posterior medians) or a .json dictionary written by "
-                        "`microcyl export`")
-    p.add_argument("--masking", metavar="on|off", help="shadowing and masking (default on)")
-    p.add_argument("--reweighting", metavar="on|off",
-                   help="reweighting by visible length (default on)")
-    p.add_argument("--tangent-samples", type=int, metavar="N", help="samples per tangent curve")
-    p.add_argument("--tangent-sampling", metavar="RULE", help="midpoint or control_points")
-    p.add_argument("--transmission", metavar="RULE", help="half_angle or longitudinal")
-    p.add_argument("--gap", metavar="RULE", help="incident or outgoing")
-    p.add_argument("--rotation", type=float, metavar="DEG",
-                   help="fabric rotation about the normal, degrees")
+    cliutil.add_fabric_argument(p, tables=True)
+    cliutil.add_fabric_options(p)
     p.add_argument("--width", type=int, default=1280, help="pixels, at most 1280 (1280)")
     p.add_argument("--height", type=int, default=720, help="pixels, at most 720 (720)")
     p.add_argument("--spp", type=int, default=16, help="samples per pixel (16)")
@@ -78,7 +61,7 @@ def register(sub):
     p.add_argument("--max-depth", type=int, default=None, metavar="N",
                    help="longest light path, 2 = direct light only, -1 unbounded (8); "
                         "--engine mitsuba only")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    cliutil.add_quiet_options(p)
     p.add_argument("-o", "--output", required=True, metavar="FILE",
                    help="out.exr (writes out.png beside it) or out.png")
     p.set_defaults(func=run)
@@ -86,27 +69,6 @@ def register(sub):
 
 #: Largest |--exposure| in stops: 2**64 already saturates any f_r; 2**1e308 overflows.
 MAX_EXPOSURE = 64
-
-
-def _fabric_options(args):
-    opts = {}
-    for name in ("masking", "reweighting"):
-        value = getattr(args, name)
-        if value is not None:
-            try:
-                opts[name] = _on_off(value)
-            except ValueError:
-                raise ValueError(f"--{name} {value!r}: must be on or off") from None
-    if args.tangent_samples is not None:
-        cliutil.check_tangent_samples(args.tangent_samples)
-        opts["tangent_samples"] = args.tangent_samples
-    for name in ("tangent_sampling", "transmission", "gap"):
-        value = getattr(args, name)
-        if value is not None:
-            opts[name] = value
-    if args.rotation is not None:
-        opts["rotation"] = math.radians(args.rotation)
-    return opts
 
 
 #: The engines of ``--engine``.
@@ -141,7 +103,7 @@ def run(args):
     """Check every argument, render, write the files; return 0."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
     from reports import imageio
-    from reports.render import check_size, render, resolve_fabric
+    from reports.render import check_size, render
     from reports.scenes import make_scene
 
     scene = make_scene(args.scene)
@@ -156,8 +118,7 @@ def run(args):
     if suffix not in (".exr", ".png"):
         raise ValueError(f"-o {args.output}: the output must end in .exr or .png")
     imageio.check_output(out)
-    fabric = resolve_fabric(cliutil.fabric_source(args.fabric, "fabric"),
-                            **_fabric_options(args))
+    fabric = cliutil.source_from_args(cliutil.fabric_argument(args), args, tables=True).brdf
     if args.light_radius is not None:
         if not (args.light_radius >= 0 and math.isfinite(args.light_radius)):
             raise ValueError(f"--light-radius {args.light_radius}: must be >= 0")
@@ -171,16 +132,16 @@ def run(args):
         from reports.mitsuba_render import render_mitsuba
         image = render_mitsuba(scene, fabric, width=args.width, height=args.height,
                                spp=args.spp, seed=args.seed, max_depth=max_depth,
-                               variant=variant, workers=args.workers, progress=not args.quiet)
+                               variant=variant, workers=args.workers,
+                               progress=cliutil.progress(args))
     else:
         image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
-                       seed=args.seed, progress=not args.quiet, workers=args.workers)
+                       seed=args.seed, progress=cliutil.progress(args), workers=args.workers)
     written = []
     if suffix == ".exr":
         written.append(imageio.write_exr(out, image))
         written.append(imageio.write_png(out.with_suffix(".png"), image, args.exposure))
     else:
         written.append(imageio.write_png(out, image, args.exposure))
-    if not args.quiet:
-        print("wrote " + ", ".join(str(w) for w in written), file=sys.stderr)
+    log.info("wrote " + ", ".join(str(w) for w in written))
     return 0

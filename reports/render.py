@@ -94,10 +94,7 @@ def resolve_fabric(fabric, **options):
         For an unknown name or an object without ``eval``.
     """
     if isinstance(fabric, str):
-        if fabric not in brdf.PRESETS:
-            raise ValueError(f"fabric {fabric!r} is unknown; choose one of "
-                             f"{', '.join(brdf.PRESETS)}")
-        return brdf.fabric(fabric, **options)
+        return brdf.fabric(brdf.check_preset(fabric), **options)
     if not isinstance(fabric, BRDF):
         raise ValueError(f"fabric={fabric!r} must be a preset name or have an eval(wi, wo) method")
     if options:

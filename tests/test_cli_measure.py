@@ -78,7 +78,7 @@ def test_unknown_fabric(tmp_path, written, capsys):
     status = main(["measure", "tweed", "-o", str(tmp_path / "t.exr")])
     err = capsys.readouterr().err.strip()
     assert status == 1 and "\n" not in err
-    assert "unknown fabric 'tweed'" in err
+    assert "FABRIC 'tweed': not a preset" in err
     for name in brdf.PRESETS:
         assert name in err
     assert not written
@@ -117,7 +117,7 @@ def test_usage_errors_exit_2(capsys, args):
 
 def test_missing_output_folder(tmp_path, written, capsys):
     status = main(["measure", "velvet", "-o", str(tmp_path / "nope" / "t.exr")])
-    assert status == 1 and "output folder does not exist" in capsys.readouterr().err
+    assert status == 1 and "does not exist" in capsys.readouterr().err
     assert not written
 
 

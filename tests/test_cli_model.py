@@ -31,13 +31,13 @@ def test_eval_prints_fr(capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["eval", "denim", "--wi", "30,0", "--wo", "30,180"], "unknown fabric 'denim'; valid presets"),
+    (["eval", "denim", "--wi", "30,0", "--wo", "30,180"], "FABRIC 'denim': not a preset (linen"),
     (["eval", "velvet", "--wi", "30", "--wo", "30,180"], "expected THETA,PHI in degrees"),
     (["eval", "velvet", "--wi", "30,0", "--wo", "30,180", "--masking", "maybe"], "expected on or off"),
     (["eval", "velvet", "--wi", "30,0", "--wo", "30,180", "--tangent-samples", "0"],
      "--tangent-samples must be an integer in 1..4096; got 0"),
     (["eval", "velvet", "--wi", "30,0"], "the following arguments are required: --wo"),
-    (["report", "--fabric", "denim"], "invalid choice: 'denim'"),
+    (["report", "--fabric", "denim"], "--fabric 'denim': not a preset (linen"),
 ])
 def test_bad_input_is_one_line_and_nonzero(argv, message, capsys):
     try:
@@ -54,7 +54,7 @@ def test_bad_input_is_one_line_and_nonzero(argv, message, capsys):
 def test_report_writes_html_and_summary(tmp_path, capsys):
     out = tmp_path / "rep"
     assert main(["report", "--fabric", "silk_shot", "--fabric", "velvet", "-o", str(out),
-                 "--quality", "fast", "--quiet"]) == 0
+                 "--quality", "fast", "--no-progress"]) == 0
     assert (out / "index.html").is_file() and (out / "velvet.html").is_file()
     data = json.loads((out / "summary.json").read_text())
     assert list(data["fabrics"]) == ["silk_shot", "velvet"]

@@ -109,13 +109,13 @@ def test_fit_arguments(table, fabric, opts):
 
 
 def _measure_checks(ns):
-    opts = cmd_measure._fabric_options(ns)
+    cliutil.fabric_options(ns)
     if not math.isfinite(ns.rotation):
         raise ValueError("--rotation must be finite")
     if ns.seed is not None and ns.seed < 0:
         raise ValueError("--seed must be >= 0")
     inst = cmd_measure._instrument(ns)
-    fab = cmd_measure._make_fabric(ns.fabric, opts)
+    fab = cliutil.source_from_args(cliutil.fabric_argument(ns), ns).brdf
     cmd_measure._check_size(ns, inst, fab)
 
 

@@ -16,7 +16,7 @@ from analysis.fit.medians import median_fabric
 from analysis.fit.results import read_results
 from analysis.params import ParamSpec
 from gonio.statefields import MAX_DEPTH, FileFields, load_json, load_toml
-from reports.cliutil import fabric_source
+from analysis.sources import resolve
 
 FUZZ = settings(max_examples=60, deadline=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
@@ -205,7 +205,7 @@ def test_fuzz_fabric_json(tmp_path, data):
     path = tmp_path / "fabric.json"
     path.write_text(json.dumps(data.draw(_damaged(_PLUGIN))))
     try:
-        fab = fabric_source(str(path))
+        fab = resolve(str(path)).brdf
     except Exception as exc:  # noqa: BLE001
         _one_line_naming(exc, path)
         return

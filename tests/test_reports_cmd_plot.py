@@ -117,7 +117,7 @@ def test_plot_table_against_preset_and_fit(tmp_path, shared_data):
 
 @pytest.mark.parametrize("argv, message", [
     (["lobes", "velvet", "-o", "x.jpg"], "-o must end in .png, .pdf or .svg"),
-    (["lobes", "denim", "-o", "x.png"], "unknown fabric 'denim'"),
+    (["lobes", "denim", "-o", "x.png"], "FABRIC 'denim': not a preset"),
     (["lobes", "velvet", "--plane", "up", "-o", "x.png"], "--plane: expected warp, weft"),
     (["lobes", "velvet", "--theta-i", "95", "-o", "x.png"], "--theta-i: angles must be in"),
     (["table", "velvet", "-o", "x.png"], "table: no such file 'velvet'"),

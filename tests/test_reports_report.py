@@ -191,7 +191,7 @@ def test_interrupted_report_leaves_nothing(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("kwargs, exc, match", [
-    (dict(fabrics=["velvet", "tweed"]), ValueError, "unknown fabric 'tweed'; valid: linen_plain"),
+    (dict(fabrics=["velvet", "tweed"]), ValueError, "unknown fabric 'tweed'; valid presets are linen_plain"),
     (dict(fabrics=[]), ValueError, "fabrics is empty"),
     (dict(fabrics=["velvet"], sections=["lobes", "poetry"]), ValueError, "unknown section"),
     (dict(fabrics=["velvet"], quality="ultra"), ValueError, "quality"),

@@ -270,8 +270,7 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
         A missing input, a file gonio cannot read, CUReT without samples, an unknown preset,
         or a spec with unknown parameters (naming the table).
     """
-    if preset not in brdf.PRESETS:
-        raise ValueError(f"unknown fabric {preset!r}; valid presets are {', '.join(brdf.PRESETS)}")
+    brdf.check_preset(preset)
     sample_list = parse_samples(samples)
     base = dict(preset=preset, free=None if free is None else tuple(free),
                 ties=None if ties is None else tuple(ties), spec=spec, fit=dict(fit or {}),
@@ -304,9 +303,7 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
 def _check(job: BatchJob) -> None:
     """The preset, its options and the spec of a job, or a ValueError naming the table."""
     try:
-        if job.preset not in brdf.PRESETS:
-            raise ValueError(f"unknown fabric {job.preset!r}; valid presets are "
-                             f"{', '.join(brdf.PRESETS)}")
+        brdf.check_preset(job.preset)
         job.param_spec()
     except ValueError as exc:
         raise ValueError(f"table {job.name} ({job.path}): {exc}") from None

@@ -63,8 +63,8 @@ def resolve_fabrics(fabrics) -> dict:
         if not isinstance(name, str) or not name or "/" in name or name.startswith(".") \
                 or name in _RESERVED:
             raise ValueError(f"fabric name {name!r} cannot name a report page")
-        if fab is None and name not in brdf.PRESETS:
-            raise ValueError(f"unknown fabric {name!r}; valid: {', '.join(brdf.PRESETS)}")
+        if fab is None:
+            brdf.check_preset(name)
         if name in out:
             raise ValueError(f"fabric {name!r} is given twice")
         out[name] = fab

@@ -6,8 +6,10 @@ builds their arrays with NumPy) with vertex normals and texture coordinates chos
 Mitsuba's first tangent ``dp_du``, which the ``microcylinder`` BSDF takes as the warp
 (:mod:`reports.mitsuba`), runs along the warp of :meth:`frame` in the built-in renderer:
 
-- cylinder side and caps, sphere: ``u`` the azimuth about +y, position
+- cylinder side, sphere: ``u`` the azimuth about +y, position
   ``(r sin(2 pi u), y, r cos(2 pi u))``, so ``dp_du`` is along ``(z, 0, -x)``;
+- cylinder caps: ``u`` affine in the coordinate along the caps' constant warp
+  (:meth:`reports.primitives.Cylinder.cap_direction`), so ``dp_du`` is that warp;
 - curtain: ``u`` along x over the height field, ``dp_du`` along ``(1, 0, z_x)``;
 - rectangle: Mitsuba's ``rectangle`` turned so that its local +x (its ``dp_du``) is the warp.
 
@@ -88,13 +90,15 @@ def _cylinder(prim: Cylinder, n: int):
                   _grid_faces(1, n)))
     rings = 8
     rad = np.linspace(0.0, 1.0, rings + 1)[:, None]
+    axis = prim.cap_direction()
     for y, ny in ((prim.height, 1.0), (0.0, -1.0)):
-        # the centre vertex repeated per segment, at the segment's middle u, keeps dp_du
-        # tangential in the innermost triangles too
-        uc = np.where(rad == 0.0, np.minimum(u + 0.5 / n, 1.0)[None, :], u[None, :])
-        cap = _around(prim.radius * rad, 2.0 * np.pi * uc, y)
+        cap = _around(prim.radius * rad, phi[None, :], y)
         nrm = np.broadcast_to([0.0, ny, 0.0], cap.shape)
-        uv = np.stack(np.broadcast_arrays(uc, rad), axis=-1)
+        # u affine in the coordinate along the cap's warp, v across it: dp_du is the
+        # constant warp of the built-in cap (Cylinder.frame), no singular centre
+        along = cap[..., 0] * axis[0] + cap[..., 2] * axis[2]
+        across = cap[..., 2] * axis[0] - cap[..., 0] * axis[2]
+        uv = 0.5 + 0.5 / prim.radius * np.stack([along, across], axis=-1)
         parts.append((cap.reshape(-1, 3), nrm.reshape(-1, 3), uv.reshape(-1, 2),
                       _grid_faces(rings, n)))
     return _join(parts, c)

@@ -22,8 +22,9 @@ Named scenes (:data:`SCENES`, built by :func:`make_scene`):
 ``cylinder``
     An upright cylinder (axis +y) covered in fabric, standing on a grey floor.  Side: warp
     around the cylinder (the azimuthal direction), so ``n x warp`` runs along the axis.
-    Caps: warp tangential (around the axis, concentric circles), so ``n x warp`` is radial
-    (inward on the top cap); at the exact centre the warp falls back to +x.
+    Caps: warp along +x everywhere (:attr:`Cylinder.cap_warp`), a field without the
+    singular centre of a tangential warp, whose anisotropic highlight would show as
+    pie-shaped wedges.
 The curtain and the cylinder are also lit by a dim sky (:class:`reports.envlight.
 EnvironmentLight`, sampled with the fabric's importance sampling and MIS), so their shadows
 are not black; the sphere and the patch have the key light alone.

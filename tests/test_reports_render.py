@@ -142,14 +142,34 @@ def test_cylinder_frames():
     p = np.array([[0.5, 0.5, 0.0], [0.0, 0.3, 0.5], [0.2, 1.0, 0.0], [0.0, 0.0, -0.2]])
     n, u = cyl.frame(p, np.array([0, 0, 1, 2]))
     np.testing.assert_allclose(n, [[1, 0, 0], [0, 0, 1], [0, 1, 0], [0, -1, 0]], atol=1e-15)
-    # warp runs around the +y axis: (z, 0, -x) normalized, on the side and on the caps
-    np.testing.assert_allclose(u, [[0, 0, -1], [1, 0, 0], [0, 0, -1], [-1, 0, 0]], atol=1e-15)
+    # warp runs around the +y axis on the side, (z, 0, -x) normalized; +x on both caps
+    np.testing.assert_allclose(u, [[0, 0, -1], [1, 0, 0], [1, 0, 0], [1, 0, 0]], atol=1e-15)
     # camera rays along -z hit the side (part 0) and from above the top cap (part 1)
     o = np.array([[0.0, 0.5, 5.0], [0.1, 3.0, 0.1]])
     d = np.array([[0.0, 0.0, -1.0], [0.0, -1.0, 0.0]])
     t, part = cyl.intersect(o, d, 1e-9)
     np.testing.assert_allclose(t, [4.5, 2.0])
     assert list(part) == [0, 1]
+
+
+def test_cylinder_cap_warp_is_continuous():
+    """No wedges: on a fine polar grid of the top cap, neighbouring points' warps differ by
+    less than 1 degree everywhere, the centre included (a tangential warp turns by 90
+    degrees between neighbours there and by about 360/segments on every ring)."""
+    cyl = Cylinder(radius=0.5, height=1.0, cap_warp=(1.0, 0.0, 2.0))
+    r = np.linspace(0.0, 0.5, 60)[:, None]
+    phi = np.linspace(0.0, 2 * np.pi, 180)[None, :]
+    p = np.stack(np.broadcast_arrays(r * np.cos(phi), 1.0, r * np.sin(phi)), axis=-1)
+    n, u = cyl.frame(p.reshape(-1, 3), np.ones(p[..., 0].size, np.int8))
+    u = u.reshape(p.shape)
+    for axis in (0, 1):
+        cos = np.sum(np.take(u, range(1, u.shape[axis]), axis) *
+                     np.take(u, range(u.shape[axis] - 1), axis), axis=-1)
+        assert np.degrees(np.arccos(np.clip(cos.min(), -1, 1))) < 1.0
+    np.testing.assert_allclose(np.einsum("ij,ij->i", n, u.reshape(-1, 3)), 0.0, atol=1e-12)
+    np.testing.assert_allclose(u[0, 0], np.array([1.0, 0.0, 2.0]) / np.sqrt(5.0), atol=1e-12)
+    with pytest.raises(ValueError, match="cap_warp"):
+        Cylinder(cap_warp=(0.0, 1.0, 0.0)).cap_direction()
 
 
 def test_sphere_frame_follows_latitude():

@@ -43,7 +43,7 @@ from reports.lights import DirectionalLight, PointLight
 from reports.primitives import Curtain, Cylinder, Plane, Rectangle, Sphere
 from reports.vec3 import unit
 
-__all__ = ["scene_dict", "meshes", "ENV_ROWS", "SEGMENTS"]
+__all__ = ["scene_dict", "meshes", "ENV_ROWS", "SEGMENTS", "LIGHT_SETS"]
 
 #: Rows of the sky's bitmap (its radiance depends on the height of the direction alone).
 ENV_ROWS = 512
@@ -290,7 +290,12 @@ def sky_bitmap(env, rows: int = ENV_ROWS) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(rad[:, None, :], (rows, 4, 3)), np.float32)
 
 
-def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8) -> dict:
+#: The lights a scene dictionary may hold: the key light, the sky, or both.
+LIGHT_SETS = ("both", "key", "sky")
+
+
+def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8,
+               lights="both") -> dict:
     """The ``mi.load_dict`` dictionary of a microcyl scene with cloth of ``fabric``.
 
     Parameters
@@ -306,16 +311,22 @@ def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8) -> dic
     max_depth : int
         The path integrator's longest path (2: direct light only, as the built-in renderer;
         -1: unbounded).
+    lights : {"both", "key", "sky"}
+        The emitters: the key light and the sky, or one of them (a scene of each, rendered
+        and summed, has every path sample both: :func:`reports.mitsuba_render.render_mitsuba`).
 
     Returns
     -------
     dict
         Scene dictionary; the meshes in it are Mitsuba objects of the variant that is set.
     """
+    if lights not in LIGHT_SETS:
+        raise ValueError(f"lights={lights!r} must be one of {', '.join(LIGHT_SETS)}")
     out = {"type": "scene",
            "integrator": {"type": "path", "max_depth": int(max_depth), "hide_emitters": True},
-           "sensor": _sensor(scene.camera, width, height, spp, seed),
-           "light": _light(scene.light, scene.scale)}
+           "sensor": _sensor(scene.camera, width, height, spp, seed)}
+    if lights != "sky":
+        out["light"] = _light(scene.light, scene.scale)
     for k, prim in enumerate(scene.primitives):
         if not isinstance(prim, (Cylinder, Sphere, Curtain, Rectangle, Plane)):
             raise ValueError(f"primitive {prim!r}: the Mitsuba engine has no mesh for it")
@@ -325,6 +336,6 @@ def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8) -> dic
             out[f"shape{k}"] = {**_flat(prim, scene.scale), "bsdf": bsdf}
         else:
             out[f"shape{k}"] = _mesh(f"shape{k}", arrays, mi.load_dict(bsdf))
-    if scene.environment is not None:
+    if scene.environment is not None and lights != "key":
         out["sky"] = {"type": "envmap", "bitmap": mi.Bitmap(sky_bitmap(scene.environment))}
     return out

@@ -43,7 +43,7 @@ from reports.imageio import write_exr, write_png
 from reports.scenes import SCENES, Scene, make_scene
 from reports.tracing import intersect, occluded
 
-__all__ = ["render", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT", "SCENES",
+__all__ = ["render", "cloth_coverage", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT", "SCENES",
            "resolve_fabric", "check_size"]
 
 #: Largest image the renderer accepts, pixels.
@@ -167,13 +167,15 @@ def _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng):
 
 def _shade(scene, fabric, o, d, rng):
     """Radiance (m, 3) of the rays ``(o, d)``: the key light, plus the sky when the scene has
-    an environment light (:mod:`reports.envlight`)."""
-    out = np.zeros((len(o), 3))
+    an environment light (:mod:`reports.envlight`); and whether each ray's first hit is cloth
+    (m,)."""
+    out = np.zeros((len(o), 4))
     hit, p, n, warp, wo, pid_h = _hits(scene, o, d)
     if hit.size == 0:
         return out
     prims = scene.primitives
     cloth = np.array([pr.material == "cloth" for pr in prims])[pid_h]
+    out[hit, 3] = cloth
     albedo = np.array([0.0 if pr.material == "cloth" else pr.albedo for pr in prims])[pid_h]
     rad = _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng)
     if scene.environment is not None:
@@ -182,8 +184,51 @@ def _shade(scene, fabric, o, d, rng):
             scene.environment, prims, fabric, p, n, frame,
             np.einsum("mij,mj->mi", frame, wo), cloth, albedo, rng,
             off=1e-4 * scene.scale, eps=1e-6 * scene.scale, batch=BRDF_BATCH)
-    out[hit] = rad
+    out[hit, :3] = rad
     return out
+
+
+def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
+    """The fraction of each pixel's samples (stratified jitter) whose first hit is cloth.
+
+    The mask of :func:`reports.exposure.auto_exposure` for an image rendered elsewhere
+    (Mitsuba's): camera rays and the first hit alone, no shading.
+
+    Parameters
+    ----------
+    scene : str or Scene
+    width, height, spp : int
+        Image size and samples per pixel.
+    seed : int
+        Seed of the jitter.
+    chunk : int
+        Rays traced at once.
+
+    Returns
+    -------
+    (height, width) float32 ndarray
+
+    Examples
+    --------
+    >>> m = cloth_coverage("patch", 4, 3, spp=1)
+    >>> m.shape, float(m.min())
+    ((3, 4), 1.0)
+    """
+    check_size(width, height, spp)
+    scene = _scene_of(scene, None, None)
+    rng = np.random.default_rng(seed)
+    cloth = np.array([pr.material == "cloth" for pr in scene.primitives])
+    ys, xs = np.mgrid[0:height, 0:width]
+    jx, jy = _sample_offsets(rng, ys.size, spp)
+    sx = (xs.reshape(-1, 1) + jx).ravel()
+    sy = (ys.reshape(-1, 1) + jy).ravel()
+    hits = np.zeros(sx.size)
+    for s in range(0, sx.size, chunk):
+        o, d = scene.camera.rays(sx[s:s + chunk], sy[s:s + chunk], width, height)
+        t, pid, _ = intersect(scene.primitives, np.ascontiguousarray(o),
+                              np.ascontiguousarray(d), 1e-6 * scene.scale)
+        hits[s:s + chunk] = np.isfinite(t) & cloth[np.maximum(pid, 0)]
+    return hits.reshape(height, width, spp).mean(axis=2).astype(np.float32)
 
 
 def _tiles(width, height, tile):
@@ -243,12 +288,12 @@ def _render_tile(tile, ctx=None):
     scene = ctx["scene"]
     o, d = scene.camera.rays(sx, sy, width, height)
     rad = _shade(scene, ctx["fabric"], np.ascontiguousarray(o), np.ascontiguousarray(d), rng)
-    img = rad.reshape(npix, spp, 3).mean(axis=1)
-    return tile, img.reshape(y1 - y0, x1 - x0, 3).astype(np.float32)
+    img = rad.reshape(npix, spp, 4).mean(axis=1)
+    return tile, img.reshape(y1 - y0, x1 - x0, 4).astype(np.float32)
 
 
 def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None,
-           camera=None, seed=0, progress=True, workers=None, tile=64):
+           camera=None, seed=0, progress=True, workers=None, tile=64, mask=False):
     """Render a scene with cloth shaded by ``fabric``.
 
     Parameters
@@ -277,11 +322,16 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
         Processes; default the usable cores.  1 renders in this process.
     tile : int
         Tile edge, pixels.
+    mask : bool
+        Also return the cloth's coverage (for :func:`reports.exposure.auto_exposure`).
 
     Returns
     -------
     (height, width, 3) float32 ndarray
         Linear RGB radiance (W / (m^2 sr) for intensities in W/sr).
+    (height, width) float32 ndarray
+        With ``mask=True``, a second value: the fraction of each pixel's samples whose first
+        hit is cloth.
 
     Raises
     ------
@@ -315,7 +365,7 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
            "spp": int(spp), "seed": int(seed)}
     tiles = _tiles(width, height, tile)
-    image = np.zeros((height, width, 3), np.float32)
+    image = np.zeros((height, width, 4), np.float32)
     workers = min(workers, len(tiles))
     new_bar = functools.partial(progress_bar, len(tiles), desc=f"render {scene.name or 'scene'}",
                                 unit="tile", enabled=progress)
@@ -326,7 +376,8 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
                 bar.update()
     else:
         _render_pool(image, tiles, ctx, workers, new_bar)
-    return image
+    rgb = np.ascontiguousarray(image[..., :3])
+    return (rgb, np.ascontiguousarray(image[..., 3])) if mask else rgb
 
 
 def _scene_of(scene, light, camera) -> Scene:

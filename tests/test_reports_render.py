@@ -295,3 +295,32 @@ def test_unwritable_folder_fails(tmp_path):
         imageio.write_exr(tmp_path / "nope" / "x.exr", np.zeros((1, 1, 3)))
     with pytest.raises(ValueError, match="must be \\(height, width, 3\\)"):
         imageio.write_png(tmp_path / "x.png", np.zeros((3, 3)))
+
+
+def _sphere_view_cosines(scene, width, height):
+    """n . v at each pixel centre's hit on the sphere scene's sphere (nan on a miss), from the
+    ray-sphere quadratic solved here."""
+    ys, xs = np.mgrid[0:height, 0:width]
+    o, d = scene.camera.rays(xs.ravel() + 0.5, ys.ravel() + 0.5, width, height)
+    sph = scene.primitives[0]
+    oc = o - np.asarray(sph.center)
+    b = np.einsum("ij,ij->i", oc, d)
+    disc = b * b - (np.einsum("ij,ij->i", oc, oc) - sph.radius ** 2)
+    t = -b - np.sqrt(np.where(disc > 0, disc, np.nan))
+    n = (oc + t[:, None] * d) / sph.radius
+    return (-np.einsum("ij,ij->i", n, d)).reshape(height, width)
+
+
+@pytest.mark.parametrize("name, rim_brighter", [("velvet", True), ("linen_plain", False)])
+def test_velvet_has_a_bright_rim(name, rim_brighter):
+    """Velvet reads as velvet: on the lit sphere its grazing rim (n . v < 0.35, theta_o > 70
+    deg) is on average at least 3 times as bright as its centre (n . v > 0.9); linen, nearly
+    Lambertian, is the other way round."""
+    from reports.colour import luminance
+    scene = make_scene("sphere")
+    img = render(scene, name, width=96, height=96, spp=4, progress=False, workers=1)
+    cos = _sphere_view_cosines(scene, 96, 96)
+    y = luminance(img)
+    rim, centre = y[cos < 0.35].mean(), y[cos > 0.9].mean()
+    assert (cos < 0.35).sum() > 100 and (cos > 0.9).sum() > 100
+    assert (rim > 3 * centre) if rim_brighter else (centre > rim)

@@ -14,8 +14,9 @@ FABRIC is a preset, a ``microcyl fit`` output folder (the fabric of its posterio
 ``-o out.png`` writes the PNG only.  The PNG's exposure is automatic by default (the 99th
 percentile of the cloth's pixels shown at 0.9, :mod:`reports.exposure`); ``--exposure 1.5``
 gives it in stops (2**1.5 times the linear values), ``--exposure 4x`` as a scale; the EXR stays
-linear and records the exposure in its header (``microcyl_exposure_stops``, ...).  Every argument is checked (scene, fabric and its
-options, size, output folder, engine and variant) before rendering starts.
+linear and records the exposure in its header (``microcyl_exposure_stops``, ...).  Every
+argument is checked (scene, fabric and its options, size, output folder, engine and variant)
+before rendering starts.
 ``--engine mitsuba`` renders the same scene in Mitsuba 3 (:mod:`reports.mitsuba_render`: the
 ``microcylinder`` BSDF, the path integrator with ``--max-depth`` bounces, ``--variant``
 llvm_ad_rgb where LLVM works, else scalar_rgb).

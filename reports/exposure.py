@@ -154,8 +154,8 @@ def exr_attributes(exposure: Exposure) -> dict:
 
     Examples
     --------
-    >>> sorted(exr_attributes(Exposure(1.0)))
-    ['microcyl_exposure', 'microcyl_exposure_mode', 'microcyl_exposure_scale', 'microcyl_exposure_stops']
+    >>> [k.replace("microcyl_exposure", "") for k in sorted(exr_attributes(Exposure(1.0)))]
+    ['', '_mode', '_scale', '_stops']
     """
     return {"microcyl_exposure_stops": float(exposure.stops),
             "microcyl_exposure_scale": float(exposure.scale),

@@ -21,7 +21,8 @@ _PRINT_OPTIONS = np.get_printoptions()
 import colour  # noqa: E402
 np.set_printoptions(**_PRINT_OPTIONS)
 
-__all__ = ["write_exr", "read_exr", "read_exr_attributes", "write_png", "encode_srgb", "check_output"]
+__all__ = ["write_exr", "read_exr", "read_exr_attributes", "write_png", "encode_srgb",
+           "check_output"]
 
 
 def _check_rgb(rgb):

@@ -5,7 +5,9 @@ hit among the scene's primitives, samples the light directly with a shadow ray, 
 cloth with ``fabric.eval(wi_local, wo_local)`` and everything else as Lambertian.  Only
 samples that hit lit cloth reach the BRDF, in batches of one image tile at a time, and tiles
 are spread over the processor cores.  :func:`write_exr` and :func:`write_png` (from
-:mod:`reports.imageio`) save the result.
+:mod:`reports.imageio`) save the result.  ``render(..., mask=True)`` also returns the cloth's
+coverage (the fraction of each pixel's samples whose first hit is cloth), and
+:func:`cloth_coverage` traces it alone, for :func:`reports.exposure.auto_exposure`.
 
 Shading (direct light only: one key-light sample per camera sample, plus the sky when the
 scene has an environment light, :mod:`reports.envlight`, no bounces):
@@ -13,6 +15,8 @@ scene has an environment light, :mod:`reports.envlight`, no bounces):
     L_o = f_r(wi, wo) * E * cos(theta_i) * V  [+ the sky's, by MIS of Fabric.sample and
                                                 cosine directions]
 
+the sky on every sample of a diffuse surface and on ``sky_spp`` samples a pixel of cloth
+(weighted ``spp / sky_spp``), its uniform numbers stratified over the pixel's samples;
 with ``E`` the light's irradiance normal to ``wi`` (point light: ``I / r^2``; disc light:
 ``I cos(theta_l) / r^2``; directional light: its irradiance), ``cos(theta_i) = n . wi``,
 and ``V`` the visibility (0 or 1) from the shadow ray.  Diffuse surfaces use
@@ -23,14 +27,10 @@ the mean of its samples; rays that hit nothing give 0.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import functools
 import multiprocessing
 import os
 import signal
-import threading
-import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
@@ -38,13 +38,15 @@ import numpy as np
 import brdf
 from brdf.protocols import BRDF
 from gonio.progress import progress_bar
+from reports import pixelsamples
 from reports.envlight import environment_radiance
 from reports.imageio import write_exr, write_png
 from reports.scenes import SCENES, Scene, make_scene
 from reports.tracing import intersect, occluded
+from reports.workerexit import exit_with_parent
 
-__all__ = ["render", "cloth_coverage", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT", "SCENES",
-           "resolve_fabric", "check_size"]
+__all__ = ["render", "cloth_coverage", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT",
+           "SCENES", "resolve_fabric", "check_size"]
 
 #: Largest image the renderer accepts, pixels.
 MAX_WIDTH, MAX_HEIGHT = 1280, 720
@@ -106,14 +108,6 @@ def resolve_fabric(fabric, **options):
 
 
 # --------------------------------------------------------------------------- shading
-def _sample_offsets(rng, npix, spp):
-    """Stratified (n-rooks) offsets in [0, 1)^2, shape (npix, spp) each."""
-    k = np.broadcast_to(np.arange(spp), (npix, spp))
-    jx = (k + rng.random((npix, spp))) / spp
-    jy = (rng.permuted(k, axis=1) + rng.random((npix, spp))) / spp
-    return jx, jy
-
-
 def _hits(scene, o, d):
     """The rays' first hits: indices of the rays that hit, points, normals turned toward
     the viewer, warps, directions to the viewer and primitive indices."""
@@ -163,28 +157,6 @@ def _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng):
         out[c] = f * (E[c] * cos_i[c, None])
     out[di] = (albedo[di] / np.pi * cos_i[di])[:, None] * E[di]     # diffuse: albedo / pi
     return out
-
-
-def _lhs(rng, npix, n, dims=4):
-    """Uniform numbers (npix, n, dims) stratified over each pixel's ``n`` samples in every
-    dimension (Latin hypercube)."""
-    strata = np.broadcast_to(np.arange(n), (npix, n))
-    return np.stack([(rng.permuted(strata, axis=1) + rng.random((npix, n))) / n
-                     for _ in range(dims)], axis=-1)
-
-
-def _sky_plan(rng, npix, spp, sky_spp):
-    """How each of a pixel's ``spp`` samples samples the sky: on diffuse surfaces every
-    sample (a cosine direction costs one shadow ray), numbers stratified over the pixel's
-    samples; on cloth ``sky_spp`` samples spread over the pixel's x strata, weighted
-    ``spp / sky_spp``, numbers stratified over them.  Returns the cloth weights (npix * spp,)
-    and the numbers (npix * spp, 4) of diffuse and of cloth hits."""
-    k = (np.arange(sky_spp) * spp) // sky_spp
-    weight = np.zeros((npix, spp))
-    weight[:, k] = spp / sky_spp
-    u_cloth = np.zeros((npix, spp, 4))
-    u_cloth[:, k] = _lhs(rng, npix, sky_spp)
-    return weight.ravel(), _lhs(rng, npix, spp, 2).reshape(-1, 2), u_cloth.reshape(-1, 4)
 
 
 def _shade(scene, fabric, o, d, rng, sky=None):
@@ -246,20 +218,7 @@ def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
     ((3, 4), 1.0)
     """
     check_size(width, height, spp)
-    scene = _scene_of(scene, None, None)
-    rng = np.random.default_rng(seed)
-    cloth = np.array([pr.material == "cloth" for pr in scene.primitives])
-    ys, xs = np.mgrid[0:height, 0:width]
-    jx, jy = _sample_offsets(rng, ys.size, spp)
-    sx = (xs.reshape(-1, 1) + jx).ravel()
-    sy = (ys.reshape(-1, 1) + jy).ravel()
-    hits = np.zeros(sx.size)
-    for s in range(0, sx.size, chunk):
-        o, d = scene.camera.rays(sx[s:s + chunk], sy[s:s + chunk], width, height)
-        t, pid, _ = intersect(scene.primitives, np.ascontiguousarray(o),
-                              np.ascontiguousarray(d), 1e-6 * scene.scale)
-        hits[s:s + chunk] = np.isfinite(t) & cloth[np.maximum(pid, 0)]
-    return hits.reshape(height, width, spp).mean(axis=2).astype(np.float32)
+    return pixelsamples.coverage(_scene_of(scene, None, None), width, height, spp, seed, chunk)
 
 
 def _tiles(width, height, tile):
@@ -273,32 +232,10 @@ def _tiles(width, height, tile):
 _CTX = {}
 
 
-#: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h).
-_PR_SET_PDEATHSIG = 1
-
-
-def _exit_with_parent(parent: int) -> None:
-    """Make this worker die with its parent, even a SIGKILLed one: PR_SET_PDEATHSIG on Linux,
-    else a daemon thread that polls the parent's pid every second."""
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        ok = libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
-    except (OSError, AttributeError):
-        ok = False
-    if os.getppid() != parent:          # the parent died before the request took effect
-        os._exit(1)
-    if not ok:
-        def watch():
-            while os.getppid() == parent:
-                time.sleep(1.0)
-            os._exit(1)
-        threading.Thread(target=watch, daemon=True, name="parent-watchdog").start()
-
-
 def _init_worker(ctx, parent=None):
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent handles Ctrl-C
     parent = os.getppid() if parent is None else parent
-    _exit_with_parent(parent)
+    exit_with_parent(parent)
     _CTX.clear()
     _CTX.update(ctx, parent=parent)
 
@@ -313,12 +250,12 @@ def _render_tile(tile, ctx=None):
     rng = np.random.default_rng([ctx["seed"], index])
     ys, xs = np.mgrid[y0:y1, x0:x1]
     npix = ys.size
-    jx, jy = _sample_offsets(rng, npix, spp)
+    jx, jy = pixelsamples.sample_offsets(rng, npix, spp)
     sx = (xs.reshape(-1, 1) + jx).ravel()
     sy = (ys.reshape(-1, 1) + jy).ravel()
     scene = ctx["scene"]
     o, d = scene.camera.rays(sx, sy, width, height)
-    sky = _sky_plan(rng, npix, spp, ctx["sky_spp"])
+    sky = pixelsamples.sky_plan(rng, npix, spp, ctx["sky_spp"])
     rad = _shade(scene, ctx["fabric"], np.ascontiguousarray(o), np.ascontiguousarray(d), rng,
                  sky)
     img = rad.reshape(npix, spp, 4).mean(axis=1)

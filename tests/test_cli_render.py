@@ -266,7 +266,8 @@ def _png_linear(path):
 
 def test_exposure_is_automatic_from_the_cloth(tmp_path):
     """By default the 99th percentile of max(R, G, B) over the cloth's pixels shows at 0.9 in
-    the PNG (velvet, far darker than its floor); the EXR stays linear and records the stops."""
+    the PNG (velvet: brightened more than 2 stops); the EXR stays linear and records the
+    stops."""
     out = tmp_path / "c.exr"
     assert main(["render", "cylinder", "velvet", "--width", "96", "--height", "54",
                  "--spp", "2", "--quiet", "-o", str(out)]) == 0
@@ -281,8 +282,7 @@ def test_exposure_is_automatic_from_the_cloth(tmp_path):
     assert p99 * 2.0 ** stops == pytest.approx(0.9, rel=0.03)
     png = _png_linear(out.with_suffix(".png"))
     assert np.percentile(png[inside].max(axis=1), 99) == pytest.approx(0.9, abs=0.03)
-    # velvet's floor is brighter than the cloth: exposing for the whole image would be darker
-    assert np.percentile(img.max(axis=2)[~inside], 99) > p99
+    assert stops > 2                     # velvet is dark: the PNG brightens it
 
 
 @pytest.mark.parametrize("given, stops", [("1.5", 1.5), ("4x", 2.0), ("-1", -1.0)])

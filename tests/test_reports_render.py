@@ -324,3 +324,24 @@ def test_velvet_has_a_bright_rim(name, rim_brighter):
     rim, centre = y[cos < 0.35].mean(), y[cos > 0.9].mean()
     assert (cos < 0.35).sum() > 100 and (cos > 0.9).sum() > 100
     assert (rim > 3 * centre) if rim_brighter else (centre > rim)
+
+
+def test_fewer_sky_samples_on_cloth_keep_the_mean():
+    """The sky on 2 of 16 samples a pixel on cloth (weighted 8) estimates the same image as on
+    every sample: the cloth's mean luminance within a tenth of the sky's share of it (linen on
+    the cylinder scene, the sky at least a tenth of its light), and sky_spp out of range is
+    refused."""
+    from reports.colour import luminance
+    scene = make_scene("cylinder")
+    full, cloth = render(scene, "linen_plain", 48, 27, spp=16, progress=False, workers=1,
+                         mask=True)
+    few = render(scene, "linen_plain", 48, 27, spp=16, progress=False, workers=1,
+                 sky_spp=2, seed=1)
+    unlit = render(scene.replace(environment=None), "linen_plain", 48, 27, spp=16,
+                   progress=False, workers=1)
+    c = cloth == 1
+    sky = luminance(full)[c].mean() - luminance(unlit)[c].mean()
+    assert sky > 0.1 * luminance(full)[c].mean()       # the sky matters on this cloth
+    assert luminance(few)[c].mean() == pytest.approx(luminance(full)[c].mean(), abs=0.1 * sky)
+    with pytest.raises(ValueError, match="sky_spp"):
+        render("cylinder", "linen_plain", 8, 8, spp=4, sky_spp=5, progress=False)

@@ -3,7 +3,7 @@
     microcyl render SCENE FABRIC [--masking on|off] [--reweighting on|off]
         [--tangent-samples N] [--tangent-sampling midpoint|control_points]
         [--transmission half_angle|longitudinal] [--gap incident|outgoing] [--rotation DEG]
-        [--width 1280] [--height 720] [--spp 16] [--exposure 0] [--seed 0]
+        [--width 1280] [--height 720] [--spp 16] [--exposure auto|STOPS|SCALEx] [--seed 0]
         [--light-radius R] [--workers N] [--engine builtin|mitsuba] [--variant V]
         [--max-depth N] [--no-progress] [-q] -o out.exr
 
@@ -12,8 +12,12 @@ of its posterior medians, as ``microcyl export`` writes it), such an exported ``
 ``.xml`` file, or a measured ``.bsdf`` or ``.binary`` table (built-in engine)
 (:func:`analysis.sources.resolve`); the variant options given change a fabric further.
 ``-o out.exr`` writes the float32 linear EXR and an sRGB PNG beside it (``out.png``);
-``-o out.png`` writes the PNG only.  Every argument is checked (scene, fabric and its
-options, size, output folder, engine and variant) before rendering starts.
+``-o out.png`` writes the PNG only.  The PNG's exposure is automatic by default (the 99th
+percentile of the cloth's pixels shown at 0.9, :mod:`reports.exposure`); ``--exposure 1.5``
+gives it in stops (2**1.5 times the linear values), ``--exposure 4x`` as a scale; the EXR stays
+linear and records the exposure in its header (``microcyl_exposure_stops``, ...).  Every
+argument is checked (scene, fabric and its options, size, output folder, engine and variant)
+before rendering starts.
 ``--engine mitsuba`` renders the same scene in Mitsuba 3 (:mod:`reports.mitsuba_render`: the
 ``microcylinder`` BSDF, the path integrator with ``--max-depth`` bounces, ``--variant``
 llvm_ad_rgb where LLVM works, else scalar_rgb).
@@ -47,7 +51,10 @@ def register(sub):
     p.add_argument("--width", type=int, default=1280, help="pixels, at most 1280 (1280)")
     p.add_argument("--height", type=int, default=720, help="pixels, at most 720 (720)")
     p.add_argument("--spp", type=int, default=16, help="samples per pixel (16)")
-    p.add_argument("--exposure", type=float, default=0.0, help="PNG exposure, stops (0)")
+    p.add_argument("--exposure", default="auto", metavar="E",
+                   help="PNG exposure: auto (the 99th percentile of the cloth's pixels shown "
+                        "at 0.9), stops (1.5: 2**1.5 times the linear values) or a scale "
+                        "(4x) (auto); recorded in the EXR's header")
     p.add_argument("--seed", type=int, default=0, help="random seed (0)")
     p.add_argument("--light-radius", type=float, default=None, metavar="R",
                    help="turn the scene's point light into a disc of this radius")
@@ -65,10 +72,6 @@ def register(sub):
     p.add_argument("-o", "--output", required=True, metavar="FILE",
                    help="out.exr (writes out.png beside it) or out.png")
     p.set_defaults(func=run)
-
-
-#: Largest |--exposure| in stops: 2**64 already saturates any f_r; 2**1e308 overflows.
-MAX_EXPOSURE = 64
 
 
 #: The engines of ``--engine``.
@@ -102,15 +105,13 @@ def _engine_options(args, fabric):
 def run(args):
     """Check every argument, render, write the files; return 0."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
-    from reports import imageio
+    from reports import exposure, imageio
     from reports.render import check_size, render
     from reports.scenes import make_scene
 
     scene = make_scene(args.scene)
     check_size(args.width, args.height, args.spp)
-    if not (math.isfinite(args.exposure) and abs(args.exposure) <= MAX_EXPOSURE):
-        raise ValueError(f"--exposure {args.exposure}: must be a number of stops in "
-                         f"[-{MAX_EXPOSURE}, {MAX_EXPOSURE}] (2**stops scales the PNG)")
+    stops = exposure.parse_exposure(args.exposure)
     if args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be a non-negative integer")
     out = Path(args.output)
@@ -133,15 +134,18 @@ def run(args):
         image = render_mitsuba(scene, fabric, width=args.width, height=args.height,
                                spp=args.spp, seed=args.seed, max_depth=max_depth,
                                variant=variant, workers=args.workers,
-                               progress=cliutil.progress(args))
+                               progress=cliutil.progress(args), mask=True)
     else:
         image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
-                       seed=args.seed, progress=cliutil.progress(args), workers=args.workers)
+                       seed=args.seed, progress=cliutil.progress(args), workers=args.workers,
+                       mask=True)
+    image, cloth = image
+    expo = exposure.auto_exposure(image, cloth) if stops is None else exposure.Exposure(stops)
     written = []
     if suffix == ".exr":
-        written.append(imageio.write_exr(out, image))
-        written.append(imageio.write_png(out.with_suffix(".png"), image, args.exposure))
+        written.append(imageio.write_exr(out, image, exposure.exr_attributes(expo)))
+        written.append(imageio.write_png(out.with_suffix(".png"), image, expo.stops))
     else:
-        written.append(imageio.write_png(out, image, args.exposure))
-    log.info("wrote " + ", ".join(str(w) for w in written))
+        written.append(imageio.write_png(out, image, expo.stops))
+    log.info(f"{expo.describe()}; wrote " + ", ".join(str(w) for w in written))
     return 0

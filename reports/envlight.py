@@ -65,7 +65,7 @@ def _eval(fabric, wi, wo, batch):
 
 
 def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, rng, *,
-                         off, eps, batch=131072) -> np.ndarray:
+                         off, eps, batch=131072, u=None) -> np.ndarray:
     """Radiance (m, 3) reflected toward the viewer from the sky at points ``p``.
 
     Parameters
@@ -85,10 +85,15 @@ def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, r
     rng : numpy.random.Generator
     off, eps : float
         Lift of shadow-ray origins and the smallest hit distance, scene units.
+    u : ndarray (m, 4), optional
+        Uniform numbers in [0, 1) of the two draws (the cosine direction: ``u[:, :2]``; the
+        fabric's: ``u[:, 2:]``), e.g. stratified over a pixel's samples; default from ``rng``.
     """
     out = np.zeros((len(p), 3))
     to_world = np.swapaxes(frame, 1, 2)
-    w_c = _cosine_local(rng.random((len(p), 2)))
+    if u is None:
+        u = rng.random((len(p), 4))
+    w_c = _cosine_local(u[:, :2])
     wc_world = np.einsum("mij,mj->mi", to_world, w_c)
     sky_c = _visible_sky(env, prims, p, n, wc_world, off, eps)
     d = ~cloth
@@ -103,7 +108,7 @@ def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, r
         return out
     pf_c = np.asarray(fabric.pdf(wo_l[c], w_c[c]))
     out[c] = f_c * (cos_c / (pf_c + pc_c))[:, None] * sky_c[c]
-    w_f, weight, pf_f = fabric.sample(wo_l[c], rng.random((c.size, 2)))
+    w_f, weight, pf_f = fabric.sample(wo_l[c], np.ascontiguousarray(u[c, 2:]))
     up = (w_f[:, 2] > 0) & (pf_f > 0) & np.all(np.isfinite(weight), axis=1)
     k = c[up]
     wf_world = np.einsum("mij,mj->mi", to_world[k], w_f[up])

@@ -21,7 +21,8 @@ _PRINT_OPTIONS = np.get_printoptions()
 import colour  # noqa: E402
 np.set_printoptions(**_PRINT_OPTIONS)
 
-__all__ = ["write_exr", "read_exr", "write_png", "encode_srgb", "check_output"]
+__all__ = ["write_exr", "read_exr", "read_exr_attributes", "write_png", "encode_srgb",
+           "check_output"]
 
 
 def _check_rgb(rgb):
@@ -59,7 +60,7 @@ def _atomic(path, write):
     return path
 
 
-def write_exr(path, rgb):
+def write_exr(path, rgb, attributes=None):
     """Write linear RGB as a float32 OpenEXR file (one ``RGB`` channel group, ZIP).
 
     Parameters
@@ -68,6 +69,9 @@ def write_exr(path, rgb):
         Output file.
     rgb : (height, width, 3) array_like
         Linear radiance; stored as float32.
+    attributes : dict, optional
+        Extra header attributes, name -> float or str (e.g. the exposure,
+        :func:`reports.exposure.exr_attributes`); :func:`read_exr_attributes` reads them.
 
     Returns
     -------
@@ -84,6 +88,11 @@ def write_exr(path, rgb):
     """
     a = np.ascontiguousarray(_check_rgb(rgb), dtype=np.float32)
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    for key, value in (attributes or {}).items():
+        if not isinstance(value, (float, str)) or key in header:
+            raise ValueError(f"EXR attribute {key!r}={value!r}: a new name with a float or "
+                             f"str value expected")
+        header[key] = value
 
     def write(tmp):
         with OpenEXR.File(header, {"RGB": a}) as f:
@@ -108,6 +117,24 @@ def read_exr(path):
             return np.stack([np.asarray(ch[c].pixels, np.float32) for c in "RGB"], axis=-1)
     except (KeyError, RuntimeError) as exc:
         raise ValueError(f"{path}: not a readable RGB OpenEXR file ({exc})") from None
+
+
+def read_exr_attributes(path) -> dict:
+    """The float and str attributes of an OpenEXR file's header (its own and microcyl's).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "x.exr"
+    >>> _ = write_exr(out, np.zeros((1, 1, 3)), {"microcyl_exposure_stops": 1.5})
+    >>> read_exr_attributes(out)["microcyl_exposure_stops"]
+    1.5
+    """
+    try:
+        with OpenEXR.File(str(path)) as f:   # the header is emptied when the file closes
+            return {k: v for k, v in f.header().items() if isinstance(v, (float, str))}
+    except (KeyError, RuntimeError) as exc:
+        raise ValueError(f"{path}: not a readable OpenEXR file ({exc})") from None
 
 
 def encode_srgb(rgb, exposure=0.0):

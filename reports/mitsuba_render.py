@@ -4,8 +4,9 @@ r"""Render microcyl's scenes in Mitsuba 3: the ``mitsuba`` engine of ``microcyl 
 the ``microcylinder`` BSDF (:mod:`reports.mitsuba`) in a scene built from the same camera,
 geometry, key light and sky (:mod:`reports.mitsuba_scene`), with Mitsuba's ``path``
 integrator: every bounce up to ``max_depth`` (8 by default; 2 is direct light alone, what the
-built-in renderer computes), next-event estimation of the key light and the sky, and MIS of
-the BSDF's own draws (``Fabric.sample``'s).
+built-in renderer computes), next-event estimation of the key light and of the sky (in two
+scenes, one per light, whose images are summed), and MIS of the BSDF's own draws
+(``Fabric.sample``'s).
 
 Variants: :func:`pick_variant` takes ``llvm_ad_rgb`` when Dr.Jit finds a usable LLVM, else
 ``scalar_rgb``. Whether LLVM works is asked of a subprocess (:func:`variant_works`): an
@@ -117,7 +118,7 @@ def _check(fabric, max_depth, threads):
 
 
 def render_mitsuba(scene, fabric, width=1280, height=720, spp=16, *, seed=0, max_depth=8,
-                   variant=None, workers=None, progress=True):
+                   variant=None, workers=None, progress=True, mask=False):
     """Render a microcyl scene in Mitsuba 3 with cloth of ``fabric``.
 
     Parameters
@@ -141,12 +142,27 @@ def render_mitsuba(scene, fabric, width=1280, height=720, spp=16, *, seed=0, max
         Dr.Jit's threads (JIT variants); default all cores.
     progress : bool
         A tqdm bar over the passes.
+    mask : bool
+        Also return the cloth's coverage (:func:`reports.render.cloth_coverage`, traced by
+        the built-in renderer's geometry), for :func:`reports.exposure.auto_exposure`.
 
     Returns
     -------
     (height, width, 3) float32 ndarray
         Linear RGB radiance, W / (m^2 sr) for intensities in W/sr (as :func:`reports.render.
         render`).
+    (height, width) float32 ndarray
+        With ``mask=True``, a second value: the fraction of each pixel's samples whose first
+        hit is cloth.
+
+    Notes
+    -----
+    A scene with a sky is rendered as two Mitsuba scenes, one with the key light alone and
+    one with the sky alone, each at ``spp`` samples a pixel, and the two images summed (light
+    transport is linear in the emitters): Mitsuba's path integrator sends each shadow ray to
+    one emitter picked at random, and a lit floor whose rays find the sky half of the time
+    flickers between twice its key light and its sky light.  Each path thus samples both
+    lights; a render costs about twice one scene's at the same ``spp``.
 
     Raises
     ------
@@ -155,7 +171,7 @@ def render_mitsuba(scene, fabric, width=1280, height=720, spp=16, *, seed=0, max
     ValueError
         An unknown scene or fabric, a bad size, spp, seed, depth or variant, before rendering.
     """
-    from reports.render import _scene_of, check_size, resolve_fabric
+    from reports.render import _scene_of, check_size, cloth_coverage, resolve_fabric
 
     check_size(width, height, spp)
     scene = _scene_of(scene, None, None)
@@ -176,13 +192,22 @@ def render_mitsuba(scene, fabric, width=1280, height=720, spp=16, *, seed=0, max
         dr.set_thread_count(workers)
     per_pass = max(1, min(spp, PASS_SAMPLES // (width * height)))
     passes = [per_pass] * (spp // per_pass) + ([spp % per_pass] if spp % per_pass else [])
-    mscene = mi.load_dict(mitsuba_scene.scene_dict(scene, fabric, width, height, per_pass,
-                                                   seed=0, max_depth=max_depth))
+    # one scene per light (key, sky), their images summed: every path samples both lights
+    # (one scene of both would send each shadow ray to one of them, chosen at random)
+    lights = ("key", "sky") if scene.environment is not None else ("both",)
+    mscenes = [mi.load_dict(mitsuba_scene.scene_dict(scene, fabric, width, height, per_pass,
+                                                     seed=0, max_depth=max_depth,
+                                                     lights=which)) for which in lights]
     total = np.zeros((height, width, 3))
-    with progress_bar(len(passes), desc=f"render {scene.name or 'scene'} (mitsuba {variant})",
-                      unit="pass", enabled=progress) as bar:
-        for k, n in enumerate(passes):
-            img = mi.render(mscene, seed=(int(seed) * 1000003 + k) % 2**32, spp=n)
-            total += np.asarray(img, dtype=np.float64)[..., :3] * n
-            bar.update()
-    return (total / spp).astype(np.float32)
+    with progress_bar(len(passes) * len(mscenes), unit="pass", enabled=progress,
+                      desc=f"render {scene.name or 'scene'} (mitsuba {variant})") as bar:
+        for j, mscene in enumerate(mscenes):
+            for k, n in enumerate(passes):
+                img = mi.render(mscene, seed=(int(seed) * 1000003 + 1009 * j + k) % 2**32,
+                                spp=n)
+                total += np.asarray(img, dtype=np.float64)[..., :3] * n
+                bar.update()
+    image = (total / spp).astype(np.float32)
+    if mask:
+        return image, cloth_coverage(scene, width, height, spp=min(spp, 4), seed=seed)
+    return image

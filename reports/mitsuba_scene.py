@@ -6,8 +6,10 @@ builds their arrays with NumPy) with vertex normals and texture coordinates chos
 Mitsuba's first tangent ``dp_du``, which the ``microcylinder`` BSDF takes as the warp
 (:mod:`reports.mitsuba`), runs along the warp of :meth:`frame` in the built-in renderer:
 
-- cylinder side and caps, sphere: ``u`` the azimuth about +y, position
+- cylinder side, sphere: ``u`` the azimuth about +y, position
   ``(r sin(2 pi u), y, r cos(2 pi u))``, so ``dp_du`` is along ``(z, 0, -x)``;
+- cylinder caps: ``u`` affine in the coordinate along the caps' constant warp
+  (:meth:`reports.primitives.Cylinder.cap_direction`), so ``dp_du`` is that warp;
 - curtain: ``u`` along x over the height field, ``dp_du`` along ``(1, 0, z_x)``;
 - rectangle: Mitsuba's ``rectangle`` turned so that its local +x (its ``dp_du``) is the warp.
 
@@ -41,7 +43,7 @@ from reports.lights import DirectionalLight, PointLight
 from reports.primitives import Curtain, Cylinder, Plane, Rectangle, Sphere
 from reports.vec3 import unit
 
-__all__ = ["scene_dict", "meshes", "ENV_ROWS", "SEGMENTS"]
+__all__ = ["scene_dict", "meshes", "ENV_ROWS", "SEGMENTS", "LIGHT_SETS"]
 
 #: Rows of the sky's bitmap (its radiance depends on the height of the direction alone).
 ENV_ROWS = 512
@@ -88,13 +90,15 @@ def _cylinder(prim: Cylinder, n: int):
                   _grid_faces(1, n)))
     rings = 8
     rad = np.linspace(0.0, 1.0, rings + 1)[:, None]
+    axis = prim.cap_direction()
     for y, ny in ((prim.height, 1.0), (0.0, -1.0)):
-        # the centre vertex repeated per segment, at the segment's middle u, keeps dp_du
-        # tangential in the innermost triangles too
-        uc = np.where(rad == 0.0, np.minimum(u + 0.5 / n, 1.0)[None, :], u[None, :])
-        cap = _around(prim.radius * rad, 2.0 * np.pi * uc, y)
+        cap = _around(prim.radius * rad, phi[None, :], y)
         nrm = np.broadcast_to([0.0, ny, 0.0], cap.shape)
-        uv = np.stack(np.broadcast_arrays(uc, rad), axis=-1)
+        # u affine in the coordinate along the cap's warp, v across it: dp_du is the
+        # constant warp of the built-in cap (Cylinder.frame), no singular centre
+        along = cap[..., 0] * axis[0] + cap[..., 2] * axis[2]
+        across = cap[..., 2] * axis[0] - cap[..., 0] * axis[2]
+        uv = 0.5 + 0.5 / prim.radius * np.stack([along, across], axis=-1)
         parts.append((cap.reshape(-1, 3), nrm.reshape(-1, 3), uv.reshape(-1, 2),
                       _grid_faces(rings, n)))
     return _join(parts, c)
@@ -286,7 +290,12 @@ def sky_bitmap(env, rows: int = ENV_ROWS) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(rad[:, None, :], (rows, 4, 3)), np.float32)
 
 
-def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8) -> dict:
+#: The lights a scene dictionary may hold: the key light, the sky, or both.
+LIGHT_SETS = ("both", "key", "sky")
+
+
+def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8,
+               lights="both") -> dict:
     """The ``mi.load_dict`` dictionary of a microcyl scene with cloth of ``fabric``.
 
     Parameters
@@ -302,16 +311,22 @@ def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8) -> dic
     max_depth : int
         The path integrator's longest path (2: direct light only, as the built-in renderer;
         -1: unbounded).
+    lights : {"both", "key", "sky"}
+        The emitters: the key light and the sky, or one of them (a scene of each, rendered
+        and summed, has every path sample both: :func:`reports.mitsuba_render.render_mitsuba`).
 
     Returns
     -------
     dict
         Scene dictionary; the meshes in it are Mitsuba objects of the variant that is set.
     """
+    if lights not in LIGHT_SETS:
+        raise ValueError(f"lights={lights!r} must be one of {', '.join(LIGHT_SETS)}")
     out = {"type": "scene",
            "integrator": {"type": "path", "max_depth": int(max_depth), "hide_emitters": True},
-           "sensor": _sensor(scene.camera, width, height, spp, seed),
-           "light": _light(scene.light, scene.scale)}
+           "sensor": _sensor(scene.camera, width, height, spp, seed)}
+    if lights != "sky":
+        out["light"] = _light(scene.light, scene.scale)
     for k, prim in enumerate(scene.primitives):
         if not isinstance(prim, (Cylinder, Sphere, Curtain, Rectangle, Plane)):
             raise ValueError(f"primitive {prim!r}: the Mitsuba engine has no mesh for it")
@@ -321,6 +336,6 @@ def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8) -> dic
             out[f"shape{k}"] = {**_flat(prim, scene.scale), "bsdf": bsdf}
         else:
             out[f"shape{k}"] = _mesh(f"shape{k}", arrays, mi.load_dict(bsdf))
-    if scene.environment is not None:
+    if scene.environment is not None and lights != "key":
         out["sky"] = {"type": "envmap", "bitmap": mi.Bitmap(sky_bitmap(scene.environment))}
     return out

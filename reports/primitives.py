@@ -141,7 +141,10 @@ class Sphere:
 class Cylinder:
     """An upright (axis +y) closed cylinder: side (part 0), top cap (1), bottom cap (2).
 
-    Warp on the side: around the axis; on the caps: tangential (concentric circles).
+    Warp on the side: around the axis; on the caps: the constant direction ``cap_warp``
+    projected onto the cap's plane, a warp field without a singular point (a tangential warp
+    would turn once around the centre, and an anisotropic fabric would show pie-shaped
+    wedges there).
 
     Parameters
     ----------
@@ -150,6 +153,8 @@ class Cylinder:
     radius, height : float
         Scene units.
     material, albedo : see :class:`Rectangle`.
+    cap_warp : (3,) array_like
+        The caps' warp before its projection onto their plane (not along +y).
     """
 
     center: tuple = (0.0, 0.0, 0.0)
@@ -157,6 +162,22 @@ class Cylinder:
     height: float = 1.0
     material: str = "cloth"
     albedo: float = 0.5
+    cap_warp: tuple = (1.0, 0.0, 0.0)
+
+    def cap_direction(self):
+        """The caps' warp: ``cap_warp`` with its y component removed, unit (3,).
+
+        Examples
+        --------
+        >>> Cylinder(cap_warp=(1.0, 5.0, 1.0)).cap_direction().round(4).tolist()
+        [0.7071, 0.0, 0.7071]
+        """
+        w = np.array(self.cap_warp, float)
+        w[1] = 0.0
+        norm = np.linalg.norm(w)
+        if not norm > 1e-9:
+            raise ValueError(f"cap_warp={self.cap_warp!r} must not be along the axis (+y)")
+        return w / norm
 
     def intersect(self, o, d, tmin):
         """Ray parameter of the first hit (inf on a miss) and the part hit."""
@@ -188,7 +209,8 @@ class Cylinder:
         return np.min(allt, axis=0), part
 
     def frame(self, p, part):
-        """Outward normal and warp (around the axis) at points ``p`` on parts ``part``."""
+        """Outward normal and warp (around the axis on the side, :meth:`cap_direction` on the
+        caps) at points ``p`` on parts ``part``."""
         q = p - np.asarray(self.center, float)
         m = len(p)
         around = np.stack([q[:, 2], np.zeros(m), -q[:, 0]], axis=-1)  # (z, 0, -x): about +y
@@ -199,6 +221,7 @@ class Cylinder:
         n[side] = _unit(radial[side]) if side.any() else n[side]
         n[part == 1, 1] = 1.0
         n[part == 2, 1] = -1.0
+        around[~side] = self.cap_direction()
         return n, _safe_tangent(around, n)
 
 

@@ -5,7 +5,9 @@ hit among the scene's primitives, samples the light directly with a shadow ray, 
 cloth with ``fabric.eval(wi_local, wo_local)`` and everything else as Lambertian.  Only
 samples that hit lit cloth reach the BRDF, in batches of one image tile at a time, and tiles
 are spread over the processor cores.  :func:`write_exr` and :func:`write_png` (from
-:mod:`reports.imageio`) save the result.
+:mod:`reports.imageio`) save the result.  ``render(..., mask=True)`` also returns the cloth's
+coverage (the fraction of each pixel's samples whose first hit is cloth), and
+:func:`cloth_coverage` traces it alone, for :func:`reports.exposure.auto_exposure`.
 
 Shading (direct light only: one key-light sample per camera sample, plus the sky when the
 scene has an environment light, :mod:`reports.envlight`, no bounces):
@@ -13,6 +15,8 @@ scene has an environment light, :mod:`reports.envlight`, no bounces):
     L_o = f_r(wi, wo) * E * cos(theta_i) * V  [+ the sky's, by MIS of Fabric.sample and
                                                 cosine directions]
 
+the sky on every sample of a diffuse surface and on ``sky_spp`` samples a pixel of cloth
+(weighted ``spp / sky_spp``), its uniform numbers stratified over the pixel's samples;
 with ``E`` the light's irradiance normal to ``wi`` (point light: ``I / r^2``; disc light:
 ``I cos(theta_l) / r^2``; directional light: its irradiance), ``cos(theta_i) = n . wi``,
 and ``V`` the visibility (0 or 1) from the shadow ray.  Diffuse surfaces use
@@ -23,14 +27,10 @@ the mean of its samples; rays that hit nothing give 0.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import functools
 import multiprocessing
 import os
 import signal
-import threading
-import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
@@ -38,13 +38,15 @@ import numpy as np
 import brdf
 from brdf.protocols import BRDF
 from gonio.progress import progress_bar
+from reports import pixelsamples
 from reports.envlight import environment_radiance
 from reports.imageio import write_exr, write_png
 from reports.scenes import SCENES, Scene, make_scene
 from reports.tracing import intersect, occluded
+from reports.workerexit import exit_with_parent
 
-__all__ = ["render", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT", "SCENES",
-           "resolve_fabric", "check_size"]
+__all__ = ["render", "cloth_coverage", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT",
+           "SCENES", "resolve_fabric", "check_size"]
 
 #: Largest image the renderer accepts, pixels.
 MAX_WIDTH, MAX_HEIGHT = 1280, 720
@@ -103,14 +105,6 @@ def resolve_fabric(fabric, **options):
 
 
 # --------------------------------------------------------------------------- shading
-def _sample_offsets(rng, npix, spp):
-    """Stratified (n-rooks) offsets in [0, 1)^2, shape (npix, spp) each."""
-    k = np.broadcast_to(np.arange(spp), (npix, spp))
-    jx = (k + rng.random((npix, spp))) / spp
-    jy = (rng.permuted(k, axis=1) + rng.random((npix, spp))) / spp
-    return jx, jy
-
-
 def _hits(scene, o, d):
     """The rays' first hits: indices of the rays that hit, points, normals turned toward
     the viewer, warps, directions to the viewer and primitive indices."""
@@ -162,25 +156,66 @@ def _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng):
     return out
 
 
-def _shade(scene, fabric, o, d, rng):
+def _shade(scene, fabric, o, d, rng, sky=None):
     """Radiance (m, 3) of the rays ``(o, d)``: the key light, plus the sky when the scene has
-    an environment light (:mod:`reports.envlight`)."""
-    out = np.zeros((len(o), 3))
+    an environment light (:mod:`reports.envlight`), on the rays of nonzero weight in ``sky =
+    (weights (m,), uniform numbers (m, 4))`` (None: every ray, weight 1); and whether each
+    ray's first hit is cloth (m,), as a fourth column."""
+    out = np.zeros((len(o), 4))
     hit, p, n, warp, wo, pid_h = _hits(scene, o, d)
     if hit.size == 0:
         return out
     prims = scene.primitives
     cloth = np.array([pr.material == "cloth" for pr in prims])[pid_h]
+    out[hit, 3] = cloth
     albedo = np.array([0.0 if pr.material == "cloth" else pr.albedo for pr in prims])[pid_h]
     rad = _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng)
     if scene.environment is not None:
-        frame = _local(n, warp)
-        rad += environment_radiance(
-            scene.environment, prims, fabric, p, n, frame,
-            np.einsum("mij,mj->mi", frame, wo), cloth, albedo, rng,
-            off=1e-4 * scene.scale, eps=1e-6 * scene.scale, batch=BRDF_BATCH)
-    out[hit] = rad
+        if sky is None:
+            k, w, u = np.arange(hit.size), 1.0, None
+        else:
+            weight, u_diffuse, u_cloth = (a[hit] for a in sky)
+            k = np.nonzero(~cloth | (weight > 0))[0]
+            w = np.where(cloth[k], weight[k], 1.0)[:, None]
+            u = np.where(cloth[k, None], u_cloth[k],
+                         np.concatenate([u_diffuse[k], u_cloth[k, 2:]], axis=1))
+        frame = _local(n[k], warp[k])
+        rad[k] += w * environment_radiance(
+            scene.environment, prims, fabric, p[k], n[k], frame,
+            np.einsum("mij,mj->mi", frame, wo[k]), cloth[k], albedo[k], rng,
+            off=1e-4 * scene.scale, eps=1e-6 * scene.scale, batch=BRDF_BATCH, u=u)
+    out[hit, :3] = rad
     return out
+
+
+def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
+    """The fraction of each pixel's samples (stratified jitter) whose first hit is cloth.
+
+    The mask of :func:`reports.exposure.auto_exposure` for an image rendered elsewhere
+    (Mitsuba's): camera rays and the first hit alone, no shading.
+
+    Parameters
+    ----------
+    scene : str or Scene
+    width, height, spp : int
+        Image size and samples per pixel.
+    seed : int
+        Seed of the jitter.
+    chunk : int
+        Rays traced at once.
+
+    Returns
+    -------
+    (height, width) float32 ndarray
+
+    Examples
+    --------
+    >>> m = cloth_coverage("patch", 4, 3, spp=1)
+    >>> m.shape, float(m.min())
+    ((3, 4), 1.0)
+    """
+    check_size(width, height, spp)
+    return pixelsamples.coverage(_scene_of(scene, None, None), width, height, spp, seed, chunk)
 
 
 def _tiles(width, height, tile):
@@ -194,32 +229,10 @@ def _tiles(width, height, tile):
 _CTX = {}
 
 
-#: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h).
-_PR_SET_PDEATHSIG = 1
-
-
-def _exit_with_parent(parent: int) -> None:
-    """Make this worker die with its parent, even a SIGKILLed one: PR_SET_PDEATHSIG on Linux,
-    else a daemon thread that polls the parent's pid every second."""
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        ok = libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
-    except (OSError, AttributeError):
-        ok = False
-    if os.getppid() != parent:          # the parent died before the request took effect
-        os._exit(1)
-    if not ok:
-        def watch():
-            while os.getppid() == parent:
-                time.sleep(1.0)
-            os._exit(1)
-        threading.Thread(target=watch, daemon=True, name="parent-watchdog").start()
-
-
 def _init_worker(ctx, parent=None):
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent handles Ctrl-C
     parent = os.getppid() if parent is None else parent
-    _exit_with_parent(parent)
+    exit_with_parent(parent)
     _CTX.clear()
     _CTX.update(ctx, parent=parent)
 
@@ -234,18 +247,21 @@ def _render_tile(tile, ctx=None):
     rng = np.random.default_rng([ctx["seed"], index])
     ys, xs = np.mgrid[y0:y1, x0:x1]
     npix = ys.size
-    jx, jy = _sample_offsets(rng, npix, spp)
+    jx, jy = pixelsamples.sample_offsets(rng, npix, spp)
     sx = (xs.reshape(-1, 1) + jx).ravel()
     sy = (ys.reshape(-1, 1) + jy).ravel()
     scene = ctx["scene"]
     o, d = scene.camera.rays(sx, sy, width, height)
-    rad = _shade(scene, ctx["fabric"], np.ascontiguousarray(o), np.ascontiguousarray(d), rng)
-    img = rad.reshape(npix, spp, 3).mean(axis=1)
-    return tile, img.reshape(y1 - y0, x1 - x0, 3).astype(np.float32)
+    sky = pixelsamples.sky_plan(rng, npix, spp, ctx["sky_spp"])
+    rad = _shade(scene, ctx["fabric"], np.ascontiguousarray(o), np.ascontiguousarray(d), rng,
+                 sky)
+    img = rad.reshape(npix, spp, 4).mean(axis=1)
+    return tile, img.reshape(y1 - y0, x1 - x0, 4).astype(np.float32)
 
 
 def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None,
-           camera=None, seed=0, progress=True, workers=None, tile=64):
+           camera=None, seed=0, progress=True, workers=None, tile=64, mask=False,
+           sky_spp=None):
     """Render a scene with cloth shaded by ``fabric``.
 
     Parameters
@@ -274,11 +290,23 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
         Processes; default the usable cores.  1 renders in this process.
     tile : int
         Tile edge, pixels.
+    sky_spp : int, optional
+        Samples of the sky per pixel on cloth, 1 to ``spp`` (default ``spp``): on that many
+        of a pixel's samples, spread over its area and weighted ``spp / sky_spp``, each with
+        one cosine and one fabric direction (numbers stratified over the pixel).  Diffuse
+        surfaces sample the sky on every sample (one cosine direction, stratified over the
+        pixel).  Fewer sky samples make a render of cloth faster: its two shadow rays and the
+        fabric's sampler cost most of a sample.
+    mask : bool
+        Also return the cloth's coverage (for :func:`reports.exposure.auto_exposure`).
 
     Returns
     -------
     (height, width, 3) float32 ndarray
         Linear RGB radiance (W / (m^2 sr) for intensities in W/sr).
+    (height, width) float32 ndarray
+        With ``mask=True``, a second value: the fraction of each pixel's samples whose first
+        hit is cloth.
 
     Raises
     ------
@@ -309,10 +337,14 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     fabric = resolve_fabric(fabric)
     workers = _check_workers(tile, workers)
     _probe(fabric)
+    sky_spp = spp if sky_spp is None else sky_spp
+    if isinstance(sky_spp, bool) or not isinstance(sky_spp, (int, np.integer)) \
+            or not 1 <= sky_spp <= spp:
+        raise ValueError(f"sky_spp={sky_spp!r} must be an integer from 1 to spp={spp}")
     ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
-           "spp": int(spp), "seed": int(seed)}
+           "spp": int(spp), "seed": int(seed), "sky_spp": int(sky_spp)}
     tiles = _tiles(width, height, tile)
-    image = np.zeros((height, width, 3), np.float32)
+    image = np.zeros((height, width, 4), np.float32)
     workers = min(workers, len(tiles))
     new_bar = functools.partial(progress_bar, len(tiles), desc=f"render {scene.name or 'scene'}",
                                 unit="tile", enabled=progress)
@@ -323,7 +355,8 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
                 bar.update()
     else:
         _render_pool(image, tiles, ctx, workers, new_bar)
-    return image
+    rgb = np.ascontiguousarray(image[..., :3])
+    return (rgb, np.ascontiguousarray(image[..., 3])) if mask else rgb
 
 
 def _scene_of(scene, light, camera) -> Scene:

@@ -22,8 +22,9 @@ Named scenes (:data:`SCENES`, built by :func:`make_scene`):
 ``cylinder``
     An upright cylinder (axis +y) covered in fabric, standing on a grey floor.  Side: warp
     around the cylinder (the azimuthal direction), so ``n x warp`` runs along the axis.
-    Caps: warp tangential (around the axis, concentric circles), so ``n x warp`` is radial
-    (inward on the top cap); at the exact centre the warp falls back to +x.
+    Caps: warp along +x everywhere (:attr:`Cylinder.cap_warp`), a field without the
+    singular centre of a tangential warp, whose anisotropic highlight would show as
+    pie-shaped wedges.
 
 The curtain and the cylinder are also lit by a dim sky
 (:class:`reports.envlight.EnvironmentLight`, sampled with the fabric's importance sampling
@@ -77,8 +78,8 @@ class Scene:
 
 def _curtain():
     return Scene(
-        primitives=(Curtain(), Plane(axis=1, offset=0.0, albedo=0.4),
-                    Plane(axis=2, offset=-0.8, albedo=0.4)),
+        primitives=(Curtain(), Plane(axis=1, offset=0.0, albedo=0.18),
+                    Plane(axis=2, offset=-0.8, albedo=0.18)),
         camera=PinholeCamera(position=(0.6, 1.4, 4.2), target=(0.0, 1.15, 0.0), fov=38.0),
         light=PointLight(position=(-1.8, 3.0, 2.6), intensity=24.0, target=(0.0, 1.0, 0.0)),
         name="curtain", scale=2.4, environment=EnvironmentLight())
@@ -87,7 +88,7 @@ def _curtain():
 def _cylinder():
     return Scene(
         primitives=(Cylinder(center=(0.0, 0.0, 0.0), radius=0.55, height=1.2),
-                    Plane(axis=1, offset=0.0, albedo=0.4)),
+                    Plane(axis=1, offset=0.0, albedo=0.18)),
         camera=PinholeCamera(position=(0.0, 1.7, 3.4), target=(0.0, 0.55, 0.0), fov=36.0),
         light=PointLight(position=(-1.6, 2.8, 2.2), intensity=14.0, target=(0.0, 0.6, 0.0)),
         name="cylinder", scale=1.2, environment=EnvironmentLight())

@@ -258,3 +258,65 @@ def test_a_bad_fit_folder_or_dictionary_is_one_line(tmp_path, capsys, content, m
     line = _one_line_error(capsys, status)
     assert match in line and str(source) in line
     assert not (tmp_path / "x.png").exists()
+
+
+# -- exposure ------------------------------------------------------------------------------
+def _interior_cloth(scene_name, width, height):
+    """Pixels whose four corners' camera rays all hit the cloth first (independent of the
+    renderer's coverage mask)."""
+    from reports.scenes import make_scene
+    from reports.tracing import intersect
+    scene = make_scene(scene_name)
+    ys, xs = np.mgrid[0:height + 1, 0:width + 1]
+    o, d = scene.camera.rays(xs.ravel().astype(float), ys.ravel().astype(float), width, height)
+    t, pid, _ = intersect(scene.primitives, np.ascontiguousarray(o), np.ascontiguousarray(d), 1e-9)
+    cloth = np.array([p.material == "cloth" for p in scene.primitives])
+    c = (np.isfinite(t) & cloth[np.maximum(pid, 0)]).reshape(height + 1, width + 1)
+    return c[:-1, :-1] & c[1:, :-1] & c[:-1, 1:] & c[1:, 1:]
+
+
+def _png_linear(path):
+    import colour
+    return colour.cctf_decoding(np.asarray(Image.open(path)) / 255.0, function="sRGB")
+
+
+def test_exposure_is_automatic_from_the_cloth(tmp_path):
+    """By default the 99th percentile of max(R, G, B) over the cloth's pixels shows at 0.9 in
+    the PNG (velvet: brightened more than 2 stops); the EXR stays linear and records the
+    stops."""
+    out = tmp_path / "c.exr"
+    assert main(["render", "cylinder", "velvet", "--width", "96", "--height", "54",
+                 "--spp", "2", "--quiet", "-o", str(out)]) == 0
+    img = imageio.read_exr(out)
+    attrs = imageio.read_exr_attributes(out)
+    assert attrs["microcyl_exposure_mode"] == "auto"
+    stops = attrs["microcyl_exposure_stops"]
+    assert attrs["microcyl_exposure_scale"] == pytest.approx(2.0 ** stops)
+    inside = _interior_cloth("cylinder", 96, 54)
+    assert inside.sum() > 300
+    p99 = np.percentile(img[inside].max(axis=1), 99)
+    assert p99 * 2.0 ** stops == pytest.approx(0.9, rel=0.03)
+    png = _png_linear(out.with_suffix(".png"))
+    assert np.percentile(png[inside].max(axis=1), 99) == pytest.approx(0.9, abs=0.03)
+    assert stops > 2                     # velvet is dark: the PNG brightens it
+
+
+@pytest.mark.parametrize("given, stops", [("1.5", 1.5), ("4x", 2.0), ("-1", -1.0)])
+def test_exposure_override(tmp_path, given, stops):
+    out = tmp_path / "s.exr"
+    assert main(["render", "sphere", "linen_plain", *SMALL, "--exposure", given,
+                 "-o", str(out)]) == 0
+    attrs = imageio.read_exr_attributes(out)
+    assert attrs["microcyl_exposure_mode"] == "manual"
+    assert attrs["microcyl_exposure_stops"] == pytest.approx(stops)
+    img = imageio.read_exr(out)
+    expect = np.round(imageio.encode_srgb(img * 2.0 ** stops) * 255)
+    assert np.array_equal(np.asarray(Image.open(out.with_suffix(".png"))), expect)
+
+
+@pytest.mark.parametrize("given", ["bright", "0x", "-2x", "65", "nan"])
+def test_bad_exposure_is_one_line(tmp_path, capsys, given):
+    status = main(["render", "sphere", "velvet", *SMALL, f"--exposure={given}",
+                   "-o", str(tmp_path / "x.exr")])
+    assert "--exposure" in _one_line_error(capsys, status)
+    assert list(tmp_path.iterdir()) == []

@@ -61,7 +61,9 @@ def test_the_sky_lights_the_curtains_shadow():
     lit = render(scene, "velvet", 64, 36, spp=16, progress=False)
     black = np.all(dark == 0, axis=-1)           # in the key light's shadow (or the sky)
     assert black.mean() > 0.05
-    assert np.mean(lit[black].sum(axis=-1) > 0) > 0.9 and lit[black].mean() > 0.005
+    # the grey backdrop (albedo 0.18) under a whole sky of about 0.06 would show 0.18 * 0.06
+    # = 0.011; in the curtain's shadow it sees a part of the sky
+    assert np.mean(lit[black].sum(axis=-1) > 0) > 0.9 and lit[black].mean() > 0.002
 
 
 def test_the_sky_blends_horizon_to_zenith():

@@ -142,14 +142,34 @@ def test_cylinder_frames():
     p = np.array([[0.5, 0.5, 0.0], [0.0, 0.3, 0.5], [0.2, 1.0, 0.0], [0.0, 0.0, -0.2]])
     n, u = cyl.frame(p, np.array([0, 0, 1, 2]))
     np.testing.assert_allclose(n, [[1, 0, 0], [0, 0, 1], [0, 1, 0], [0, -1, 0]], atol=1e-15)
-    # warp runs around the +y axis: (z, 0, -x) normalized, on the side and on the caps
-    np.testing.assert_allclose(u, [[0, 0, -1], [1, 0, 0], [0, 0, -1], [-1, 0, 0]], atol=1e-15)
+    # warp runs around the +y axis on the side, (z, 0, -x) normalized; +x on both caps
+    np.testing.assert_allclose(u, [[0, 0, -1], [1, 0, 0], [1, 0, 0], [1, 0, 0]], atol=1e-15)
     # camera rays along -z hit the side (part 0) and from above the top cap (part 1)
     o = np.array([[0.0, 0.5, 5.0], [0.1, 3.0, 0.1]])
     d = np.array([[0.0, 0.0, -1.0], [0.0, -1.0, 0.0]])
     t, part = cyl.intersect(o, d, 1e-9)
     np.testing.assert_allclose(t, [4.5, 2.0])
     assert list(part) == [0, 1]
+
+
+def test_cylinder_cap_warp_is_continuous():
+    """No wedges: on a fine polar grid of the top cap, neighbouring points' warps differ by
+    less than 1 degree everywhere, the centre included (a tangential warp turns by 90
+    degrees between neighbours there and by about 360/segments on every ring)."""
+    cyl = Cylinder(radius=0.5, height=1.0, cap_warp=(1.0, 0.0, 2.0))
+    r = np.linspace(0.0, 0.5, 60)[:, None]
+    phi = np.linspace(0.0, 2 * np.pi, 180)[None, :]
+    p = np.stack(np.broadcast_arrays(r * np.cos(phi), 1.0, r * np.sin(phi)), axis=-1)
+    n, u = cyl.frame(p.reshape(-1, 3), np.ones(p[..., 0].size, np.int8))
+    u = u.reshape(p.shape)
+    for axis in (0, 1):
+        cos = np.sum(np.take(u, range(1, u.shape[axis]), axis) *
+                     np.take(u, range(u.shape[axis] - 1), axis), axis=-1)
+        assert np.degrees(np.arccos(np.clip(cos.min(), -1, 1))) < 1.0
+    np.testing.assert_allclose(np.einsum("ij,ij->i", n, u.reshape(-1, 3)), 0.0, atol=1e-12)
+    np.testing.assert_allclose(u[0, 0], np.array([1.0, 0.0, 2.0]) / np.sqrt(5.0), atol=1e-12)
+    with pytest.raises(ValueError, match="cap_warp"):
+        Cylinder(cap_warp=(0.0, 1.0, 0.0)).cap_direction()
 
 
 def test_sphere_frame_follows_latitude():
@@ -260,7 +280,7 @@ def test_area_light_softens_but_keeps_the_lit_level():
     (dict(spp=0), "spp=0 must be an integer from 1"),
     (dict(scene="teapot"), "scene 'teapot' is unknown"),
     (dict(fabric=object()), "must be a preset name or have an eval"),
-    (dict(fabric="tweed"), "fabric 'tweed' is unknown"),
+    (dict(fabric="tweed"), "unknown fabric 'tweed'"),
     (dict(workers=0), "workers=0"),
 ])
 def test_bad_input_fails_at_once(kwargs, match):
@@ -275,3 +295,53 @@ def test_unwritable_folder_fails(tmp_path):
         imageio.write_exr(tmp_path / "nope" / "x.exr", np.zeros((1, 1, 3)))
     with pytest.raises(ValueError, match="must be \\(height, width, 3\\)"):
         imageio.write_png(tmp_path / "x.png", np.zeros((3, 3)))
+
+
+def _sphere_view_cosines(scene, width, height):
+    """n . v at each pixel centre's hit on the sphere scene's sphere (nan on a miss), from the
+    ray-sphere quadratic solved here."""
+    ys, xs = np.mgrid[0:height, 0:width]
+    o, d = scene.camera.rays(xs.ravel() + 0.5, ys.ravel() + 0.5, width, height)
+    sph = scene.primitives[0]
+    oc = o - np.asarray(sph.center)
+    b = np.einsum("ij,ij->i", oc, d)
+    disc = b * b - (np.einsum("ij,ij->i", oc, oc) - sph.radius ** 2)
+    t = -b - np.sqrt(np.where(disc > 0, disc, np.nan))
+    n = (oc + t[:, None] * d) / sph.radius
+    return (-np.einsum("ij,ij->i", n, d)).reshape(height, width)
+
+
+@pytest.mark.parametrize("name, rim_brighter", [("velvet", True), ("linen_plain", False)])
+def test_velvet_has_a_bright_rim(name, rim_brighter):
+    """Velvet reads as velvet: on the lit sphere its grazing rim (n . v < 0.35, theta_o > 70
+    deg) is on average at least 3 times as bright as its centre (n . v > 0.9); linen, nearly
+    Lambertian, is the other way round."""
+    from reports.colour import luminance
+    scene = make_scene("sphere")
+    img = render(scene, name, width=96, height=96, spp=4, progress=False, workers=1)
+    cos = _sphere_view_cosines(scene, 96, 96)
+    y = luminance(img)
+    rim, centre = y[cos < 0.35].mean(), y[cos > 0.9].mean()
+    assert (cos < 0.35).sum() > 100 and (cos > 0.9).sum() > 100
+    assert (rim > 3 * centre) if rim_brighter else (centre > rim)
+
+
+def test_fewer_sky_samples_on_cloth_keep_the_mean():
+    """The sky on 2 of 16 samples a pixel on cloth (weighted 8) estimates the same image as on
+    every sample: the cloth's mean luminance within a tenth of the sky's share of it (linen on
+    the cylinder scene, the sky at least a tenth of its light), and sky_spp out of range is
+    refused."""
+    from reports.colour import luminance
+    scene = make_scene("cylinder")
+    full, cloth = render(scene, "linen_plain", 48, 27, spp=16, progress=False, workers=1,
+                         mask=True)
+    few = render(scene, "linen_plain", 48, 27, spp=16, progress=False, workers=1,
+                 sky_spp=2, seed=1)
+    unlit = render(scene.replace(environment=None), "linen_plain", 48, 27, spp=16,
+                   progress=False, workers=1)
+    c = cloth == 1
+    sky = luminance(full)[c].mean() - luminance(unlit)[c].mean()
+    assert sky > 0.1 * luminance(full)[c].mean()       # the sky matters on this cloth
+    assert luminance(few)[c].mean() == pytest.approx(luminance(full)[c].mean(), abs=0.1 * sky)
+    with pytest.raises(ValueError, match="sky_spp"):
+        render("cylinder", "linen_plain", 8, 8, spp=4, sky_spp=5, progress=False)

@@ -57,7 +57,7 @@ def fake_energy_report(calls):
 
 
 def fake_providers(monkeypatch, calls):
-    def render(scene, fab, width, height, spp, progress):
+    def render(scene, fab, width, height, spp, progress, **_):
         calls.append(("render", scene, getattr(fab, "options", {}).get("masking")))
         return np.full((height, width, 3), 0.25, dtype=np.float32)
 
@@ -211,13 +211,14 @@ def test_unwritable_output_folder(tmp_path):
         rep.build_report(["velvet"], blocker, progress=False)
 
 
-@pytest.mark.parametrize("quality, size", [("default", (640, 360)), ("high", (1280, 720))])
+@pytest.mark.parametrize("quality, size", [("default", (448, 252)), ("high", (1280, 720))])
 def test_renders_size_per_quality(tmp_path, monkeypatch, quality, size):
-    """Renders are 640 x 360 by default and 1280 x 720 at --quality high; each links to
-    itself at full size."""
+    """Renders are 448 x 252 by default and 1280 x 720 at --quality high, 16 spp or more;
+    each links to itself at full size."""
     sizes = []
 
-    def render(scene, fab, width, height, spp, progress):
+    def render(scene, fab, width, height, spp, progress, **_):
+        assert spp >= 16
         sizes.append((width, height))
         return np.full((height, width, 3), 0.25)
 
@@ -241,8 +242,8 @@ def test_renders_engine_is_mitsuba_where_it_runs(tmp_path, monkeypatch, usable):
     calls = []
     monkeypatch.setattr(mitsuba_render, "have_mitsuba", lambda: usable)
     monkeypatch.setattr(mitsuba_render, "variant_works", lambda v: (usable, ""))
-    monkeypatch.setattr(sec_renders, "render", lambda scene, fab, width, height, spp, progress:
-                        calls.append(("builtin", width, height, spp))
+    monkeypatch.setattr(sec_renders, "render", lambda scene, fab, width, height, spp, progress,
+                        **_: calls.append(("builtin", width, height, spp))
                         or np.full((height, width, 3), 0.25))
     monkeypatch.setattr(sec_renders, "render_mitsuba",
                         lambda scene, fab, width, height, spp, variant, progress:

@@ -1,4 +1,4 @@
-"""The "renders" section: the curtain and the cylinder, masking on and off, one exposure.
+"""The "renders" section: the curtain and the cylinder, masking on and off, exposed for the cloth.
 
 The renders are Mitsuba 3's (:func:`reports.mitsuba_render.render_mitsuba`: path tracing, 8
 bounces) where Mitsuba is installed with a usable LLVM (``llvm_ad_rgb``) and the fabric is a
@@ -6,12 +6,18 @@ bounces) where Mitsuba is installed with a usable LLVM (``llvm_ad_rgb``) and the
 light); each caption names its engine. The quality's ``render`` sets the built-in size and
 spp, ``render_mitsuba`` Mitsuba's (None: the built-in renderer unless ``mitsuba`` is asked
 for, at the built-in size); ``render_engine`` (``auto``, ``builtin``, ``mitsuba``) in the
-quality dictionary overrides the choice.
+quality dictionary overrides the choice. The built-in renderer samples the sky on
+:data:`SKY_SPP` of each pixel's samples on cloth (every sample on the backdrop). Each scene is
+exposed automatically for its cloth (:func:`reports.exposure.auto_exposure`: the 99th
+percentile of the cloth's pixels shown at 0.9, the mask traced once per scene and size by
+:func:`reports.render.cloth_coverage`); the cylinder without masking takes the exposure of the
+cylinder with masking, so that the two compare.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import io
 from typing import Any
 
@@ -21,8 +27,9 @@ import numpy as np
 import brdf
 from reports import mitsuba_render
 from reports.colour import luminance, to_srgb
+from reports.exposure import TARGET, auto_exposure
 from reports.mitsuba_render import render_mitsuba
-from reports.render import render
+from reports.render import cloth_coverage, render
 from reports.report.folder import write_file
 from reports.report.markup import join
 from reports.report.page import Page, figure_html
@@ -39,6 +46,8 @@ RENDERS = (("curtain", "curtain", True, "curtain"),
 #: The report's render engines and how each caption names them.
 ENGINES = {"builtin": "built-in renderer (direct light, MIS sky)",
            "mitsuba": "Mitsuba 3 llvm_ad_rgb (path tracing, 8 bounces)"}
+#: Sky samples a pixel on cloth in the built-in renderer's renders (at most spp).
+SKY_SPP = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -48,11 +57,11 @@ class RendersData:
     Attributes
     ----------
     exposure_reference : float
-        The 99th percentile of the first render's non-zero luminance; every render of the
-        fabric is exposed so that it shows at 0.8.
+        The first render's exposure reference: the 99th percentile of max(R, G, B) over its
+        cloth's pixels, shown at 0.9.
     renders : dict
-        File stem -> scene, masking, engine, width, height, spp, exposure (stops),
-        mean_luminance.
+        File stem -> scene, masking, engine, width, height, spp, sky_spp (built-in),
+        exposure (stops), exposure_reference, mean_luminance.
     """
 
     exposure_reference: float
@@ -63,9 +72,10 @@ class RendersData:
         return {"renders": {"exposure_reference": self.exposure_reference, **self.renders}}
 
 
-def _exposure_reference(img: np.ndarray) -> float:
-    y = luminance(img)
-    return float(np.percentile(y[y > 0], 99)) if np.any(y > 0) else 1.0
+@functools.lru_cache(maxsize=8)
+def _cloth_mask(scene: str, width: int, height: int) -> np.ndarray:
+    """The cloth's coverage of a scene at a size: the same for every fabric."""
+    return cloth_coverage(scene, width, height)
 
 
 def _png(img: np.ndarray, exposure: float) -> bytes:
@@ -114,7 +124,8 @@ def _render(engine, scene, fab, width, height, spp):
         img = render_mitsuba(scene, fab, width=width, height=height, spp=spp,
                              variant="llvm_ad_rgb", progress=False)
     else:
-        img = render(scene, fab, width=width, height=height, spp=spp, progress=False)
+        img = render(scene, fab, width=width, height=height, spp=spp, progress=False,
+                     sky_spp=min(spp, SKY_SPP))
     return np.asarray(img, dtype=np.float64)
 
 
@@ -126,7 +137,7 @@ def section_renders(p: Page) -> Section:
     engine = render_engine(p.fabric, choice)
     width, height, spp = p.q.get("render_mitsuba" if engine == "mitsuba" else "render") \
         or p.q["render"]
-    out, stats, ref = [], {}, None
+    out, stats, per_scene = [], {}, {}
     for stem, scene, masking, caption in RENDERS:
         fab = p.fabric
         if not masking:
@@ -134,15 +145,26 @@ def section_renders(p: Page) -> Section:
                 continue
             fab = fab.replace(masking=False)
         img = _render(engine, scene, fab, width, height, spp)
-        if ref is None:  # one exposure for all renders of a fabric
-            ref = _exposure_reference(img)
-        exposure = float(np.log2(0.8 / ref))
-        write_file(p.path(f"render_{stem}.png"), _png(img, exposure))
-        out.append(figure_html(p.rel(f"render_{stem}.png"),
-                               f"{caption}, {ENGINES[engine]}, {width} × {height}, {spp} spp, "
-                               f"exposure {exposure:+.1f} stops (sRGB via colour-science)"))
+        if scene not in per_scene:  # one exposure per scene: masking on and off compare
+            per_scene[scene] = auto_exposure(img, _cloth_mask(scene, width, height))
+        expo = per_scene[scene]
+        write_file(p.path(f"render_{stem}.png"), _png(img, expo.stops))
+        sky = f" (sky: {min(spp, SKY_SPP)} on cloth)" if engine == "builtin" else ""
+        out.append(figure_html(
+            p.rel(f"render_{stem}.png"),
+            f"{caption}, {ENGINES[engine]}, {width} × {height}, {spp} spp{sky}, exposure "
+            f"{expo.stops:+.1f} stops ({_exposure_words(expo)}; sRGB via colour-science)"))
         stats[stem] = {"scene": scene, "masking": masking, "engine": engine,
-                       "width": width, "height": height,
-                       "spp": spp, "exposure": exposure,
+                       "width": width, "height": height, "spp": spp,
+                       "sky_spp": min(spp, SKY_SPP) if engine == "builtin" else None,
+                       "exposure": expo.stops, "exposure_reference": expo.reference,
                        "mean_luminance": float(luminance(img).mean())}
-    return Section(join(out), RendersData(ref, stats))
+    first = next(iter(per_scene.values()), None)
+    return Section(join(out), RendersData(first.reference if first else 1.0, stats))
+
+
+def _exposure_words(expo) -> str:
+    """How the exposure was chosen, as the caption says it."""
+    if expo.cloth:
+        return f"automatic: the cloth's 99th percentile shown at {TARGET:g}"
+    return f"automatic: the image's 99th percentile shown at {TARGET:g}, no cloth in view"

@@ -73,7 +73,7 @@ class Geometry:
     Build one with a constructor of :mod:`gonio.layouts` (:func:`~gonio.layouts.full_grid`,
     :func:`~gonio.layouts.plane`, :func:`~gonio.layouts.rusinkiewicz`,
     :func:`~gonio.layouts.merl`, :func:`~gonio.layouts.pairs`,
-    :func:`~gonio.layouts.pairs_from_angles`) or :meth:`from_spec`.
+    :func:`~gonio.layouts.pairs_from_angles`) or :func:`gonio.geomspec.from_spec`.
 
     Parameters
     ----------
@@ -210,50 +210,6 @@ class Geometry:
                 **self.info}
 
     # --------------------------------------------------------------------- alternative builds
-
-    @classmethod
-    def from_spec(cls, spec: str, rotation: float = 0.0) -> "Geometry":
-        """Build a geometry from a compact string (the command line's ``--geometry``).
-
-        Parameters
-        ----------
-        spec : str
-            One of (angles in degrees)::
-
-                full:STEP                 full grid, all four steps STEP
-                full:STEP:PHI_STEP        theta steps STEP, phi steps PHI_STEP
-                full:TI:PI:TO:PO          four steps
-                plane:WHICH:STEP          plane of incidence; WHICH is warp (0), weft (90),
-                                          45 or an azimuth in degrees; theta_o every STEP
-                plane:WHICH:STEP:T1,T2    ... with these incidence angles
-                rusinkiewicz:STEP         half/difference grid, all four steps STEP
-                rusinkiewicz:TH:PH:TD:PD  four steps
-                merl                      the MERL 90 x 90 x 180 layout
-                merl:STRIDE               ... every STRIDE-th node in each dimension
-                pairs:FILE.csv            a CSV with columns theta_i,phi_i,theta_o,phi_o (deg)
-        rotation : float
-            Sample rotation, radians.
-
-        Raises
-        ------
-        ValueError
-            On an unknown kind or a malformed or out-of-range parameter; the message quotes
-            the spec and the allowed forms.
-
-        Examples
-        --------
-        >>> len(Geometry.from_spec("plane:warp:5"))
-        210
-        >>> Geometry.from_spec("merl:10").params
-        {'stride': 10}
-        >>> Geometry.from_spec("sphere:3")  # doctest: +ELLIPSIS
-        Traceback (most recent call last):
-        ...
-        ValueError: geometry spec 'sphere:3': unknown kind 'sphere'; use full:STEP[:PHI_STEP] | ...
-        """
-        # Imported here: a real cycle, geomspec builds Geometry objects through gonio.layouts.
-        from gonio.geomspec import from_spec
-        return from_spec(spec, rotation=rotation)
 
     @classmethod
     def from_table(cls, table) -> "Geometry":

@@ -118,7 +118,32 @@ def _checked(spec, make):
 
 
 def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
-    """Build a geometry from a compact string; see :meth:`Geometry.from_spec`.
+    """Build a geometry from a compact string (the command line's ``--geometry``).
+
+    Parameters
+    ----------
+    spec : str
+        One of (angles in degrees)::
+
+            full:STEP                 full grid, all four steps STEP
+            full:STEP:PHI_STEP        theta steps STEP, phi steps PHI_STEP
+            full:TI:PI:TO:PO          four steps
+            plane:WHICH:STEP          plane of incidence; WHICH is warp (0), weft (90),
+                                      45 or an azimuth in degrees; theta_o every STEP
+            plane:WHICH:STEP:T1,T2    ... with these incidence angles
+            rusinkiewicz:STEP         half/difference grid, all four steps STEP
+            rusinkiewicz:TH:PH:TD:PD  four steps
+            merl                      the MERL 90 x 90 x 180 layout
+            merl:STRIDE               ... every STRIDE-th node in each dimension
+            pairs:FILE.csv            a CSV with columns theta_i,phi_i,theta_o,phi_o (deg)
+    rotation : float
+        Sample rotation, radians.
+
+    Raises
+    ------
+    ValueError
+        On an unknown kind or a malformed or out-of-range parameter; the message quotes
+        the spec and the allowed forms.
 
     Examples
     --------
@@ -126,6 +151,14 @@ def from_spec(spec: str, rotation: float = 0.0) -> Geometry:
     'full:30:30:30:30'
     >>> from_spec("plane:45:45:0").spec
     'plane:45:45:0'
+    >>> len(from_spec("plane:warp:5"))
+    210
+    >>> from_spec("merl:10").params
+    {'stride': 10}
+    >>> from_spec("sphere:3")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: geometry spec 'sphere:3': unknown kind 'sphere'; use full:STEP[:PHI_STEP] | ...
     """
     def make():
         kind, args, kw = _parse(spec)

@@ -87,7 +87,7 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
         with flat (m, 3) arrays of directions in the sample frame and must return f_r in 1/sr
         (shape (m, 3), or (m,) for grey).
     geometry : Geometry or str
-        The (wi, wo) pairs, or a spec string for :meth:`Geometry.from_spec`. Its rotation
+        The (wi, wo) pairs, or a spec string for :func:`gonio.from_spec`. Its rotation
         turns the sample: directions reach the BRDF turned by -rotation about n.
     instrument : Instrument, optional
         Cones and noise; a noiseless point instrument when None.

@@ -58,7 +58,7 @@ def test_measure_good(tmp_path, written, made, capsys):
     fab = brdf.fabric("velvet", masking=False, tangent_samples=4,
                       tangent_sampling="control_points", transmission="longitudinal",
                       gap="outgoing")
-    ref = gonio.measure(fab, gonio.Geometry.from_spec("plane:warp:30",
+    ref = gonio.measure(fab, gonio.from_spec("plane:warp:30",
                                                       rotation=math.radians(30)),
                         gonio.Instrument(cone_source=1, cone_detector=2, snr=50, floor=0.001),
                         seed=1)

@@ -10,6 +10,7 @@ import gonio
 from gonio import geometry as G
 from gonio import layouts as L
 from gonio.geometry import Geometry
+from gonio.geomspec import from_spec
 
 
 def _unit(rng, n, upper=True):
@@ -260,17 +261,17 @@ def test_subset_keeps_coordinates():
     ("  MERL:30 ", "merl", None),
 ])
 def test_from_spec_good(spec, kind, n):
-    g = Geometry.from_spec(spec, rotation=0.25)
+    g = from_spec(spec, rotation=0.25)
     assert g.kind == kind and g.rotation == 0.25
     if n is not None:
         assert len(g) == n
     # the spec of the result rebuilds the same layout
-    again = Geometry.from_spec(g.spec)
+    again = from_spec(g.spec)
     assert np.array_equal(again.wi_lab, g.wi_lab) and np.array_equal(again.wo_lab, g.wo_lab)
 
 
 def test_from_spec_plane_azimuths():
-    assert np.allclose(Geometry.from_spec("plane:weft:30:30").wi_lab,
+    assert np.allclose(from_spec("plane:weft:30:30").wi_lab,
                        L.plane(90, 30, theta_i=[30]).wi_lab)
 
 
@@ -293,7 +294,7 @@ def test_from_spec_plane_azimuths():
 ])
 def test_from_spec_bad(spec, match):
     with pytest.raises(ValueError, match=match) as exc:
-        Geometry.from_spec(spec)
+        from_spec(spec)
     msg = str(exc.value)
     assert "\n" not in msg
     if spec:
@@ -304,20 +305,20 @@ def test_from_spec_pairs_file(tmp_path):
     f = tmp_path / "p.csv"
     f.write_text("# CUReT-like list\ntheta_i,phi_i,theta_o,phi_o,extra\n"
                  "30,0,30,180,x\n0,0,45,90,y\n95,0,10,0,z\n")
-    g = Geometry.from_spec(f"pairs:{f}")
+    g = from_spec(f"pairs:{f}")
     assert len(g) == 2 and g.info["dropped_below_horizon"] == 1
     assert np.allclose(g.wo[1], [0, math.sin(math.radians(45)), math.cos(math.radians(45))])
     assert g.spec == f"pairs:{f}"
     bad = tmp_path / "bad.csv"
     bad.write_text("theta_i,phi_i,theta_o,phi_o\n10,0,10,0\n10,0,ten,0\n")
     with pytest.raises(ValueError, match="line 3"):
-        Geometry.from_spec(f"pairs:{bad}")
+        from_spec(f"pairs:{bad}")
     nohead = tmp_path / "nohead.csv"
     nohead.write_text("theta_i,phi_i,theta_o\n10,0,10\n")
     with pytest.raises(ValueError, match="phi_o"):
-        Geometry.from_spec(f"pairs:{nohead}")
+        from_spec(f"pairs:{nohead}")
     with pytest.raises(OSError, match="cannot read"):
-        Geometry.from_spec(f"pairs:{tmp_path / 'missing.csv'}")
+        from_spec(f"pairs:{tmp_path / 'missing.csv'}")
 
 
 def test_describe_is_plain():

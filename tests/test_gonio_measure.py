@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import gonio
-from gonio import Geometry, Instrument, measure
+from gonio import Geometry, Instrument, from_spec, measure
 from gonio import geometry as G
 from gonio import layouts as L
 
@@ -281,7 +281,7 @@ def test_meta_is_plain_and_complete():
 
 @pytest.mark.parametrize("spec", ["full:30", "plane:45:15", "merl:9", "rusinkiewicz:30"])
 def test_geometry_from_table(spec):
-    g = Geometry.from_spec(spec, rotation=0.7)
+    g = from_spec(spec, rotation=0.7)
     t = measure(Lambert(), g)
     back = Geometry.from_table(t)
     assert back.kind == g.kind and back.rotation == g.rotation and back.params == g.params

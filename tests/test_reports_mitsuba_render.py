@@ -98,7 +98,7 @@ def test_passes_split_large_sample_counts(monkeypatch):
 @pytest.mark.parametrize("kwargs, match", [
     (dict(width=2000), "width=2000"), (dict(spp=0), "spp=0"), (dict(seed=-1), "seed=-1"),
     (dict(max_depth=0), "max_depth=0"), (dict(variant="gpu_rgb"), "'gpu_rgb' is unknown"),
-    (dict(fabric="tweed"), "fabric 'tweed' is unknown"), (dict(scene="teapot"), "teapot"),
+    (dict(fabric="tweed"), "unknown fabric 'tweed'"), (dict(scene="teapot"), "teapot"),
 ])
 def test_bad_input_is_refused_before_rendering(kwargs, match):
     args = dict(scene="cylinder", fabric="velvet", width=8, height=8, spp=1, progress=False)

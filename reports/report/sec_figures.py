@@ -80,7 +80,7 @@ def section_lobes(p: Page) -> Section:
 
 def section_slices(p: Page) -> Section:
     """Cartesian slices against θo, θh and θd, and θh × θd images (BRDF Explorer)."""
-    fig, axes = new_figure(3, 1, figsize=(15.0, 3.6))
+    fig, axes = new_figure(3, 1, figsize=(11.0, 3.3))
     plot_slice_theta_o(p.fabric, 30.0, 180.0, 0.0, resolution=p.q["lobe"], ax=axes[0], log=True)
     plot_slice_theta_h(p.fabric, 10.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[1])
     plot_slice_theta_d(p.fabric, 0.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[2])
@@ -115,7 +115,7 @@ def _colour_and_lobe3d(p: Page) -> Markup:
 
 def section_hemisphere(p: Page) -> Section:
     """f_r over the viewing hemisphere for three lights, its colour, and the 3-D lobe."""
-    fig, axes = new_figure(3, 1, figsize=(15.0, 4.2))
+    fig, axes = new_figure(3, 1, figsize=(11.0, 3.6))
     plot_hemisphere(p.fabric, 45.0, 0.0, resolution=p.q["hemi"], ax=axes[0])
     plot_hemisphere(p.fabric, 45.0, 90.0, resolution=p.q["hemi"], ax=axes[1])
     plot_hemisphere(p.fabric, 60.0, 45.0, resolution=p.q["hemi"], ax=axes[2])
@@ -145,7 +145,7 @@ def section_masking(p: Page) -> Section:
              "φ = 0° (warp), 45° and 90° (weft)."),
             (80.0, "log", "masking_lobes_grazing.png", "The same at grazing incidence "
              "θi = 80°.")):
-        fig, axes = new_figure(3, 1, figsize=(12.6, 3.1), polar=True)
+        fig, axes = new_figure(3, 1, figsize=(11.0, 3.0), polar=True)
         for ax, phi in zip(axes, PLANES):
             plot_masking_lobes(p.fabric, ti, phi, resolution=p.q["lobe"], ax=ax, scale=scale,
                                legend=False)

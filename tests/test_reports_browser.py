@@ -40,7 +40,9 @@ const min = arguments[0], out = {overflow: 0, broken: [], small_text: [], small_
 const de = document.documentElement;
 out.overflow = de.scrollWidth - de.clientWidth;
 for (const img of document.images) {
-  if (!(img.complete && img.naturalWidth > 0)) { out.broken.push(img.getAttribute('src')); continue; }
+  if (!(img.complete && img.naturalWidth > 0)) {
+    out.broken.push(img.getAttribute('src')); continue;
+  }
   const fp = parseFloat(img.dataset.fontPx || '0');
   if (fp > 0) {
     const shown = img.getBoundingClientRect().width / img.naturalWidth * fp;

@@ -33,8 +33,8 @@ TITLES = {
 #: 3° before the reflectance was added). Angles in degrees; render = (width, height, spp)
 #: of the built-in renderer, render_mitsuba the same for Mitsuba
 #: (reports.report.sec_renders; its path tracing is noisier per sample than the built-in's
-#: direct light, and a sample costs less once LLVM has compiled the kernel, about 20-45 s per fabric, scene and size the first time, then
-#: cached by Dr.Jit in ~/.drjit; None: the built-in renderer unless Mitsuba is asked for by
+#: direct light, and a sample costs less once LLVM has compiled the kernel, about 20-45 s
+#: per fabric, scene and size the first time, then cached by Dr.Jit in ~/.drjit; None: the built-in renderer unless Mitsuba is asked for by
 #: name, as "fast" does, where a compile would cost more than the renders); dpi of the PNG
 #: figures.
 QUALITIES = {

@@ -24,18 +24,19 @@ TITLES = {
     "renders": "Renders", "fit": "Fitting results",
 }
 
-#: Resolutions per quality. "default" keeps plotting near 5 s a preset on 2 cores and renders 640 x
-#: 360 at 4 samples a pixel (the cost of 320 x 180 at 16); "high" is for publication (1280 x 720, 8
-#: spp, finer curves and images; several times slower); "fast" is for tests and previews. The
-#: albedo angles end at 89° (as `microcyl energy`'s do): the reflectance of some presets exceeds 1
-#: only near grazing incidence; "default" samples both albedos every 7.5° and at 85°, 87°, 89° (30
-#: points in all, the cost of the one albedo at every 3° before the reflectance was added). Angles
-#: in degrees; render = (width, height, spp) of the built-in renderer, render_mitsuba the same for
-#: Mitsuba (reports.report.sec_renders; its path tracing is noisier per sample than the built-in's
-#: direct light, and a sample costs less once LLVM has compiled the kernel, about 20-45 s per
-#: fabric, scene and size the first time, then cached by Dr.Jit in ~/.drjit; None: the built-in
-#: renderer unless Mitsuba is asked for by name, as "fast" does, where a compile would cost more
-#: than the renders); dpi of the PNG figures.
+#: Resolutions per quality. "default" keeps plotting near 5 s a preset on 2 cores and renders
+#: 640 x 360 at 4 samples a pixel (the cost of 320 x 180 at 16); "high" is for publication
+#: (1280 x 720, 8 spp, finer curves and images; several times slower); "fast" is for tests
+#: and previews. Angles in degrees; render = (width, height, spp) of the built-in renderer,
+#: render_mitsuba the same for Mitsuba (reports.report.sec_renders; its path tracing is
+#: noisier per sample than the built-in's direct light, and a sample costs less once
+#: LLVM has compiled the kernel, about 20-45 s per fabric, scene and size the first time, then
+#: cached by Dr.Jit in ~/.drjit; None: the built-in renderer unless Mitsuba is asked for by
+#: name, as "fast" does, where a compile would cost more than the renders); dpi of the PNG
+#: figures.
+#: The albedo angles end at 89° (as `microcyl energy`'s do): the reflectance of some presets
+#: exceeds 1 only near grazing incidence; "default" samples both albedos every 7.5° and at 85°,
+#: 87° and 89° (30 points in all: the cost of the one albedo every 3° before).
 QUALITIES = {
     "default": dict(lobe=181, hemi=101, image=90, recip=45, lobe3d=(30, 60),
                     albedo_theta=np.r_[np.arange(0.0, 85.0, 7.5), 85.0, 87.0, 89.0],

@@ -69,7 +69,7 @@ def _albedo(p: Page, reports: list[FabricReport]) -> Markup:
             ax.set_xlabel(f"{angle} (degrees)", fontsize=FONT["label"])
             ax.set_ylabel(f"{name} (unitless)", fontsize=FONT["label"])
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=len(have),
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(have), 3),
                fontsize=FONT["small"], frameon=False)
     out.append(p.figure(fig, "albedo_comparison.png", "Rec. 709 luminance of both directional "
                         "albedos of every fabric: the furnace albedo ρ(wo) against θo (top) and "

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import logging
+import shlex
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -147,7 +149,8 @@ def run_report(args):
     index = build_report(fabrics, args.output, progress=cliutil.progress(args),
                          quality=args.quality,
                          fit_results=fits, measured=args.measured,
-                         render_engine=args.render_engine)
+                         render_engine=args.render_engine,
+                         command=shlex.join(["microcyl", *sys.argv[1:]]))
     labels = [g[0] for g in STANDARD_GEOMETRIES]
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name, src in zip(names, chosen):

@@ -18,7 +18,7 @@ from analysis.energy import VARIANTS, EnergyReport, energy_report
 from analysis.reciprocity import reciprocity_report
 from gonio.atomic import atomic_write
 from reports import cliutil
-from reports.prose import energy_statements, reciprocity_statements
+from reports.prose import energy_statements, energy_summary, reciprocity_statements
 
 log = logging.getLogger("microcyl")
 
@@ -118,6 +118,8 @@ def register(sub):
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes (default: up to 2)")
     p.add_argument("--json", metavar="PATH", help="write the full results as JSON")
+    p.add_argument("--verbose", action="store_true",
+                   help="print the full tables and findings after the summary")
     cliutil.add_quiet_options(p)
     p.set_defaults(func=run_energy)
 
@@ -199,6 +201,16 @@ def format_energy(rep) -> str:
     return "\n".join(lines)
 
 
+def format_energy_summary(doc: dict) -> str:
+    """The summary ``microcyl energy`` prints first (:func:`reports.prose.energy_summary`)."""
+    s = doc["settings"]
+    head = (f"Energy: directional albedos (value +- error bound; angles in degrees; theta "
+            f"{', '.join(f'{t:g}' for t in s['theta_deg'])}; phi "
+            f"{', '.join(f'{p:g}' for p in s['phi_deg'])})")
+    tail = f"({doc['seconds']:.1f} s; the full tables with --verbose, every value with --json)"
+    return "\n".join([head] + energy_summary(doc) + [tail])
+
+
 def run_energy(args) -> int:
     """``microcyl energy``."""
     presets = _presets(args)
@@ -217,7 +229,10 @@ def run_energy(args) -> int:
                         hemispherical=not args.no_hemispherical, furnace=not args.no_furnace,
                         workers=args.workers, progress=cliutil.progress(args))
     doc = document(rep, energy_statements(rep))
-    print(format_energy(doc))
+    print(format_energy_summary(doc))
+    if args.verbose:
+        print()
+        print(format_energy(doc))
     if target is not None:
         write_json(target, doc)
         log.info(f"wrote {target}")

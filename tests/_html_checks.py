@@ -14,6 +14,7 @@ PAYLOADS = [P, '"><img src=x onerror=alert(1)>', "javascript:alert(1)", "' onmou
 TAGS = {"html", "head", "meta", "title", "style", "body", "nav", "h1", "h2", "h3", "p", "a",
         "b", "i", "small", "code", "sub", "section", "figure", "figcaption", "img", "table",
         "thead", "tbody", "tr", "th", "td", "ul", "li", "div", "span", "footer", "br",
+        "link", "main", "header", "article", "dl", "dt", "dd",
         "script"}
 
 

@@ -89,3 +89,29 @@ def test_sanity_reports_a_broken_fabric(monkeypatch, capsys):
     assert main(["sanity", "velvet"]) == 1
     out = capsys.readouterr().out
     assert "velvet: VIOLATIONS" in out and "non-finite" in out
+
+
+def test_energy_prints_a_summary_first_and_the_tables_with_verbose(tmp_path):
+    """As a user runs it: the summary names velvet's reflectance above 1 at grazing incidence
+    in a few lines; --verbose adds the full tables."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(root))
+    base = [sys.executable, "-m", "reports", "energy", "velvet", "--variants", "default",
+            "--theta-step", "45", "--phi", "0", "--no-furnace", "--no-hemispherical",
+            "--workers", "1", "--quiet"]
+    short = subprocess.run(base, capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert short.returncode == 0, short.stderr
+    lines = short.stdout.strip().splitlines()
+    assert len(lines) <= 6
+    assert lines[1].startswith("velvet (default): ENERGY CREATED: reflectance exceeds 1 "
+                               "from theta_i = 89 deg")
+    assert "Directional albedo maxima" not in short.stdout
+    full = subprocess.run(base + ["--verbose"], capture_output=True, text=True, env=env,
+                          cwd=tmp_path)
+    assert full.returncode == 0, full.stderr
+    assert full.stdout.startswith(short.stdout.split("\n(")[0])
+    assert "Directional albedo maxima" in full.stdout and "Findings" in full.stdout

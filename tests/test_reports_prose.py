@@ -49,3 +49,88 @@ def test_reciprocity_statements_compare_variants():
     word = "lower" if d["gap_outgoing"] < d["default"] else "not lower"
     assert f"gap_outgoing median {d['gap_outgoing']:.3f} ({word})" in lines[0]
     assert math.isfinite(d["default"])
+
+
+# -- the report's sentences: each kind on a case where it holds and one where it does not ------
+
+import numpy as np  # noqa: E402
+
+from analysis import albedo_curve  # noqa: E402
+import brdf  # noqa: E402
+from reports.prose import (albedo_exceeds, albedo_sentence, energy_summary,  # noqa: E402
+                           energy_verdict, overview_sentence)
+
+_T = [0.0, 60.0, 89.0]
+
+
+def _grazing_reflectance(name):
+    """The default variant's directional reflectance at theta_i = 0, 60, 89 deg, phi = 0."""
+    c = albedo_curve(brdf.fabric(name), _T, 0.0, swap=True, workers=1)
+    return np.asarray(c.value).reshape(3, -1), np.asarray(c.error).reshape(3, -1)
+
+
+def test_the_reflectance_sentence_on_velvet_says_where_and_how_much_it_exceeds_one():
+    """velvet's reflectance grows like 1/cos(theta_i) toward the horizon (prose._energy_grazing)
+    and exceeds 1 at 89 deg; the sentence names that angle and the value computed here."""
+    v, e = _grazing_reflectance("velvet")
+    assert v[2].max() - e[2].max() > 1.0 > v[:2].max()     # independent of the sentence
+    s = albedo_sentence("reflectance", _T, v, e)
+    assert s.startswith("The directional reflectance ρ'(wi) exceeds 1 from θi = 89°, up to ")
+    assert f"{v.max():.3f} at θi = 89°" in s
+    assert "at or below" not in s
+
+
+def test_the_reflectance_sentence_on_a_lambertian_half_albedo_says_at_or_below_one():
+    """A Lambertian surface of albedo 0.5 reflects 0.5 from every direction."""
+    v = np.full((3, 3), 0.5)
+    s = albedo_sentence("reflectance", _T, v, np.full_like(v, 1e-4))
+    assert "stays at or below 1" in s and "at most 0.500" in s and "exceeds" not in s
+
+
+def test_the_furnace_sentence_both_ways_and_within_the_error():
+    th = [0.0, 30.0, 60.0, 85.0]
+    over = np.array([[0.9], [0.95], [1.2], [1.1]])
+    s = albedo_sentence("furnace", th, over, np.full_like(over, 0.01))
+    # 60 exceeds, 85 exceeds too: "from"; the maximum 1.2 is at 60
+    assert "The furnace albedo ρ(wo) exceeds 1 from θo = 60°, up to 1.200 at θo = 60°." == s
+    gap = np.array([[0.9], [1.2], [0.8], [1.1]])
+    s = albedo_sentence("furnace", th, gap, np.full_like(gap, 0.01))
+    assert "at 2 of the 4 angles θo on the grid, the first 30°" in s
+    near = np.array([[0.9], [0.995], [0.9], [0.9]])
+    s = albedo_sentence("furnace", th, near, np.full_like(near, 0.01))
+    assert "within its error bound of 1" in s and "exceeds 1 " not in s
+
+
+def test_verdicts_and_the_overview_sentence_count_what_exceeds():
+    over = albedo_exceeds([0, 89], [[0.5], [4.6]], [[1e-3], [1e-3]])
+    ok = albedo_exceeds([0, 89], [[0.5], [0.6]], [[1e-3], [1e-3]])
+    assert energy_verdict(ok, over) == "reflectance exceeds 1 (up to 4.60 at θi = 89°)"
+    assert energy_verdict(ok, ok) == "both albedos at or below 1"
+    s = overview_sentence({"velvet": {"furnace": ok, "reflectance": over},
+                           "linen": {"furnace": ok, "reflectance": ok}, "x": {}})
+    assert "exceeds 1 for 1 of 2 fabrics (velvet up to 4.6 at θi = 89°)" in s
+    assert "stays at or below 1 for all 2" in s
+    s = overview_sentence({"linen": {"furnace": ok, "reflectance": ok}})
+    assert "exceeds" not in s
+
+
+def test_energy_summary_names_the_largest_reflectance_and_the_verdict():
+    def curve(p, mode, top, variant="default"):
+        v = np.full((2, 1, 3), 0.4)
+        v[1, 0, 0] = top
+        return {"preset": p, "variant": variant, "mode": mode, "theta_deg": [0.0, 89.0],
+                "value": v.tolist(), "error": np.full_like(v, 1e-3).tolist(),
+                "exceeds_one": top - 1e-3 > 1, "possibly_exceeds_one": top + 1e-3 > 1,
+                "max": {"value": top, "error": 1e-3, "theta_deg": 89.0, "phi_deg": 0.0,
+                        "channel": 0}}
+    doc = {"settings": {"modes": ["furnace", "reflectance"]}, "furnace": [],
+           "curves": [curve("velvet", "furnace", 0.85), curve("velvet", "reflectance", 4.6),
+                      curve("linen", "furnace", 0.7), curve("linen", "reflectance", 0.8),
+                      curve("linen", "reflectance", 1.3, "masking_off")]}
+    lines = energy_summary(doc)
+    assert lines[0] == ("velvet (default): ENERGY CREATED: reflectance exceeds 1 from "
+                        "theta_i = 89 deg, up to 4.600")
+    assert "largest 4.600 +- 1e-03 at theta_i = 89, phi = 0 (R)" in lines[1]
+    assert "furnace albedo rho(wo) 0.400 - 0.850" in lines[2]
+    assert lines[3] == "linen (default): ok: both albedos at or below 1"
+    assert lines[-1] == "other variants: 1 of 1 curves exceed 1 (linen/masking_off/reflectance)."

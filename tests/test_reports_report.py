@@ -24,7 +24,7 @@ FABRICS = ["velvet", "silk_crepe_de_chine"]
 class _Links(HTMLParser):
     def __init__(self):
         super().__init__()
-        self.links, self.sections = [], []
+        self.links, self.sections, self.cards = [], [], []
 
     def handle_starttag(self, tag, attrs):
         a = dict(attrs)
@@ -34,6 +34,8 @@ class _Links(HTMLParser):
             self.links.append(a["href"].split("#")[0])
         if tag == "section":
             self.sections.append((a.get("id"), a.get("class"), a.get("data-fabric")))
+        if tag == "article":
+            self.cards.append(a.get("id"))
 
 
 def parse(path: Path) -> _Links:
@@ -49,9 +51,10 @@ def fake_energy_report(calls):
         t = np.radians(np.asarray(theta_deg))[:, None, None]
         value = np.broadcast_to(0.5 * np.cos(t) * np.array([1.0, 0.8, 0.6]),
                                 (len(theta_deg), len(phi_deg), 3)).copy()
-        curve = {"preset": presets[0], "variant": variants[0], "mode": "furnace",
-                 "value": value.tolist(), "error": np.full_like(value, 1e-3).tolist()}
-        return EnergyReport(settings={}, curves=[curve], hemispherical=[], furnace=[],
+        curves = [{"preset": presets[0], "variant": variants[0], "mode": m,
+                   "value": value.tolist(), "error": np.full_like(value, 1e-3).tolist()}
+                  for m in kw.get("modes", ("furnace",))]
+        return EnergyReport(settings={}, curves=curves, hemispherical=[], furnace=[],
                             seconds=0.0)
     return energy_report
 
@@ -87,8 +90,7 @@ def test_report_has_a_section_per_preset_and_every_link_exists(built):
     out, index, calls = built
     assert index == out / "index.html"
     idx = parse(index)
-    fabric_sections = [s for s in idx.sections if s[1] == "fabric"]
-    assert [s[0] for s in fabric_sections] == [f"fabric-{n}" for n in FABRICS]
+    assert idx.cards == [f"fabric-{n}" for n in FABRICS]      # one card per fabric
     pages = [index] + [out / f"{n}.html" for n in FABRICS]
     n_images = 0
     for page in pages:
@@ -155,14 +157,14 @@ def test_a_brdf_that_is_no_preset_gets_its_albedo_and_says_what_is_not_available
     page = (tmp_path / "rep" / "standin.html").read_text()
     assert page.count("Not available") == 2          # masking (no replace) and fit
     assert "replace(masking" in page and "results.json" in page
-    assert "Albedo compared" in index.read_text()
+    assert "Albedos compared" in index.read_text()
     assert (tmp_path / "rep" / "standin" / "parameters.json").is_file()
     energy = json.loads((tmp_path / "rep" / "summary.json").read_text())[
         "fabrics"]["standin"]["energy"]
     # a Lambertian surface of albedo A reflects exactly A in every direction
     assert energy["max"] == pytest.approx(0.5, abs=1e-3)
     assert np.asarray(energy["value"]) == pytest.approx(
-        np.broadcast_to([0.5, 0.4, 0.3], (3, 2, 3)), abs=1e-3)
+        np.broadcast_to([0.5, 0.4, 0.3], (4, 2, 3)), abs=1e-3)
 
 
 def test_rerun_replaces_a_report_but_never_another_folder(tmp_path, monkeypatch):
@@ -279,4 +281,6 @@ def test_page_is_a_grid_of_clickable_figures(built):
     for fig in figures:
         src = fig.split('<img src="', 1)[1].split('"', 1)[0]
         assert f'<a href="{src}"' in fig.split("<img", 1)[0]
-    assert "display:grid" in page and "minmax(min(100%,560px),1fr)" in page
+    assert '<link rel="stylesheet" href="report.css">' in page
+    css = (out / "report.css").read_text(encoding="utf-8")
+    assert "display:grid" in css and "minmax(min(100%,560px),1fr)" in css

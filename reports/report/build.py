@@ -14,12 +14,17 @@ from gonio.atomic import file_mode
 from gonio.progress import progress_bar
 from reports.report.folder import (check_output_dir, check_report_folder, make_build_folder,
                                    swap_into_place, write_file, write_marker)
-from reports.report.markup import Markup, html, join, nav, now, page, plain_json, swatch, url
+from reports._plotting import series_styles
+from reports.report.cards import cards
+from reports.report.markup import (CSS_NAME, Markup, html, join, nav, now, page, plain_json,
+                                   run_header, stylesheet, swatch, version)
 from reports.report.overview import overview
 from reports.report.page import Page
-from reports.report.sec_renders import check_engine
+from reports.report.sec_energy import EnergyData
+from reports.report.sec_renders import ENGINES, RendersData, check_engine
 from reports.report.sections import FabricReport, run_section
-from reports.report.settings import QUALITIES, SECTIONS, TITLES
+from reports.prose import overview_sentence
+from reports.report.settings import QUALITIES, SECTIONS
 from reports.report_measured import measured_page, overview_table, read_measured
 
 __all__ = ["build_report", "resolve_fabrics"]
@@ -92,18 +97,38 @@ def _fabric_page(tmp: Path, name: str, given, sections, q, fit_results, bar) -> 
     return rep
 
 
-def _fabric_html(rep: FabricReport) -> Markup:
-    return (html("<p>{}Fabric <b>{}</b>.</p>", swatch(rep.fabric), rep.name)
-            + join(r.html(rep.name) for r in rep.runs))
+def _engines(reports: list[FabricReport]) -> str:
+    """The render engines the report used, in words."""
+    used = {v.get("engine") for r in reports if (d := r.data(RendersData)) is not None
+            for v in (getattr(d, "renders", None) or {}).values()}
+    used.discard(None)
+    if not used:
+        return "no renders (the renders section was not built)"
+    return "; ".join(ENGINES.get(e, str(e)) for e in sorted(used))
 
 
-def _index_fabrics(reports: list[FabricReport]) -> Markup:
-    return join(
-        html('<section class="fabric" id="fabric-{name}"><h2>{swatch}<a href="{href}">{name}'
-             "</a></h2><ul>{items}</ul></section>", name=r.name, swatch=swatch(r.fabric),
-             href=url(f"{r.name}.html"),
-             items=join(html("<li>{}: {}</li>", TITLES[s.name], s.status) for s in r.runs))
-        for r in reports)
+def _lede(reports: list[FabricReport]) -> str:
+    """The overview's first sentences: what the report holds and what the albedos show."""
+    findings = {r.name: (e.findings() if (e := r.data(EnergyData)) is not None else {})
+                for r in reports}
+    return (f"{len(reports)} fabric{'s' if len(reports) != 1 else ''} of the microcylinder "
+            "cloth model (Sadeghi et al. 2013), each on its own page with its lobes, "
+            "albedos, reciprocity, sanity checks and renders. " + overview_sentence(findings))
+
+
+def _run_info(reports, quality: str, command: str | None, generated: str) -> dict:
+    """What was run, for every page's header."""
+    return {"microcyl": version(), "generated": generated,
+            "command": ("code", command or "reports.report.build_report(...) (Python)"),
+            "renders": _engines(reports), "quality": quality}
+
+
+def _fabric_header(rep: FabricReport, colour, run: dict) -> Markup:
+    e = rep.data(EnergyData)
+    lede = html("{} of the microcylinder cloth model (Sadeghi et al. 2013); energy: {}.",
+                "A preset fabric" if rep.name in brdf.PRESETS else "A fabric", 
+                e.verdict() if e is not None else "not computed (no energy section)")
+    return run_header(rep.name, lede, run, swatch(colour))
 
 
 def _measured(tmp: Path, title: str, names, measured_fits) -> tuple[Markup, dict]:
@@ -117,31 +142,38 @@ def _measured(tmp: Path, title: str, names, measured_fits) -> tuple[Markup, dict
 
 
 def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,
-           measured_fits, title: str, progress: bool, render_engine: str = "auto") -> None:
+           measured_fits, title: str, progress: bool, render_engine: str = "auto",
+           command: str | None = None) -> None:
     """Write the whole report into ``tmp``."""
     t_start = time.perf_counter()
+    generated = now()
     q = dict(QUALITIES[quality], render_engine=render_engine)
     names = list(resolved)
+    colours = {n: st["color"] for n, st in series_styles(names).items()}
     has_measured = measured_fits is not None
     bar = progress_bar(len(names) * len(sections) + 1, desc="report", unit="section",
                        enabled=progress)
-    reports = []
-    for name, given in resolved.items():
-        rep = _fabric_page(tmp, name, given, sections, q, fit_results, bar)
-        reports.append(rep)
-        write_file(tmp / f"{name}.html", page(f"{title}: {name}",
-                                              nav(names, name, has_measured), _fabric_html(rep)))
+    reports = [_fabric_page(tmp, name, given, sections, q, fit_results, bar)
+               for name, given in resolved.items()]
+    run = _run_info(reports, quality, command, generated)
+    write_file(tmp / CSS_NAME, stylesheet())
+    for rep in reports:
+        write_file(tmp / f"{rep.name}.html",
+                   page(f"{title}: {rep.name}", nav(names, rep.name, has_measured),
+                        join(r.html(rep.name) for r in rep.runs),
+                        _fabric_header(rep, colours[rep.name], run)))
     bar.set_description("overview")
-    body = overview(tmp, reports, sections, q)
+    body = cards(tmp, reports, colours) + overview(tmp, reports, sections, q, colours)
     measured_summary = None
     if has_measured:
         section, measured_summary = _measured(tmp, title, names, measured_fits)
         body += section
-    write_file(tmp / "index.html", page(title, nav(names, None, has_measured),
-                                        body + _index_fabrics(reports)))
+    write_file(tmp / "index.html", page(title, nav(names, None, has_measured), body,
+                                        run_header(title, _lede(reports), run)))
     bar.update(1)
     bar.close()
-    doc = {"title": title, "generated": now(), "quality": quality, "sections": sections,
+    doc = {"title": title, "generated": generated, "microcyl": version(), "command": command,
+           "quality": quality, "sections": sections,
            "fabrics": {r.name: r.summary() for r in reports},
            "seconds": round(time.perf_counter() - t_start, 2)}
     if measured_summary is not None:
@@ -152,7 +184,8 @@ def _write(tmp: Path, resolved: dict, sections, quality: str, fit_results: dict,
 
 def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True,
                  quality="default", fit_results=None, measured=None,
-                 title="microcyl report", render_engine="auto") -> Path:
+                 title="microcyl report", render_engine="auto",
+                 command: str | None = None) -> Path:
     """Write the HTML report on ``fabrics`` to ``out_dir``; return the path of index.html.
 
     Parameters
@@ -180,6 +213,9 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
     render_engine : {"auto", "builtin", "mitsuba"}
         The renders' engine (:func:`reports.report.sec_renders.render_engine`): ``auto`` is
         Mitsuba 3 where it runs in llvm_ad_rgb, else the built-in renderer.
+    command : str, optional
+        The command line that asked for the report, shown in every page's header (the
+        CLI passes its own; default: the Python call).
 
     Returns
     -------
@@ -218,7 +254,7 @@ def build_report(fabrics=None, out_dir="report", *, sections=None, progress=True
         try:
             os.chmod(tmp, file_mode(0o777))
             _write(tmp, resolved, sections, quality, fits, measured_fits, title, progress,
-                   render_engine)
+                   render_engine, command)
             swap_into_place(tmp, out)
         except BaseException:
             shutil.rmtree(tmp, ignore_errors=True)

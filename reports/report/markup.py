@@ -8,28 +8,33 @@ escapes a body that is not Markup.
 from __future__ import annotations
 
 import datetime
+import importlib.metadata
+from importlib import resources
 
 import numpy as np
 
 from gonio.jsonplain import plain
-from reports.colour import fabric_colour
 from reports.safehtml import Markup, html, join, table, text, url
 
 __all__ = ["plain_json", "table", "fmt", "swatch", "nav", "page", "now", "not_available",
-           "html", "join", "text", "url", "Markup"]
+           "html", "join", "text", "url", "Markup", "CSS_NAME", "stylesheet", "version",
+           "run_header"]
 
-_CSS = Markup("""
-body{font-family:system-ui,sans-serif;max-width:1400px;margin:1em auto;padding:0 1em;color:#222}
-h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
-section{display:grid;grid-template-columns:repeat(auto-fill,minmax(min(100%,560px),1fr));
-gap:.4em 1.2em;align-items:start}section>:not(figure){grid-column:1/-1}
-figure{margin:0;min-width:0}
-figure a{display:block;cursor:zoom-in}figure img{width:100%;height:auto;border:1px solid #eee}
-figcaption{font-size:.85em;color:#555}
-table{border-collapse:collapse;font-size:.9em;margin:.5em 0}td,th{border:1px solid #ccc;padding:.2em .5em}
-th{background:#f4f4f4}.na{color:#a33}nav a{margin-right:1em}.swatch{display:inline-block;width:1em;
-height:1em;border:1px solid #999;vertical-align:middle;margin-right:.3em}
-""")
+#: The report's stylesheet (package data), copied beside the pages as :data:`CSS_NAME`.
+CSS_NAME = "report.css"
+
+
+def stylesheet() -> str:
+    """The text of the report's one stylesheet, ``reports/report/report.css``."""
+    return resources.files("reports.report").joinpath(CSS_NAME).read_text(encoding="utf-8")
+
+
+def version() -> str:
+    """microcyl's installed version, or "unknown (not installed)"."""
+    try:
+        return importlib.metadata.version("microcyl")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown (not installed)"
 
 
 def plain_json(obj):
@@ -63,10 +68,24 @@ def not_available(reason: str) -> Markup:
     return html('<p class="na">Not available: {}</p>', reason)
 
 
-def swatch(fab) -> Markup:
-    """A square in the fabric's sRGB colour (:func:`reports.colour.fabric_colour`)."""
-    r, g, b = (int(round(255 * c)) for c in fabric_colour(fab))
-    return html('<span class="swatch" style="background:rgb({},{},{})"></span>', r, g, b)
+def swatch(colour) -> Markup:
+    """A square in ``colour``: a fabric's colour in the plots (``#rrggbb``, from
+    :func:`reports._plotting.series_styles`), so that a swatch and its curve match.
+
+    Examples
+    --------
+    >>> swatch("#0072B2")
+    Markup('<span class="swatch" style="background:#0072B2"></span>')
+    >>> swatch((1.0, 0.5, 0.0))
+    Markup('<span class="swatch" style="background:#ff8000"></span>')
+    """
+    if not isinstance(colour, str):
+        colour = "#" + "".join(f"{int(round(255 * min(max(float(c), 0.0), 1.0))):02x}"
+                               for c in colour)
+    if not (len(colour) == 7 and colour[0] == "#" and
+            all(c in "0123456789abcdefABCDEF" for c in colour[1:])):
+        raise ValueError(f"swatch colour must be #rrggbb; got {colour!r}")
+    return html('<span class="swatch" style="background:{}"></span>', colour)
 
 
 def nav(names, current=None, measured=False) -> Markup:
@@ -93,19 +112,36 @@ def now() -> str:
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
 
 
-def page(title: str, nav_html: Markup, body: Markup) -> str:
-    """A whole HTML page: title, navigation, body and a dated footer.
+def run_header(title: str, lede, run: dict, mark: Markup = Markup("")) -> Markup:
+    """The top of a page: its title (after ``mark``, e.g. a swatch), a lede (Markup or
+    text) and what was run (label -> value, each shown as text; a value of
+    ``("code", text)`` in code type)."""
+    rows = join(html("<dt>{}</dt><dd>{}</dd>", k,
+                     html("<code>{}</code>", v[1]) if isinstance(v, tuple) else v)
+                for k, v in run.items())
+    return html('<header class="run"><h1>{}{}</h1>{}<dl class="runinfo">{}</dl></header>',
+                mark, title,
+                html('<p class="lede">{}</p>', lede) if lede else Markup(""), rows)
 
-    ``nav_html`` and ``body`` are Markup (a plain ``str`` is shown as text, escaped).
+
+def page(title: str, nav_html: Markup, body: Markup, header: Markup | None = None) -> str:
+    """A whole HTML page: title, navigation, header (default the title alone), body and a
+    dated footer, styled by :data:`CSS_NAME` beside it.
+
+    ``nav_html``, ``body`` and ``header`` are Markup (a plain ``str`` is shown as text,
+    escaped).
 
     Examples
     --------
-    >>> "<h1>a&lt;b</h1>&lt;p&gt;" in page("a<b", Markup(""), "<p>")
+    >>> "<h1>a&lt;b</h1>" in page("a<b", Markup(""), "<p>") and "&lt;p&gt;" in page("t", "", "<p>")
     True
     """
+    if header is None:
+        header = html('<header class="run"><h1>{}</h1></header>', title)
     return str(html('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-                    "<title>{title}</title><style>{css}</style></head><body>"
-                    "<nav>{nav}</nav><h1>{title}</h1>{body}"
-                    "<footer><p><small>microcyl report, {now}</small></p></footer>"
-                    "</body></html>\n", title=title, css=_CSS, nav=nav_html, body=body,
-                    now=now()))
+                    '<meta name="viewport" content="width=device-width, initial-scale=1">'
+                    '<title>{title}</title><link rel="stylesheet" href="{css}"></head><body>'
+                    "<nav>{nav}</nav><main>{header}{body}"
+                    "<footer><p>microcyl {version} report, {now}</p></footer>"
+                    "</main></body></html>\n", title=title, css=CSS_NAME, nav=nav_html,
+                    header=header, body=body, version=version(), now=now()))

@@ -5,15 +5,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from reports._plotting import FONT, series_styles
 from reports.plot_albedo import plot_albedo
 from reports.plot_lobes import plot_lobe_comparison
 from reports.plot_masking import plot_masking_terms
+from reports.prose import ALBEDO_KINDS, albedo_range, overview_sentence
 from reports.report.markup import Markup, fmt, html, join, swatch, table, url
 from reports.report.page import Page, new_figure
-from reports.report.sec_energy import EnergyData
+from reports.report.sec_energy import ALBEDO_PHI, EnergyData
 from reports.report.sec_parameters import THREAD_FIELDS, THREAD_HEADER, parameters_of
 from reports.report.sec_reciprocity import ReciprocityData
 from reports.report.sec_sanity import SanityData
@@ -22,19 +21,19 @@ from reports.report.sections import FabricReport
 __all__ = ["overview"]
 
 
-def _fabrics(reports: list[FabricReport]) -> Markup:
+def _fabrics(reports: list[FabricReport], colours: dict) -> Markup:
     rows = []
     for r in reports:
         params = parameters_of(r.fabric)
+        name = html('{}<a href="{}">{}</a>', swatch(colours[r.name]), url(f"{r.name}.html"),
+                    r.name)
         for j, t in enumerate(params["threads"]):
-            rows.append([r.name if j == 0 else "", f"T{j + 1}"] +
+            rows.append([name if j == 0 else "", f"T{j + 1}"] +
                         [fmt(t[f]) for f in THREAD_FIELDS])
         if not params["threads"]:
-            rows.append([r.name, "n/a"] + [""] * len(THREAD_FIELDS))
-    links = join(html('<li>{}<a href="{}">{}</a></li>', swatch(r.fabric), url(f"{r.name}.html"),
-                      r.name) for r in reports)
-    return html('<section id="overview"><h2>Fabrics</h2>{}<ul>{}</ul></section>',
-                table(["fabric", "thread", *THREAD_HEADER], rows), links)
+            rows.append([name, "n/a"] + [""] * len(THREAD_FIELDS))
+    return html('<section id="overview"><h2>Parameters</h2>{}</section>',
+                table(["fabric", "thread", *THREAD_HEADER], rows))
 
 
 def _lobes(p: Page, reports: list[FabricReport]) -> Markup:
@@ -50,31 +49,48 @@ def _lobes(p: Page, reports: list[FabricReport]) -> Markup:
 
 def _albedo(p: Page, reports: list[FabricReport]) -> Markup:
     have = {r.name: e for r in reports if (e := r.data(EnergyData)) is not None}
-    out = [Markup('<section id="albedo-comparison"><h2>Albedo compared</h2>')]
+    out = [Markup('<section id="albedo-comparison"><h2>Albedos compared</h2>')]
     if not have:
         out.append(Markup('<p class="na">Not available: no fabric has energy results (the '
                           'energy section was not requested).</p></section>'))
         return join(out)
-    fig, axes = new_figure(2, 1, figsize=(11.0, 4.2))
+    modes = [m for m in ALBEDO_KINDS if all(m in e.curves() for e in have.values())]
+    fig, axes = new_figure(2, len(modes), figsize=(11.0, 3.4 * len(modes) + 0.6))
     styles = series_styles(have)
-    for j, (ax, phi) in enumerate(zip(axes, (0.0, 90.0))):
-        for name, e in have.items():
-            plot_albedo(e.theta_deg, np.asarray(e.value)[:, j], np.asarray(e.error)[:, j],
-                        quantity="luminance", style=styles[name], label=name, ax=ax,
-                        legend=False, title=f"luminance albedo, wo at φ = {phi:g}°")
-        ax.set_xlabel("θo (degrees)")
+    for row, mode in enumerate(modes):
+        name, symbol, angle = ALBEDO_KINDS[mode]
+        for j, phi in enumerate(ALBEDO_PHI):
+            ax = axes[2 * row + j]
+            for fab, e in have.items():
+                value, error = e.curves()[mode]
+                plot_albedo(e.theta_deg, value[:, j], error[:, j], quantity="luminance",
+                            style=styles[fab], label=fab, ax=ax, legend=False,
+                            title=f"{name} {symbol.split(' = ')[0]}, luminance, φ = {phi:g}°")
+            ax.set_xlabel(f"{angle} (degrees)", fontsize=FONT["label"])
+            ax.set_ylabel(f"{name} (unitless)", fontsize=FONT["label"])
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=FONT["small"],
-               frameon=False)
-    out.append(p.figure(fig, "albedo_comparison.png", "Rec. 709 luminance of the "
-                        "directional albedo of every fabric, against θo, wo along the warp "
-                        "(left) and the weft (right); each fabric in its own colour, line style "
-                        "and marker."))
-    rows = [[n, f"{e.max:.4f}", f"{e.max_error:.1e}", f"{e.max_where[0]:g}",
-             f"{e.max_where[1]:g}", e.max_where[2], "yes" if e.exceeds_one else "no"]
-            for n, e in have.items()]
-    out.append(table(["fabric", "max albedo", "error", "θ (deg)", "φ (deg)", "channel",
-                      "exceeds 1"], rows))
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(have), 3),
+               fontsize=FONT["small"], frameon=False)
+    out.append(p.figure(fig, "albedo_comparison.png", "Rec. 709 luminance of both directional "
+                        "albedos of every fabric: the furnace albedo ρ(wo) against θo (top) and "
+                        "the directional reflectance ρ'(wi) against θi (bottom), the fixed "
+                        "direction along the warp (left) and the weft (right); each fabric in "
+                        "its own colour, line style and marker; the dotted line is 1."))
+    out.append(html("<p>{}</p>", overview_sentence({n: e.findings() for n, e in have.items()})))
+    rows = []
+    for n, e in have.items():
+        f = e.findings()
+        row = [html("{}{}", swatch(styles[n]["color"]), n), albedo_range(e.value),
+               "yes" if f["furnace"]["exceeds"] else "no"]
+        if "reflectance" in f:
+            d = f["reflectance"]
+            row += [albedo_range(e.reflectance), f"{d['max']:.3f} at θi = {d['max_theta']:g}°",
+                    f"from θi = {d['first']:g}°" if d["exceeds"] else "no"]
+        rows.append(row)
+    header = ["fabric", "furnace albedo ρ(wo), range", "ρ(wo) exceeds 1"]
+    if "reflectance" in modes:
+        header += ["reflectance ρ'(wi), range", "largest ρ'(wi)", "ρ'(wi) exceeds 1"]
+    out.append(table(header, rows))
     return join(out) + Markup("</section>")
 
 
@@ -110,7 +126,8 @@ def _sanity(reports: list[FabricReport]) -> Markup:
                 table(["fabric", "checks", "evaluations", "failing", "all pass"], rows))
 
 
-def overview(root: Path, reports: list[FabricReport], sections, q: dict) -> Markup:
+def overview(root: Path, reports: list[FabricReport], sections, q: dict,
+             colours: dict | None = None) -> Markup:
     """The body of index.html; its figures go to ``root/overview``.
 
     Parameters
@@ -123,9 +140,13 @@ def overview(root: Path, reports: list[FabricReport], sections, q: dict) -> Mark
         The per-fabric sections requested.
     q : dict
         Resolutions (a value of :data:`reports.report.QUALITIES`).
+    colours : dict, optional
+        Fabric name -> its plot colour (default :func:`series_styles` of the names).
     """
     p = Page(root, "overview", None, q)
-    return (_fabrics(reports) + _lobes(p, reports) + _albedo(p, reports) + _masking(p)
+    if colours is None:
+        colours = {n: st["color"] for n, st in series_styles([r.name for r in reports]).items()}
+    return (_fabrics(reports, colours) + _lobes(p, reports) + _albedo(p, reports) + _masking(p)
             + _reciprocity(reports) + _sanity(reports)
             + html('<p>Sections per fabric: {}. Data: <a href="summary.json">summary.json</a>.'
                    "</p>", ", ".join(sections)))

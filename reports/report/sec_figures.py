@@ -67,7 +67,7 @@ def section_lobes(p: Page) -> Section:
 
 def section_slices(p: Page) -> Section:
     """Cartesian slices against θo, θh and θd, and θh × θd images (BRDF Explorer)."""
-    fig, axes = new_figure(3, 1, figsize=(15.0, 3.6))
+    fig, axes = new_figure(3, 1, figsize=(11.0, 3.3))
     plot_slice_theta_o(p.fabric, 30.0, 180.0, 0.0, resolution=p.q["lobe"], ax=axes[0], log=True)
     plot_slice_theta_h(p.fabric, 10.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[1])
     plot_slice_theta_d(p.fabric, 0.0, 90.0, 0.0, resolution=p.q["lobe"], ax=axes[2])
@@ -103,7 +103,7 @@ def section_hemisphere(p: Page) -> Section:
     light at 45° along the warp evaluated once for its luminance and its colour."""
     views = [compute_hemisphere(p.fabric, ti, phi, p.q["hemi"])
              for ti, phi in ((45.0, 0.0), (45.0, 90.0), (60.0, 45.0))]
-    fig, axes = new_figure(3, 1, figsize=(15.0, 4.2))
+    fig, axes = new_figure(3, 1, figsize=(11.0, 3.6))
     for ax, view in zip(axes, views):
         draw_hemisphere(view, ax=ax)
     out = [p.figure(fig, "hemisphere.png", "Luminance f_r(wo) (1/sr, log colour scale) over "
@@ -133,7 +133,7 @@ def section_masking(p: Page) -> Section:
              "φ = 0° (warp), 45° and 90° (weft)."),
             (80.0, "log", "masking_lobes_grazing.png", "The same at grazing incidence "
              "θi = 80°.")):
-        fig, axes = new_figure(3, 1, figsize=(12.6, 3.1), polar=True)
+        fig, axes = new_figure(3, 1, figsize=(11.0, 3.0), polar=True)
         for ax, phi in zip(axes, PLANES):
             draw_masking_lobes(view, ti, phi, ax=ax, scale=scale, legend=False)
         handles, labels = axes[0].get_legend_handles_labels()

@@ -12,7 +12,6 @@ import importlib.util
 import json
 import math
 import os
-import re
 import subprocess
 import sys
 import zlib
@@ -444,7 +443,7 @@ def test_mitsuba_chi2(jit, name, theta, tmp_path, monkeypatch):
     assert test.run(0.01, test_count=len(CHI2_CASES), quiet=True), test.messages
 
 
-# -- microcyl export and the README --------------------------------------------------------
+# -- microcyl export ----------------------------------------------------------------------
 def _export(folder, target):
     """`microcyl export FOLDER -o TARGET` run as a user runs it, in TARGET's folder."""
     return subprocess.run([sys.executable, "-m", "reports", "export", str(folder), "-o",
@@ -505,22 +504,3 @@ def test_export_xml_loads_in_a_scene_file(fit_folder, scalar, tmp_path):
     ref = med.fabric.eval(light.astype(float), view.astype(float)) * light[:, 2:3]
     assert _worst(got, ref) < RTOL
     assert not med.fabric.options["masking"]        # the fit's variant came through
-
-
-def test_readme_mitsuba_example(scalar, tmp_path, monkeypatch):
-    """The README's "Mitsuba 3" example (a ```py block, kept out of test_readme's run because
-    the main venv may lack Mitsuba) runs and renders a non-black image."""
-    text = (REPO / "README.md").read_text()
-    block = re.search(r"## Mitsuba 3.*?```py\n(.*?)```", text, flags=re.S)
-    assert block, "README has no Mitsuba 3 example"
-    monkeypatch.chdir(tmp_path)
-    # Mitsuba resolves relative paths against the folder it was first imported in
-    code = block.group(1).replace('"velvet.exr"', repr(str(tmp_path / "velvet.exr")))
-    ns = {}
-    exec(compile(code, "README Mitsuba block", "exec"), ns)
-    img = np.asarray(ns["image"])
-    assert img.shape[-1] == 3 and np.isfinite(img).all() and img.mean() > 0
-    assert (tmp_path / "velvet.exr").exists()      # write_async=False: written at once
-    edited = np.asarray(ns["edited"])               # after the edit through mi.traverse
-    assert np.isfinite(edited).all() and edited.mean() > 0
-    assert np.abs(edited - img).max() > 0.01 * img.max()

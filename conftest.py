@@ -8,7 +8,7 @@ import pytest
 #: These import Mitsuba at their top (an optional dependency at run time, imported only by
 #: reports.mitsuba.register()): their doctests are collected only where it is installed.
 collect_ignore = [] if importlib.util.find_spec("mitsuba") else [
-    "reports/mitsuba_kernel.py", "reports/mitsuba_bsdf.py"]
+    "reports/mitsuba/kernel.py", "reports/mitsuba/bsdf.py"]
 
 
 @pytest.fixture(autouse=True)

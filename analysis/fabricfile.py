@@ -4,7 +4,7 @@
 3 BSDF ``microcylinder`` (:func:`plugin_dict`, JSON) or as its ``<bsdf>`` element for scene
 files (:func:`plugin_xml`); :func:`fabric_from_dict` and :func:`fabric_from_xml` read them back,
 and :func:`read_fabric_file` reads either from a file. None of this needs Mitsuba
-(:mod:`reports.mitsuba` registers the plugin itself and re-exports these names).
+(:mod:`reports.mitsuba.plugin` registers the plugin itself and re-exports these names).
 
 Such files come from others: they are read size-limited (:data:`MAX_FILE_BYTES`), the XML
 without a document type (no entity is ever expanded) and every value checked by

@@ -123,7 +123,7 @@ MEASURED: dict[str, MeasuredDataset] = {d.name: d for d in (
 def default_data_dir() -> Path:
     """The measured-data folder: ``$MICROCYL_DATA``, else ``shared/data`` beside this source
     tree (``../shared/data`` from the repository). The command line also looks beside the
-    current folder (:func:`reports.cliutil.data_dir`)."""
+    current folder (:func:`reports.cli.options.data_dir`)."""
     env = os.environ.get("MICROCYL_DATA")
     if env:
         return Path(env)

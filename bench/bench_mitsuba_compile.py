@@ -26,8 +26,8 @@ CHILD = r"""
 import sys, time
 import brdf
 from reports import mitsuba_render
-from reports.mitsuba import fabric_from_dict
-from reports.scenes import make_scene
+from reports.mitsuba.plugin import fabric_from_dict
+from reports.render.scenes import make_scene
 scene, name, w, h, spp = sys.argv[1], sys.argv[2], *map(int, sys.argv[3:6])
 fab = fabric_from_dict(eval(name)) if name.startswith("{") else brdf.fabric(name)
 times = []

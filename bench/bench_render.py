@@ -18,9 +18,9 @@ import time
 import numpy as np
 
 import brdf
-import reports.render as R
-from reports import mitsuba_render
-from reports.scenes import make_scene
+import reports.render.engine as R
+from reports.mitsuba import render as mitsuba_render
+from reports.render.scenes import make_scene
 
 
 def _stamp():

@@ -28,7 +28,7 @@ th{background:#f0f0f0}td.num{text-align:right;font-variant-numeric:tabular-nums}
 .plots img{width:100%;border:1px solid #ddd}figure{margin:0}figcaption{font-size:13px}""")
 
 
-#: Captions of the fit plots (reports.fitplots) by name.
+#: Captions of the fit plots (reports.plots.fit_diagnostics) by name.
 CAPTIONS = {"corner": "posterior (corner plot)",
             "lobes": "posterior predictive: 5-95% band of f_r cos(theta_o) over the data",
             "residuals": "residuals at the posterior median", "traces": "chains (traces)",

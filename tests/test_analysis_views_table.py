@@ -10,7 +10,7 @@ import numpy as np  # noqa: E402
 import brdf  # noqa: E402
 from analysis.views import compute_table_panel  # noqa: E402
 from gonio import Table  # noqa: E402
-from reports import plot_views  # noqa: E402
+from reports.plots import views as plot_views  # noqa: E402
 
 W = np.array([0.2126, 0.7152, 0.0722])
 

@@ -24,9 +24,6 @@ LAZY = {"matplotlib", "corner", "colour", "distributed", "mitsuba", "drjit", "ar
 #: when that branch lands (the test says so when one is gone).
 KNOWN_CYCLES = {
     frozenset({"brdf.fabric", "brdf.prepared"}),    # issue 26.1 (FabricPlan), branch h-plan
-    # branch h-cli moves the plugin's dictionary to analysis/fabricfile.py; then
-    # mitsuba_bsdf imports PLUGIN_NAME and fabric_from_dict from there, not reports.mitsuba
-    frozenset({"reports.mitsuba", "reports.mitsuba_bsdf"}),
 }
 MAX_REPORTS_TOP = 25
 MAX_UNDOCUMENTED = 10

@@ -1,4 +1,4 @@
-"""Tests of ``microcyl fit`` (reports.cmd_fit) end to end on small simulated tables."""
+"""Tests of ``microcyl fit`` (reports.cli.fit) end to end on small simulated tables."""
 
 import json
 import os
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import reports.cmd_fit as cmd_fit
+import reports.cli.fit as cmd_fit
 from gonio.table import Table
 from reports.cli import main
 from _fitmodels import fabric_table

@@ -1,4 +1,4 @@
-"""Tests of the ``microcyl measure`` verb (reports/cmd_measure.py)."""
+"""Tests of the ``microcyl measure`` verb (reports/cli/measure.py)."""
 
 import math
 

@@ -15,7 +15,10 @@ from hypothesis import HealthCheck, given, settings
 
 import brdf
 from analysis.paramnames import PARAM_NAMES
-from reports import cliutil, cmd_fit, cmd_measure, cmd_model
+from reports.cli import options as cliutil
+from reports.cli import fit as cmd_fit
+from reports.cli import measure as cmd_measure
+from reports.cli import model as cmd_model
 from reports.cli import build_parser
 
 PARSER = build_parser()

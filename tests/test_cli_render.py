@@ -1,4 +1,4 @@
-"""Tests of the ``microcyl render`` verb (reports.cmd_render)."""
+"""Tests of the ``microcyl render`` verb (reports.cli.render)."""
 
 import time
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from reports import imageio
+from reports.render import imageio
 from reports.cli import main
 
 
@@ -50,7 +50,7 @@ def test_bad_input_is_one_line_at_once(tmp_path, capsys, argv, match):
 
 
 def test_bad_variant_flag_is_a_usage_error(tmp_path, capsys):
-    """The variant flags are every verb's (reports.cliutil.add_fabric_options): a bad value is
+    """The variant flags are every verb's (reports.cli.options.add_fabric_options): a bad value is
     argparse's one-line usage error, status 2."""
     status = main_status(["render", "cylinder", "velvet", "--masking", "maybe",
                           "-o", str(tmp_path / "x.exr")])
@@ -97,7 +97,7 @@ def test_render_writes_exr_and_png(tmp_path):
 @needs_brdf
 def test_masking_toggle_changes_the_render(tmp_path):
     import brdf
-    from reports.render import render
+    from reports.render.engine import render
     on = brdf.fabric("velvet", tangent_samples=4)
     kw = dict(width=16, height=9, spp=1, progress=False)
     a = render("cylinder", on, **kw)
@@ -122,8 +122,8 @@ class _Interrupting:
 
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_interrupt_leaves_no_file(tmp_path, capsys, monkeypatch, workers):
-    import reports.render
-    monkeypatch.setattr(reports.render, "resolve_fabric", lambda name, **kw: _Interrupting())
+    import reports.render.engine
+    monkeypatch.setattr(reports.render.engine, "resolve_fabric", lambda name, **kw: _Interrupting())
     status = main(["render", "cylinder", "velvet", "--width", "200", "--height", "100",
                    "--spp", "1", "--quiet", "--workers", workers, "-o", str(tmp_path / "x.exr")])
     assert status == 130
@@ -145,7 +145,7 @@ def test_engine_options_are_checked_at_once(tmp_path, capsys, argv, match):
 
 
 def test_engine_mitsuba_without_mitsuba_is_one_line(tmp_path, capsys, monkeypatch):
-    from reports import mitsuba_render
+    from reports.mitsuba import render as mitsuba_render
     monkeypatch.setattr(mitsuba_render, "have_mitsuba", lambda: False)
     status = main(["render", "cylinder", "velvet", *SMALL, "--engine", "mitsuba",
                    "-o", str(tmp_path / "x.exr")])
@@ -155,7 +155,7 @@ def test_engine_mitsuba_without_mitsuba_is_one_line(tmp_path, capsys, monkeypatc
 
 
 def _mitsuba_llvm():
-    from reports import mitsuba_render
+    from reports.mitsuba import render as mitsuba_render
     if not mitsuba_render.have_mitsuba():
         pytest.skip("mitsuba is not installed")
     ok, why = mitsuba_render.variant_works("llvm_ad_rgb")
@@ -175,8 +175,8 @@ def test_engine_mitsuba_end_to_end(tmp_path):
     _mitsuba_llvm()
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     env = dict(os.environ, PYTHONPATH=root)
-    from reports.render import render
-    from reports.scenes import make_scene
+    from reports.render.engine import render
+    from reports.render.scenes import make_scene
     from test_reports_mitsuba_render import agree, shadow_mask
     out = tmp_path / "c.exr"
     p = subprocess.run([sys.executable, "-m", "reports", "render", "cylinder", "velvet",
@@ -212,7 +212,7 @@ def test_render_a_fit_folder_and_its_export(fit_folder, tmp_path):
     by hand; `microcyl export`'s JSON renders the same image, and a variant flag given on the
     command line applies on top of the fit's options (its masking is off)."""
     import brdf
-    from reports.render import render
+    from reports.render.engine import render
     folder, res = fit_folder
     gs, kd = (res.summary[k]["median"] for k in ("gamma_s1", "kd1"))
     base = brdf.fabric("velvet", masking=False, rotation=0.25)
@@ -264,8 +264,8 @@ def test_a_bad_fit_folder_or_dictionary_is_one_line(tmp_path, capsys, content, m
 def _interior_cloth(scene_name, width, height):
     """Pixels whose four corners' camera rays all hit the cloth first (independent of the
     renderer's coverage mask)."""
-    from reports.scenes import make_scene
-    from reports.tracing import intersect
+    from reports.render.scenes import make_scene
+    from reports.render.tracing import intersect
     scene = make_scene(scene_name)
     ys, xs = np.mgrid[0:height + 1, 0:width + 1]
     o, d = scene.camera.rays(xs.ravel().astype(float), ys.ravel().astype(float), width, height)

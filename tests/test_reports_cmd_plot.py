@@ -1,4 +1,4 @@
-"""Tests of ``microcyl plot`` (reports.cmd_plot) and its figures (reports.plot_views).
+"""Tests of ``microcyl plot`` (reports.cli.plot) and its figures (reports.plots.views).
 
 End to end: one subprocess per view, as a user runs it, the format chosen by the suffix.
 Layout: every view's figure, drawn, has no two texts overlapping and none outside the figure
@@ -22,9 +22,10 @@ from PIL import Image  # noqa: E402
 
 import brdf  # noqa: E402
 from gonio import Table  # noqa: E402
-from reports import plot_views, plots  # noqa: E402
+from reports import plots  # noqa: E402
+from reports.plots import views as plot_views
 from reports.cli import main  # noqa: E402
-from reports.cmd_plot import fitted_fabric  # noqa: E402
+from reports.cli.plot import fitted_fabric  # noqa: E402
 from reports.report import overview, sec_figures  # noqa: E402
 from reports.report.page import Page  # noqa: E402
 from reports.report.sec_energy import EnergyData  # noqa: E402
@@ -269,7 +270,7 @@ def test_plot_table_draws_the_fits_model_with_its_tangent_and_overall_scales(tmp
     tangent_scale, times scale), not the preset's f_r."""
     from analysis.fit import FabricModel
     from analysis.params import ParamSpec, defaults_from_fabric
-    from reports.cmd_plot import fitted_model
+    from reports.cli.plot import fitted_model
     preset = "silk_crepe_de_chine"
     folder = tmp_path / "fit"
     folder.mkdir()
@@ -293,7 +294,7 @@ def test_plot_table_draws_the_fits_model_with_its_tangent_and_overall_scales(tmp
     ref = 0.5 * FabricModel(fab0, np.broadcast_to(wi, wo.shape), wo)(
         tangent_scale=np.array([1.5, 1.0]))
     table = Table(np.broadcast_to(wi, (5, 3)), wo[::4][:5], np.full((5, 3), 0.1))
-    from reports.plot_fit import plot_table_models
+    from reports.plots.fit import plot_table_models
     fig, ax = plot_table_models(table, {label: model}, 30.0, 0.0, resolution=19,
                             log=False)
     y = {l.get_gid(): l.get_ydata() for l in ax.get_lines()}[f"model {label}"]

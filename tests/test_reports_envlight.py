@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import brdf
-from reports.envlight import EnvironmentLight
-from reports.render import render
-from reports.scenes import DirectionalLight, make_scene
+from reports.render.envlight import EnvironmentLight
+from reports.render.engine import render
+from reports.render.scenes import DirectionalLight, make_scene
 
 L = 0.7
 

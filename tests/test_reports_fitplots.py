@@ -1,4 +1,4 @@
-"""Tests of reports.fitplots: the adequacy figure (residuals against angle, the optional PIT
+"""Tests of reports.plots.fit_diagnostics: the adequacy figure (residuals against angle, the optional PIT
 histogram, the verdict and warnings as text) and the corner plot a reviewer reads (titles
 apart, whole tick values, a PNG small enough for a page)."""
 
@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 import brdf  # noqa: E402
 from analysis.fit import FabricModel, fit  # noqa: E402
 from analysis.params import ParamSpec, defaults_from_fabric  # noqa: E402
-from reports.fitplots import adequacy_plot, corner_plot  # noqa: E402
+from reports.plots.fit_diagnostics import adequacy_plot, corner_plot  # noqa: E402
 from _fitmodels import fabric_table  # noqa: E402
 
 
@@ -86,7 +86,7 @@ def test_corner_titles_apart_no_offset_and_small_png(tmp_path):
 
 
 def test_a_band_thinner_than_its_line_is_noted_and_a_wide_one_is_not():
-    from reports.fitplots import _note_thin_band
+    from reports.plots.fit_diagnostics import _note_thin_band
     th = np.radians(np.linspace(-89, 89, 61))
     for width, thin in ((1e-4, True), (0.3, False)):
         fig = plt.figure(figsize=(4.2, 3.6))

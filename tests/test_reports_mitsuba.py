@@ -1,4 +1,4 @@
-"""reports.mitsuba: the Mitsuba 3 BSDF 'microcylinder' against brdf.Fabric (eval in float32,
+"""reports.mitsuba.plugin: the Mitsuba 3 BSDF 'microcylinder' against brdf.Fabric (eval in float32,
 sample and pdf), Mitsuba's own chi-square test of its sampler, the warp along dp_du, and
 ``microcyl export`` run as a user runs it.
 
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import brdf
-from reports.mitsuba import fabric_from_dict, plugin_dict
+from reports.mitsuba.plugin import fabric_from_dict, plugin_dict
 
 REPO = Path(__file__).resolve().parents[1]
 HAVE_MITSUBA = importlib.util.find_spec("mitsuba") is not None
@@ -92,7 +92,7 @@ def test_fabric_from_dict_keys_and_errors():
 def scalar():
     mi = pytest.importorskip("mitsuba", reason="mitsuba is not installed")
     mi.set_variant("scalar_rgb")
-    from reports import mitsuba as plugin
+    from reports.mitsuba import plugin
     plugin.register()
     return mi
 
@@ -171,7 +171,7 @@ def test_scalar_sample_weight_and_pdf(scalar, name):
 @needs_mitsuba
 def test_register_needs_an_rgb_variant():
     import mitsuba as mi
-    from reports import mitsuba as plugin
+    from reports.mitsuba import plugin
     mi.set_variant("scalar_spectral")
     try:
         with pytest.raises(ValueError, match="needs an RGB variant"):
@@ -189,18 +189,18 @@ JIT_NEEDS = {"llvm_ad_rgb": "install libllvm19 and set DRJIT_LIBLLVM_PATH to its
 
 @pytest.fixture(scope="module", params=list(JIT_NEEDS))
 def jit(request):
-    """mitsuba in a JIT variant (llvm_ad_rgb, cuda_ad_rgb), after reports.mitsuba_render's
+    """mitsuba in a JIT variant (llvm_ad_rgb, cuda_ad_rgb), after reports.mitsuba.render's
     probe in a subprocess (an unusable LLVM aborts the process that tries it); skips with the
     probe's reason where the variant does not run."""
     if not HAVE_MITSUBA:
         pytest.skip("mitsuba is not installed")
-    from reports.mitsuba_render import variant_works
+    from reports.mitsuba.render import variant_works
     ok, why = variant_works(request.param)
     if not ok:
         pytest.skip(f"{request.param} does not run here ({why}): {JIT_NEEDS[request.param]}")
     import mitsuba as mi
     mi.set_variant(request.param)
-    from reports import mitsuba as plugin
+    from reports.mitsuba import plugin
     plugin.register()
     yield mi
     mi.set_variant("scalar_rgb")

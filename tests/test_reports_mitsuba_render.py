@@ -1,4 +1,4 @@
-"""Tests of reports.mitsuba_render: the Mitsuba engine agrees with the built-in renderer.
+"""Tests of reports.mitsuba.render: the Mitsuba engine agrees with the built-in renderer.
 
 Both renderers estimate the same integral when Mitsuba's paths stop after the first bounce
 (``max_depth=2``): the key light and the sky (the built-in by MIS of Fabric.sample and cosine
@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 import brdf
-from reports import mitsuba_render
+from reports.mitsuba import render as mitsuba_render
 from reports.colour import luminance
-from reports.render import cloth_coverage, render
-from reports.scenes import make_scene
-from reports.tracing import intersect, occluded
+from reports.render.engine import cloth_coverage, render
+from reports.render.scenes import make_scene
+from reports.render.tracing import intersect, occluded
 
 pytestmark = pytest.mark.skipif(not mitsuba_render.have_mitsuba(),
                                 reason="mitsuba is not installed")
@@ -130,8 +130,8 @@ def test_floor_noise_falls_when_each_path_samples_both_lights(jit):
     lower, and the mean agrees within that noise."""
     import mitsuba as mi
     mi.set_variant(jit)
-    from reports import mitsuba as plugin
-    from reports import mitsuba_scene
+    from reports.mitsuba import plugin
+    from reports.mitsuba import scene as mitsuba_scene
     plugin.register()
     scene, fab, spp = make_scene("cylinder"), brdf.fabric("velvet"), 8
     lit = ~shadow_mask(scene, W, H)

@@ -1,7 +1,7 @@
-"""Tests of reports.mitsuba_scene: Mitsuba's copies of the built-in scenes hit the same points
+"""Tests of reports.mitsuba.scene: Mitsuba's copies of the built-in scenes hit the same points
 with the same normals and warps, and their sky has the built-in sky's radiance.
 
-The reference is the built-in renderer's own geometry (reports.tracing and each primitive's
+The reference is the built-in renderer's own geometry (reports.render.tracing and each primitive's
 frame), traced independently of Mitsuba. Skips where Mitsuba is not installed; everything
 runs in scalar_rgb (no LLVM needed).
 """
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import brdf
-from reports.envlight import EnvironmentLight
-from reports.scenes import make_scene
-from reports.tracing import intersect
+from reports.render.envlight import EnvironmentLight
+from reports.render.scenes import make_scene
+from reports.render.tracing import intersect
 
 mi = pytest.importorskip("mitsuba", reason="mitsuba is not installed")
 
@@ -20,9 +20,9 @@ mi = pytest.importorskip("mitsuba", reason="mitsuba is not installed")
 @pytest.fixture(scope="module")
 def scalar():
     mi.set_variant("scalar_rgb")
-    from reports import mitsuba as plugin
+    from reports.mitsuba import plugin
     plugin.register()
-    from reports import mitsuba_scene
+    from reports.mitsuba import scene as mitsuba_scene
     return mitsuba_scene
 
 

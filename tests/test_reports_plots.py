@@ -1,7 +1,7 @@
 """Tests of the plot modules: every plot returns a figure holding the expected data.
 
 Reference values are computed here from the BRDF directly, with direction formulas written out
-independently of reports._plotting.
+independently of reports.plots.common.
 """
 
 import matplotlib
@@ -101,7 +101,7 @@ def test_log_lobe_panels_share_their_decades(velvet, silk):
     """Every panel of a log figure: one floor (the power of 10 four decades below the
     figure's peak, found here from eval), so the same radius is the same f_r in each, and
     the same radial limit and tick labels."""
-    from reports.plot_views import lobes_view
+    from reports.plots.views import lobes_view
     thetas, planes, n = (0.0, 30.0, 60.0), (0.0, 45.0, 90.0), 37
     fig, axes = plots.plot_lobe_planes(velvet, thetas, planes, scale="log", resolution=n)
     x = np.linspace(-90, 90, n)
@@ -217,7 +217,7 @@ def _bar_gap(fig, ax):
 def test_the_colour_bar_sits_beside_its_image(velvet):
     """No wide gap between an image and its colour bar: at most a tenth of the image's
     width, alone and in the slices view's grid (whose image keeps its aspect)."""
-    from reports.plot_views import slices_view
+    from reports.plots.views import slices_view
     fig, ax = plots.plot_slice_image(velvet, 90.0, resolution=8)
     gap, width = _bar_gap(fig, ax)
     assert 0 <= gap <= 0.1 * width, (gap, width)
@@ -371,7 +371,7 @@ def test_reciprocity_map_and_statistics_share_one_definition():
     the largest map value is reciprocity()'s max, and a hand-computed cell agrees."""
     import brdf
     from analysis.reciprocity import reciprocity
-    from reports.plot_reciprocity import reciprocity_map
+    from reports.plots.reciprocity import reciprocity_map
     fab = brdf.fabric("velvet")
     theta, err = reciprocity_map(fab, resolution=9)
     t = np.radians(theta)
@@ -400,7 +400,7 @@ def test_polar_lobe_takes_a_preset_name_and_names_anything_else():
 def test_lobe_figures_evaluate_each_curve_once():
     """plot lobes of two fabrics and plot_lobe_planes: each curve evaluated once (the shared
     radial limit read from the same curves), and the drawn line is the curve."""
-    from reports import plot_views
+    from reports.plots import views as plot_views
 
     class Counted(Lambert):
         pairs = 0

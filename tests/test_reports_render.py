@@ -1,12 +1,12 @@
-"""Tests of reports.render, reports.scenes and reports.imageio (tiny images, fast)."""
+"""Tests of reports.render.engine, reports.render.scenes and reports.render.imageio (tiny images, fast)."""
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from reports import imageio
-from reports.render import render
-from reports.scenes import (Curtain, Cylinder, DirectionalLight, OrthographicCamera,
+from reports.render import imageio
+from reports.render.engine import render
+from reports.render.scenes import (Curtain, Cylinder, DirectionalLight, OrthographicCamera,
                             PointLight, Rectangle, Scene, Sphere, make_scene)
 
 

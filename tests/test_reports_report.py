@@ -240,7 +240,7 @@ def test_renders_engine_is_mitsuba_where_it_runs(tmp_path, monkeypatch, usable):
     render_mitsuba size), by the built-in renderer otherwise; the caption and the summary
     name the engine; any BRDF other than a brdf.Fabric goes to the built-in renderer."""
     import brdf
-    from reports import mitsuba_render
+    from reports.mitsuba import render as mitsuba_render
     calls = []
     monkeypatch.setattr(mitsuba_render, "have_mitsuba", lambda: usable)
     monkeypatch.setattr(mitsuba_render, "variant_works", lambda v: (usable, ""))

@@ -8,7 +8,7 @@ import pytest
 
 import brdf
 from reports import report as rep
-from reports.render import cloth_coverage
+from reports.render.engine import cloth_coverage
 from reports.report import sec_renders
 from reports.report.page import Page
 

@@ -65,7 +65,7 @@ class BatchJob:
         ``loader() -> gonio.Table`` instead of reading ``path`` (a picklable function, e.g.
         a :func:`functools.partial` of :func:`analysis.measured.load_measured`).
     plots : callable, optional
-        Passed to :func:`analysis.fit.fit_fabric` (e.g. ``reports.fitplots.write_fit_plots``).
+        Passed to :func:`analysis.fit.fit_fabric` (e.g. ``reports.plots.fit_diagnostics.write_fit_plots``).
     config_extra : dict, optional
         Recorded in (and matched against) the fit's stored configuration; default the
         preset, its options and the sample, as ``microcyl fit`` records them.

@@ -85,7 +85,7 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         Output folder.
     plots : callable, optional
         ``plots(result, table, model_factory, out_dir) -> {name: path}`` (for example
-        ``reports.fitplots.write_fit_plots``); ``model_factory(wi, wo)`` is a
+        ``reports.plots.fit_diagnostics.write_fit_plots``); ``model_factory(wi, wo)`` is a
         :class:`~analysis.fit.posterior.FabricModel` of the fabric at other pairs.
     **fit_kw
         Passed to :func:`analysis.fit.fit`.

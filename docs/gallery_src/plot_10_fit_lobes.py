@@ -14,7 +14,7 @@ import brdf
 import gonio
 from analysis.fit import FabricModel, fit_fabric
 from analysis.params import ParamSpec, defaults_from_fabric
-from reports import fitplots
+from reports.plots import fit_diagnostics as fitplots
 
 work = Path(os.environ.get("MICROCYL_DOCS_WORK", "."))
 fab = brdf.fabric("velvet")

@@ -10,7 +10,7 @@ The ``microcylinder`` BSDF in a Mitsuba 3 scene written by hand: a cloth rectang
 import matplotlib.pyplot as plt
 import numpy as np
 
-from reports.mitsuba_render import have_mitsuba, variant_works
+from reports.mitsuba.render import have_mitsuba, variant_works
 
 ok, why = variant_works("llvm_ad_rgb") if have_mitsuba() else (False, "no Mitsuba")
 print("llvm_ad_rgb:", "runs" if ok else f"does not run here ({why})")
@@ -22,7 +22,7 @@ if not ok:
 else:
     import mitsuba as mi
     mi.set_variant("llvm_ad_rgb")
-    from reports import mitsuba as microcyl_mitsuba
+    from reports.mitsuba import plugin as microcyl_mitsuba
     microcyl_mitsuba.register()
     scene = mi.load_dict({
         "type": "scene",

@@ -71,6 +71,6 @@ if have_data:
 # The posterior of the CUReT fit: ridges where the parameters trade against each other, which
 # ``microcyl fit --suggest`` would have flagged before sampling.
 if have_data:
-    from reports import fitplots
+    from reports.plots import fit_diagnostics as fitplots
 
     fig = fitplots.corner_plot(result)

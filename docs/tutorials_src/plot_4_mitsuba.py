@@ -2,7 +2,7 @@
 The fabric in Mitsuba 3
 =======================
 
-:mod:`reports.mitsuba` is a Mitsuba 3 plugin: the BSDF ``microcylinder``, written in Dr.Jit, in
+:mod:`reports.mitsuba.plugin` is a Mitsuba 3 plugin: the BSDF ``microcylinder``, written in Dr.Jit, in
 the ``scalar_rgb``, ``llvm_ad_rgb`` and ``cuda_ad_rgb`` variants. After ``register()``, a preset
 is ``{"type": "microcylinder", "fabric": "velvet"}``, and every thread parameter (``eta1``,
 ``albedo1``, ``kd1``, ``gamma_s1``, ``gamma_v1`` in degrees, ``area1``, ``offsets1``, ...) and
@@ -18,7 +18,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from reports.mitsuba_render import have_mitsuba, variant_works
+from reports.mitsuba.render import have_mitsuba, variant_works
 
 ok, why = variant_works("llvm_ad_rgb") if have_mitsuba() else (False, "no Mitsuba")
 print("llvm_ad_rgb:", "runs" if ok else f"does not run here ({why}); the steps below are skipped")
@@ -30,7 +30,7 @@ print("llvm_ad_rgb:", "runs" if ok else f"does not run here ({why}); the steps b
 if ok:
     import mitsuba as mi
     mi.set_variant("llvm_ad_rgb")
-    from reports import mitsuba as microcyl_mitsuba
+    from reports.mitsuba import plugin as microcyl_mitsuba
     microcyl_mitsuba.register()             # after set_variant, once per variant
 
     scene = mi.load_dict({

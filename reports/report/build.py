@@ -14,7 +14,7 @@ from gonio.atomic import file_mode
 from gonio.progress import progress_bar
 from reports.report.folder import (check_output_dir, check_report_folder, make_build_folder,
                                    swap_into_place, write_file, write_marker)
-from reports._plotting import series_styles
+from reports.plots.common import series_styles
 from reports.report.cards import cards
 from reports.report.markup import (CSS_NAME, Markup, html, join, nav, now, page, plain_json,
                                    run_header, stylesheet, swatch, version)

@@ -70,7 +70,7 @@ def not_available(reason: str) -> Markup:
 
 def swatch(colour) -> Markup:
     """A square in ``colour``: a fabric's colour in the plots (``#rrggbb``, from
-    :func:`reports._plotting.series_styles`), so that a swatch and its curve match.
+    :func:`reports.plots.common.series_styles`), so that a swatch and its curve match.
 
     Examples
     --------

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from reports._plotting import FONT, series_styles
-from reports.plot_albedo import plot_albedo
-from reports.plot_lobes import plot_lobe_comparison
-from reports.plot_masking import plot_masking_terms
+from reports.plots.common import FONT, series_styles
+from reports.plots.albedo import plot_albedo
+from reports.plots.lobes import plot_lobe_comparison
+from reports.plots.masking import plot_masking_terms
 from reports.prose import ALBEDO_KINDS, albedo_range, overview_sentence
 from reports.report.markup import Markup, fmt, html, join, swatch, table, url
 from reports.report.page import Page, new_figure

@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
-from reports._plotting import FONT, save_figure
+from reports.plots.common import FONT, save_figure
 from reports.report.folder import write_file
 from reports.report.markup import Markup, html, plain_json, url
 

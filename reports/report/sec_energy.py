@@ -11,7 +11,7 @@ import numpy as np
 
 from analysis import albedo_curve, energy_report
 from reports.colour import line_colour
-from reports.plot_albedo import plot_albedo
+from reports.plots.albedo import plot_albedo
 from reports.prose import ALBEDO_KINDS, albedo_exceeds, albedo_sentence, energy_verdict
 from reports.report.markup import html, join
 from reports.report.page import Page, new_figure

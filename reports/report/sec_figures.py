@@ -6,12 +6,12 @@ import numpy as np
 
 from analysis.views import (HemisphereView, compute_hemisphere, compute_lobes,
                             compute_masking_lobes)
-from reports._plotting import FONT
-from reports.plot_hemisphere import draw_hemisphere
-from reports.plot_lobe3d import plot_lobe_3d
-from reports.plot_lobes import draw_lobe_planes
-from reports.plot_masking import draw_masking_lobes
-from reports.plot_slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
+from reports.plots.common import FONT
+from reports.plots.hemisphere import draw_hemisphere
+from reports.plots.lobe3d import plot_lobe_3d
+from reports.plots.lobes import draw_lobe_planes
+from reports.plots.masking import draw_masking_lobes
+from reports.plots.slices import (plot_slice_image, plot_slice_theta_d, plot_slice_theta_h,
                                  plot_slice_theta_o)
 from reports.report.markup import Markup, html, join
 from reports.report.page import Page, new_figure, replace_3d

@@ -9,7 +9,7 @@ import numpy as np
 
 from analysis import reciprocity
 from analysis.views import compute_reciprocity
-from reports.plot_reciprocity import draw_reciprocity_map
+from reports.plots.reciprocity import draw_reciprocity_map
 from reports.report.markup import Markup, fmt, html, join, plain_json, table
 from reports.report.page import Page, new_figure
 from reports.report.settings import Section

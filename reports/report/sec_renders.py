@@ -1,16 +1,16 @@
 """The "renders" section: the curtain and the cylinder, masking on and off, exposed for the cloth.
 
-The renders are Mitsuba 3's (:func:`reports.mitsuba_render.render_mitsuba`: path tracing, 8
+The renders are Mitsuba 3's (:func:`reports.mitsuba.render.render_mitsuba`: path tracing, 8
 bounces) where Mitsuba is installed with a usable LLVM (``llvm_ad_rgb``) and the fabric is a
-:class:`brdf.Fabric`, else the built-in renderer's (:func:`reports.render.render`: direct
+:class:`brdf.Fabric`, else the built-in renderer's (:func:`reports.render.engine.render`: direct
 light); each caption names its engine. The quality's ``render`` sets the built-in size and
 spp, ``render_mitsuba`` Mitsuba's (None: the built-in renderer unless ``mitsuba`` is asked
 for, at the built-in size); ``render_engine`` (``auto``, ``builtin``, ``mitsuba``) in the
 quality dictionary overrides the choice. The built-in renderer samples the sky on
 :data:`SKY_SPP` of each pixel's samples on cloth (every sample on the backdrop). Each scene is
-exposed automatically for its cloth (:func:`reports.exposure.auto_exposure`: the 99th
+exposed automatically for its cloth (:func:`reports.render.exposure.auto_exposure`: the 99th
 percentile of the cloth's pixels shown at 0.9, the mask traced once per scene and size by
-:func:`reports.render.cloth_coverage`); the cylinder without masking takes the exposure of the
+:func:`reports.render.engine.cloth_coverage`); the cylinder without masking takes the exposure of the
 cylinder with masking, so that the two compare.
 """
 
@@ -25,11 +25,11 @@ import matplotlib.image as mimage
 import numpy as np
 
 import brdf
-from reports import mitsuba_render
+from reports.mitsuba import render as mitsuba_render
 from reports.colour import luminance, to_srgb
-from reports.exposure import TARGET, auto_exposure
-from reports.mitsuba_render import render_mitsuba
-from reports.render import cloth_coverage, render
+from reports.render.exposure import TARGET, auto_exposure
+from reports.mitsuba.render import render_mitsuba
+from reports.render.engine import cloth_coverage, render
 from reports.report.folder import write_file
 from reports.report.markup import join
 from reports.report.page import Page, figure_html

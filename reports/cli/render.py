@@ -1,0 +1,152 @@
+"""The ``microcyl render`` verb: render a scene of cloth to OpenEXR and PNG.
+
+    microcyl render SCENE FABRIC [--masking on|off] [--reweighting on|off]
+        [--tangent-samples N] [--tangent-sampling midpoint|control_points]
+        [--transmission half_angle|longitudinal] [--gap incident|outgoing] [--rotation DEG]
+        [--width 1280] [--height 720] [--spp 16] [--exposure auto|STOPS|SCALEx] [--seed 0]
+        [--light-radius R] [--workers N] [--engine builtin|mitsuba] [--variant V]
+        [--max-depth N] [--no-progress] [-q] -o out.exr
+
+FABRIC (positional or ``--fabric``) is a preset, a ``microcyl fit`` output folder (the fabric
+of its posterior medians, as ``microcyl export`` writes it), such an exported ``.json`` or
+``.xml`` file, or a measured ``.bsdf`` or ``.binary`` table (built-in engine)
+(:func:`analysis.sources.resolve`); the variant options given change a fabric further.
+``-o out.exr`` writes the float32 linear EXR and an sRGB PNG beside it (``out.png``);
+``-o out.png`` writes the PNG only.  The PNG's exposure is automatic by default (the 99th
+percentile of the cloth's pixels shown at 0.9, :mod:`reports.render.exposure`); ``--exposure 1.5``
+gives it in stops (2**1.5 times the linear values), ``--exposure 4x`` as a scale; the EXR stays
+linear and records the exposure in its header (``microcyl_exposure_stops``, ...).  Every
+argument is checked (scene, fabric and its options, size, output folder, engine and variant)
+before rendering starts.
+``--engine mitsuba`` renders the same scene in Mitsuba 3 (:mod:`reports.mitsuba.render`: the
+``microcylinder`` BSDF, the path integrator with ``--max-depth`` bounces, ``--variant``
+llvm_ad_rgb where LLVM works, else scalar_rgb).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from pathlib import Path
+
+import brdf
+from reports.cli import options as cliutil
+from reports.render.lights import PointLight
+
+__all__ = ["register", "run"]
+
+log = logging.getLogger("microcyl")
+
+
+def register(sub):
+    """Add ``render`` to the ``microcyl`` sub-parsers."""
+    p = sub.add_parser(
+        "render", help="render a scene of cloth (curtain, cylinder, sphere, patch)",
+        description="Render a scene of cloth shaded with the microcylinder BRDF to a float32 "
+                    "OpenEXR (linear RGB) and an sRGB PNG.")
+    p.add_argument("scene", metavar="SCENE", help="curtain, cylinder, sphere or patch")
+    cliutil.add_fabric_argument(p, tables=True)
+    cliutil.add_fabric_options(p)
+    p.add_argument("--width", type=int, default=1280, help="pixels, at most 1280 (1280)")
+    p.add_argument("--height", type=int, default=720, help="pixels, at most 720 (720)")
+    p.add_argument("--spp", type=int, default=16, help="samples per pixel (16)")
+    p.add_argument("--exposure", default="auto", metavar="E",
+                   help="PNG exposure: auto (the 99th percentile of the cloth's pixels shown "
+                        "at 0.9), stops (1.5: 2**1.5 times the linear values) or a scale "
+                        "(4x) (auto); recorded in the EXR's header")
+    p.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    p.add_argument("--light-radius", type=float, default=None, metavar="R",
+                   help="turn the scene's point light into a disc of this radius")
+    p.add_argument("--workers", type=int, default=None, help="processes (all cores)")
+    p.add_argument("--engine", default="builtin", metavar="ENGINE",
+                   help="builtin (direct light, NumPy) or mitsuba (Mitsuba 3 path tracing) "
+                        "(builtin)")
+    p.add_argument("--variant", default=None, metavar="V",
+                   help="Mitsuba variant: llvm_ad_rgb, scalar_rgb or cuda_ad_rgb (llvm_ad_rgb "
+                        "where LLVM works, else scalar_rgb); --engine mitsuba only")
+    p.add_argument("--max-depth", type=int, default=None, metavar="N",
+                   help="longest light path, 2 = direct light only, -1 unbounded (8); "
+                        "--engine mitsuba only")
+    cliutil.add_quiet_options(p)
+    p.add_argument("-o", "--output", required=True, metavar="FILE",
+                   help="out.exr (writes out.png beside it) or out.png")
+    p.set_defaults(func=run)
+
+
+#: The engines of ``--engine``.
+ENGINES = ("builtin", "mitsuba")
+
+
+def _engine_options(args, fabric):
+    """Check ``--engine``, ``--variant`` and ``--max-depth``; return the Mitsuba variant and
+    depth (None, None for the built-in engine)."""
+    if args.engine not in ENGINES:
+        raise ValueError(f"--engine {args.engine!r}: must be one of {', '.join(ENGINES)}")
+    if args.engine == "builtin":
+        for name in ("variant", "max_depth"):
+            if getattr(args, name) is not None:
+                raise ValueError(f"--{name.replace('_', '-')}: only with --engine mitsuba "
+                                 f"(the built-in renderer computes direct light alone)")
+        return None, None
+    max_depth = 8 if args.max_depth is None else args.max_depth
+    if not (max_depth == -1 or 1 <= max_depth <= 1024):
+        raise ValueError(f"--max-depth {max_depth}: must be -1 (unbounded) or 1 to 1024")
+    if not isinstance(fabric, brdf.Fabric):
+        raise ValueError("--engine mitsuba renders a brdf.Fabric only")
+    from reports.mitsuba import render as mitsuba_render  # no Mitsuba import: that waits for the render
+    try:
+        variant = mitsuba_render.pick_variant(args.variant)
+    except ImportError as exc:
+        raise ValueError(str(exc)) from None
+    return variant, max_depth
+
+
+def run(args):
+    """Check every argument, render, write the files; return 0."""
+    # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
+    from reports.render import exposure
+    from reports.render import imageio
+    from reports.render.engine import check_size, render
+    from reports.render.scenes import make_scene
+
+    scene = make_scene(args.scene)
+    check_size(args.width, args.height, args.spp)
+    stops = exposure.parse_exposure(args.exposure)
+    if args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be a non-negative integer")
+    out = Path(args.output)
+    suffix = out.suffix.lower()
+    if suffix not in (".exr", ".png"):
+        raise ValueError(f"-o {args.output}: the output must end in .exr or .png")
+    imageio.check_output(out)
+    fabric = cliutil.source_from_args(cliutil.fabric_argument(args), args, tables=True).brdf
+    if args.light_radius is not None:
+        if not (args.light_radius >= 0 and math.isfinite(args.light_radius)):
+            raise ValueError(f"--light-radius {args.light_radius}: must be >= 0")
+        if not isinstance(scene.light, PointLight):
+            raise ValueError(f"--light-radius: scene {args.scene!r} has a directional light")
+        scene = scene.replace(light=dataclasses.replace(scene.light, radius=args.light_radius))
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers {args.workers}: must be at least 1")
+    variant, max_depth = _engine_options(args, fabric)
+    if args.engine == "mitsuba":
+        from reports.mitsuba.render import render_mitsuba
+        image = render_mitsuba(scene, fabric, width=args.width, height=args.height,
+                               spp=args.spp, seed=args.seed, max_depth=max_depth,
+                               variant=variant, workers=args.workers,
+                               progress=cliutil.progress(args), mask=True)
+    else:
+        image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
+                       seed=args.seed, progress=cliutil.progress(args), workers=args.workers,
+                       mask=True)
+    image, cloth = image
+    expo = exposure.auto_exposure(image, cloth) if stops is None else exposure.Exposure(stops)
+    written = []
+    if suffix == ".exr":
+        written.append(imageio.write_exr(out, image, exposure.exr_attributes(expo)))
+        written.append(imageio.write_png(out.with_suffix(".png"), image, expo.stops))
+    else:
+        written.append(imageio.write_png(out, image, expo.stops))
+    log.info(f"{expo.describe()}; wrote " + ", ".join(str(w) for w in written))
+    return 0

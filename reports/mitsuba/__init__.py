@@ -1,0 +1,21 @@
+"""Mitsuba 3: the ``microcylinder`` BSDF plugin and the ``--engine mitsuba`` render.
+
+:mod:`~reports.mitsuba.plugin` registers the plugin (:func:`register`; its names are re-exported
+here, with the plugin's dictionary, which needs no Mitsuba); :mod:`~reports.mitsuba.bsdf`
+the BSDF class, :mod:`~reports.mitsuba.kernel` its Dr.Jit kernel, :mod:`~reports.mitsuba.consts` a
+fabric's numbers as the kernel's parameters; :mod:`~reports.mitsuba.scene` the scenes as Mitsuba scenes,
+:mod:`~reports.mitsuba.render` the render and its variant choice. Mitsuba is imported on use.
+"""
+
+from reports.mitsuba.plugin import (  # noqa: F401  (re-exported)
+    register,
+    plugin_dict,
+    plugin_xml,
+    fabric_from_dict,
+    PLUGIN_NAME,
+    THREAD_KEYS,
+    OPTION_KEYS,
+    RGB_VARIANTS,
+)
+
+__all__ = ['register', 'plugin_dict', 'plugin_xml', 'fabric_from_dict', 'PLUGIN_NAME', 'THREAD_KEYS', 'OPTION_KEYS', 'RGB_VARIANTS']

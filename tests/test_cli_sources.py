@@ -108,7 +108,7 @@ def test_plot_lobes_of_every_kind_at_once(sources, tmp_path):
 
 @pytest.mark.parametrize("verb, extra, expect", [
     ("energy", ["--variants", "default", "--theta-step", "45", "--phi", "0", "--no-furnace",
-                "--no-hemispherical", "--tol", "1e-2", "-q"], "Directional albedo maxima"),
+                "--no-hemispherical", "--tol", "1e-2", "-q"], "Energy: directional albedos"),
     ("reciprocity", ["-n", "200", "--grid-step", "0", "--no-felts", "--variants",
                      "default"], "Reciprocity error"),
     ("sanity", [], "ok ("),

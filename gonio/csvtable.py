@@ -1,4 +1,4 @@
-"""BRDF tables as CSV text (specification: README.md, "The CSV table format")."""
+"""BRDF tables as CSV text (specification: docs/guide/formats.rst, "The CSV table format")."""
 
 from __future__ import annotations
 

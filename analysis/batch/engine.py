@@ -50,12 +50,18 @@ def _quiet_dask():
         log.setLevel(level)
 
 
+def _distributed():
+    """The ``distributed`` module, imported on first use (the one place it is imported)."""
+    # distributed is imported on use: it takes most of a second, and every `microcyl` verb
+    # imports this package (for the batch page).
+    import distributed
+    return distributed
+
+
 @contextlib.contextmanager
 def _client(workers: int | None, scheduler: str | None):
     """A Dask client: of a new LocalCluster, or connected to ``scheduler``."""
-    # distributed is imported on use: it takes most of a second, and every `microcyl` verb
-    # imports this package (for the batch page).
-    from distributed import Client, LocalCluster
+    Client, LocalCluster = _distributed().Client, _distributed().LocalCluster
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout="20s")
@@ -242,7 +248,7 @@ def _record(fut, job, summary, names, bar, say):
 
 def _gather(client, todo, out, summary, names, bar, say):
     """Submit ``todo`` and record each row as its fit ends."""
-    from distributed import as_completed   # on use, as in _client
+    as_completed = _distributed().as_completed
     run = uuid.uuid4().hex[:8]
     futures = {client.submit(run_job, job, str(out), key=f"microcyl-fit-{job.name}-{run}",
                              pure=False): job for job in todo}

@@ -159,17 +159,15 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
         Walkers per ensemble (>= 2 x ndim; default 2 x ndim + 2, even).
     seed : int
         Seeds the optimizer starts and every ensemble (via SeedSequence).
-    max_steps : int
-        Step limit per ensemble.
-    check_every : int
-        Steps between convergence checks, which are also the checkpoints.
+    max_steps, check_every : int
+        Step limit per ensemble; steps between convergence checks (also the checkpoints).
     min_ratio, tau_tol, rhat_max, burn_fraction : float
         Convergence criteria (:mod:`analysis.fit.convergence`).
     laplace_move : float
         Largest share of the independence move (0 turns it off).
     adapt : int, optional
-        First refit point of the independence proposal (then doubling; default
-        ``2 * check_every``, 0 for never; :func:`analysis.fit.moves.refit`).
+        First refit of the independence proposal (then doubling; default ``2 * check_every``,
+        0 never; :func:`analysis.fit.moves.refit`).
     threads : int, optional
         Threads sharing each batched evaluation (default min(2, cores)).
     out_dir : path, optional
@@ -177,37 +175,34 @@ def fit(table, spec: ParamSpec, model: Callable, *, likelihood: str = "gaussian"
     time_limit : float, optional
         Seconds after which sampling stops (checked at each convergence check).
     progress : bool or callable
-        A tqdm bar (True) whose total is the step count expected at convergence, re-estimated
-        at each check (one line a check instead on a pipe or a file:
-        :mod:`analysis.fit.progress`), none (False), or ``progress(steps)`` called about
-        every 0.25 s.
+        A tqdm bar (True; total the steps expected at convergence, re-estimated at each check;
+        a line a check on a pipe or file: :mod:`analysis.fit.progress`), none (False), or
+        ``progress(steps)`` called about every 0.25 s.
     config_extra : mapping, optional
         Also recorded in (and matched against) the stored configuration.
     notify : callable, optional
-        ``notify(line)`` is given the estimated time of the fit before it starts when it may
-        take ``ESTIMATE_MIN_S`` or more (:func:`estimate_time`; not on a resume), and a
-        point estimate that ends on bounds.
+        ``notify(line)`` gets the fit's estimated time before it starts when that may be
+        ``ESTIMATE_MIN_S`` or more (:func:`estimate_time`; not on a resume), and a point
+        estimate that ends on bounds.
     shading : {"float32", "float64"}
-        Precision of the model's shading while sampling, when ``model`` offers
-        ``with_dtype`` (as :class:`~analysis.fit.posterior.FabricModel` does). float32 (the
-        default) shades about twice as fast, at a relative error of a few 1e-6 in f_r: a
-        change of the log-likelihood far below its sampling noise. The point estimate, the
-        Laplace step and every prediction of the result use float64. Not part of the
-        stored configuration: a checkpoint resumes under either.
+        Precision of the model's shading while sampling (when ``model`` has ``with_dtype``,
+        as :class:`~analysis.fit.posterior.FabricModel`): float32 shades twice as fast, f_r
+        off by a few 1e-6 relative, far below the log-likelihood's noise; the point estimate,
+        Laplace step and predictions use float64. Not stored: a checkpoint resumes under either.
 
     Returns
     -------
     FitResult
-        With its ``adequacy`` and ``warnings`` (:func:`analysis.fit.trust.assess`: does the
-        model describe the table, and what the posterior cannot tell).
+        With ``adequacy`` and ``warnings`` (:func:`analysis.fit.trust.assess`: does the model
+        describe the table, what the posterior cannot tell).
 
     Raises
     ------
     ValueError
-        Too few valid values for the free parameters, bad options, more memory than there
-        is (the estimate in the message), a checkpoint made with another configuration, a
-        corrupt checkpoint, or a point estimate whose log-posterior is not finite (nothing is
-        then written): all before sampling starts.
+        Too few valid values for the free parameters, bad options, more memory than there is
+        (the estimate in the message), a checkpoint of another configuration, a corrupt
+        checkpoint, or a point estimate whose log-posterior is not finite (nothing written):
+        all before sampling starts.
     FitInterrupted
         On Ctrl-C during sampling, after checkpointing the steps done (a KeyboardInterrupt).
     """

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import brdf
 from analysis.batch import jobs_from_inputs, run_batch
+from reports.cli import lazy
 from reports.cli import options as cliutil
 from reports.report_batch import write_batch_page
 
@@ -55,8 +56,7 @@ def run(args) -> int:
     brdf.check_preset(args.fabric)
     plots = None
     if not args.no_plots:
-        # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
-        from reports.plots.fit_diagnostics import write_fit_plots as plots
+        plots = lazy.plots().fit_diagnostics.write_fit_plots
     fab = cliutil.fabric_from_args(args.fabric, args)
     out = cliutil.check_writable_dir(Path(args.output))
     free = args.free.split(",") if args.free and not args.free.endswith(".toml") else args.free

@@ -18,6 +18,7 @@ from analysis.budget import check_fit_rows
 from analysis.fit import FabricModel, FitOptions, fit_fabric, fit_spec
 from analysis.fit.fisher import suggest_free
 from analysis.fit.loo import HIGH_K
+from reports.cli import lazy
 from reports.cli import options as cliutil
 
 __all__ = ["register", "run", "read_table", "format_summary", "format_information",
@@ -86,8 +87,7 @@ def run(args) -> int:
     table = read_table(args.table, args.sample)
     plots = None
     if not args.no_plots:
-        # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
-        from reports.plots.fit_diagnostics import write_fit_plots as plots
+        plots = lazy.plots().fit_diagnostics.write_fit_plots
     result = fit_fabric(
         table, fab, spec, out, plots=plots, progress=cliutil.progress(args), **fit_kw,
         notify=lambda line: print(line, file=sys.stderr, flush=True),

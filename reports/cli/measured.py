@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from analysis.measured import MEASURED, SUMMARY_FILE, fit_measured
+from reports.cli import lazy
 from reports.cli import options as cliutil
 
 __all__ = ["register", "run"]
@@ -49,8 +50,7 @@ def run(args) -> int:
     out = cliutil.check_writable_dir(Path(args.output))
     plots = None
     if not args.no_plots:
-        # lazy: fitplots loads matplotlib and corner (~1 s), which `microcyl --help` skips
-        from reports.plots.fit_diagnostics import write_fit_plots as plots
+        plots = lazy.plots().fit_diagnostics.write_fit_plots
     doc = fit_measured(args.names, out, data_dir=cliutil.data_dir(args.data),
                        seed=args.seed,
                        max_steps=args.max_steps, time_limit=args.time_limit,

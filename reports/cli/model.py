@@ -13,8 +13,10 @@ import numpy as np
 import brdf
 import gonio
 from analysis import sources
+from analysis.colour import luminance
 from analysis.folderlock import output_lock
 from analysis.fit.results import read_results
+from reports.cli import lazy
 from reports.cli import options as cliutil
 from reports.report_batch import write_batch_page
 from reports.standard import STANDARD_GEOMETRIES, standard_values
@@ -124,11 +126,7 @@ def run_eval(args):
 
 
 def run_report(args):
-    # lazy: the report loads matplotlib and colour-science (~2 s), which the other verbs of
-    # this module and `microcyl --help` skip
-    from analysis.colour import luminance
-    from reports.report import build_report
-
+    build_report = lazy.report()
     if args.batch is not None:
         with output_lock(Path(args.batch), "report"):    # the batch folder's own lock
             log.info(f"wrote the batch page {write_batch_page(args.batch)}")

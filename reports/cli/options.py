@@ -148,8 +148,9 @@ def add_fit_options(p: argparse.ArgumentParser) -> None:
                    help="comma-separated free parameters, or a TOML file (default "
                         f"{','.join(DEFAULT_FREE)}: the albedo stays at the preset's, on RGB "
                         "tables too, as freeing both threads' is slower and often "
-                        "confounded (README); add albedo1 (albedo2) to fit the table's "
-                        "colour; `microcyl fit --suggest` tells which the table informs)")
+                        "confounded (docs: guide/fitting, 'Parameters, free and tied'); "
+                        "add albedo1 (albedo2) to fit the table's colour; "
+                        "`microcyl fit --suggest` tells which the table informs)")
     p.add_argument("--spec", default=None, metavar="TOML",
                    help="TOML file with free, tie, [bounds], [prior], [start]")
     p.add_argument("--tie", action="append", default=None, metavar="A=B",

@@ -20,6 +20,7 @@ import brdf
 import gonio
 from analysis import sources
 from analysis.fit.medians import median_fabric
+from reports.cli import lazy
 from reports.cli import options as cliutil
 
 __all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes",
@@ -165,8 +166,7 @@ def _check(args) -> None:
 
 
 def _check_incidences(table, args) -> None:
-    from reports.plots.fit import plane_incidences   # matplotlib: loaded by run_plot already
-
+    plane_incidences = lazy.plots().fit.plane_incidences
     phi = (args.plane or (0.0,))[0]
     have = plane_incidences(table, phi)
     for t in args.theta_i or ():
@@ -215,10 +215,7 @@ def _models(args) -> dict:
 def run_plot(args):
     _check(args)
     models = _models(args)
-    # lazy: matplotlib and colour-science (~2 s), which `microcyl --help` and the other
-    # verbs skip
-    from reports.plots import views as plot_views
-    from reports.plots.common import save_figure
+    plot_views, save_figure = lazy.plots().views, lazy.plots().common.save_figure
 
     opts = dict(channel=args.channel, theta_i=args.theta_i, planes=args.plane,
                 scale=args.scale, resolution=args.resolution)

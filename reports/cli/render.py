@@ -31,8 +31,11 @@ import math
 from pathlib import Path
 
 import brdf
+from reports.cli import lazy
 from reports.cli import options as cliutil
+from reports.mitsuba import render as mitsuba_render
 from reports.render.lights import PointLight
+from reports.render.scenes import make_scene
 
 __all__ = ["register", "run"]
 
@@ -94,7 +97,6 @@ def _engine_options(args, fabric):
         raise ValueError(f"--max-depth {max_depth}: must be -1 (unbounded) or 1 to 1024")
     if not isinstance(fabric, brdf.Fabric):
         raise ValueError("--engine mitsuba renders a brdf.Fabric only")
-    from reports.mitsuba import render as mitsuba_render  # no Mitsuba import: that waits for the render
     try:
         variant = mitsuba_render.pick_variant(args.variant)
     except ImportError as exc:
@@ -104,12 +106,9 @@ def _engine_options(args, fabric):
 
 def run(args):
     """Check every argument, render, write the files; return 0."""
-    # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
-    from reports.render import exposure
-    from reports.render import imageio
-    from reports.render.engine import check_size, render
-    from reports.render.scenes import make_scene
-
+    built_in = lazy.renderer()
+    exposure, imageio = built_in.exposure, built_in.imageio
+    check_size, render = built_in.engine.check_size, built_in.engine.render
     scene = make_scene(args.scene)
     check_size(args.width, args.height, args.spp)
     stops = exposure.parse_exposure(args.exposure)
@@ -131,8 +130,7 @@ def run(args):
         raise ValueError(f"--workers {args.workers}: must be at least 1")
     variant, max_depth = _engine_options(args, fabric)
     if args.engine == "mitsuba":
-        from reports.mitsuba.render import render_mitsuba
-        image = render_mitsuba(scene, fabric, width=args.width, height=args.height,
+        image = mitsuba_render.render_mitsuba(scene, fabric, width=args.width, height=args.height,
                                spp=args.spp, seed=args.seed, max_depth=max_depth,
                                variant=variant, workers=args.workers,
                                progress=cliutil.progress(args), mask=True)

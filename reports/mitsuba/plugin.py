@@ -45,6 +45,20 @@ __all__ = ["register", "plugin_dict", "plugin_xml", "fabric_from_dict", "PLUGIN_
 RGB_VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
 
 
+def mitsuba_modules():
+    """``(mitsuba, drjit, bsdf)``: Mitsuba, Dr.Jit and :mod:`reports.mitsuba.bsdf`, imported on
+    first use (the one place the plugin's modules load them).
+
+    Raises
+    ------
+    ImportError
+        Mitsuba is not installed.
+    """
+    # optional dependency, loaded on use: bsdf imports mitsuba and drjit at its top
+    from reports.mitsuba import bsdf
+    return bsdf.mi, bsdf.dr, bsdf
+
+
 def register() -> None:
     """Register the BSDF ``microcylinder`` with Mitsuba for the variant that is set.
 
@@ -58,12 +72,10 @@ def register() -> None:
     ValueError
         No variant is set, or it is not one of :data:`RGB_VARIANTS`' kind (``*_rgb``).
     """
-    import mitsuba as mi  # optional dependency, loaded on use (and the plugin with it)
+    mi, _, mitsuba_bsdf = mitsuba_modules()
 
     variant = mi.variant()
     if variant is None or not variant.endswith("_rgb") or "polarized" in variant:
         raise ValueError(f"the {PLUGIN_NAME} BSDF needs an RGB variant "
                          f"({', '.join(RGB_VARIANTS)}); the variant set is {variant!r}")
-    from reports.mitsuba import bsdf as mitsuba_bsdf  # imports mitsuba and drjit at its top
-
     mi.register_bsdf(PLUGIN_NAME, lambda props: mitsuba_bsdf.bsdf_class()(props))

@@ -31,7 +31,9 @@ import numpy as np
 
 from brdf.fabric import Fabric
 from gonio.progress import progress_bar
+from reports.mitsuba import plugin
 from reports.mitsuba.plugin import RGB_VARIANTS
+from reports.render.checks import check_size, resolve_fabric, scene_of
 
 __all__ = ["render_mitsuba", "pick_variant", "variant_works", "have_mitsuba", "MISSING",
            "PASS_SAMPLES"]
@@ -171,43 +173,59 @@ def render_mitsuba(scene, fabric, width=1280, height=720, spp=16, *, seed=0, max
     ValueError
         An unknown scene or fabric, a bad size, spp, seed, depth or variant, before rendering.
     """
-    from reports.render.engine import _scene_of, check_size, cloth_coverage, resolve_fabric
+    # lazy: the engine's imageio pulls in colour-science (~2 s), which `microcyl --help` skips
+    from reports.render.engine import cloth_coverage
 
     check_size(width, height, spp)
-    scene = _scene_of(scene, None, None)
+    scene = scene_of(scene, None, None)
     fabric = resolve_fabric(fabric)
     _check(fabric, max_depth, workers)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed={seed!r} must be a non-negative integer")
     variant = pick_variant(variant)
-    import drjit as dr     # optional dependency, loaded on use
-    import mitsuba as mi
+    mi = _start_mitsuba(variant, workers)
+    per_pass = max(1, min(spp, PASS_SAMPLES // (width * height)))
+    passes = [per_pass] * (spp // per_pass) + ([spp % per_pass] if spp % per_pass else [])
+    mscenes = _load_scenes(mi, scene, fabric, width, height, per_pass, max_depth)
+    image = _render_passes(mi, mscenes, passes, seed, (height, width), progress,
+                           desc=f"render {scene.name or 'scene'} (mitsuba {variant})")
+    if mask:
+        return image, cloth_coverage(scene, width, height, spp=min(spp, 4), seed=seed)
+    return image
 
+
+def _start_mitsuba(variant, workers):
+    """Set ``variant``, register the plugin, set Dr.Jit's threads; return the mitsuba module."""
+    mi, dr, _ = plugin.mitsuba_modules()
     mi.set_variant(variant)
-    from reports.mitsuba import plugin
-    from reports.mitsuba import scene as mitsuba_scene
-
     plugin.register()
     if workers is not None and variant != "scalar_rgb":
         dr.set_thread_count(workers)
-    per_pass = max(1, min(spp, PASS_SAMPLES // (width * height)))
-    passes = [per_pass] * (spp // per_pass) + ([spp % per_pass] if spp % per_pass else [])
+    return mi
+
+
+def _load_scenes(mi, scene, fabric, width, height, per_pass, max_depth) -> list:
+    """The Mitsuba scenes of ``scene``: one per light (key, sky), or one of its only light."""
+    from reports.mitsuba import scene as mitsuba_scene  # imports mitsuba at its top
+
     # one scene per light (key, sky), their images summed: every path samples both lights
     # (one scene of both would send each shadow ray to one of them, chosen at random)
     lights = ("key", "sky") if scene.environment is not None else ("both",)
-    mscenes = [mi.load_dict(mitsuba_scene.scene_dict(scene, fabric, width, height, per_pass,
-                                                     seed=0, max_depth=max_depth,
-                                                     lights=which)) for which in lights]
-    total = np.zeros((height, width, 3))
+    return [mi.load_dict(mitsuba_scene.scene_dict(scene, fabric, width, height, per_pass,
+                                                  seed=0, max_depth=max_depth,
+                                                  lights=which)) for which in lights]
+
+
+def _render_passes(mi, mscenes, passes, seed, shape, progress, desc) -> np.ndarray:
+    """The mean over ``passes`` (samples per pass) of every scene's images summed, float32
+    (height, width, 3); each pass of each scene with its own seed."""
+    total = np.zeros((*shape, 3))
     with progress_bar(len(passes) * len(mscenes), unit="pass", enabled=progress,
-                      desc=f"render {scene.name or 'scene'} (mitsuba {variant})") as bar:
+                      desc=desc) as bar:
         for j, mscene in enumerate(mscenes):
             for k, n in enumerate(passes):
                 img = mi.render(mscene, seed=(int(seed) * 1000003 + 1009 * j + k) % 2**32,
                                 spp=n)
                 total += np.asarray(img, dtype=np.float64)[..., :3] * n
                 bar.update()
-    image = (total / spp).astype(np.float32)
-    if mask:
-        return image, cloth_coverage(scene, width, height, spp=min(spp, 4), seed=seed)
-    return image
+    return (total / sum(passes)).astype(np.float32)

@@ -35,73 +35,21 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
-import brdf
-from brdf.protocols import BRDF
 from gonio.progress import progress_bar
 from reports.render import pixelsamples
+from reports.render.checks import (MAX_HEIGHT, MAX_SPP, MAX_WIDTH, check_size,  # noqa: F401
+                                   check_workers, probe, resolve_fabric, scene_of)
 from reports.render.envlight import environment_radiance
 from reports.render.imageio import write_exr, write_png
-from reports.render.scenes import SCENES, Scene, make_scene
+from reports.render.scenes import SCENES
 from reports.render.tracing import intersect, occluded
 from reports.render.workerexit import exit_with_parent
 
 __all__ = ["render", "cloth_coverage", "write_exr", "write_png", "MAX_WIDTH", "MAX_HEIGHT",
            "SCENES", "resolve_fabric", "check_size"]
 
-#: Largest image the renderer accepts, pixels.
-MAX_WIDTH, MAX_HEIGHT = 1280, 720
-#: Most samples per pixel accepted.
-MAX_SPP = 4096
 #: Largest number of (wi, wo) pairs passed to one ``fabric.eval`` call.
 BRDF_BATCH = 131072
-
-
-def check_size(width, height, spp=16):
-    """Raise ValueError unless ``0 < width <= 1280``, ``0 < height <= 720`` and
-    ``0 < spp <= 4096`` (all integers).
-
-    Examples
-    --------
-    >>> check_size(1280, 720, 16)
-    >>> check_size(1920, 1080)
-    Traceback (most recent call last):
-    ...
-    ValueError: width=1920 is beyond the limit: images are at most 1280 x 720 pixels
-    """
-    for name, value, top in (("width", width, MAX_WIDTH), ("height", height, MAX_HEIGHT)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise ValueError(f"{name}={value!r} must be an integer number of pixels")
-        if value < 1:
-            raise ValueError(f"{name}={value} must be at least 1 pixel")
-        if value > top:
-            raise ValueError(f"{name}={value} is beyond the limit: images are at most "
-                             f"{MAX_WIDTH} x {MAX_HEIGHT} pixels")
-    if isinstance(spp, bool) or not isinstance(spp, (int, np.integer)) or not 1 <= spp <= MAX_SPP:
-        raise ValueError(f"spp={spp!r} must be an integer from 1 to {MAX_SPP}")
-
-
-def resolve_fabric(fabric, **options):
-    """A BRDF object from a preset name (through ``brdf.fabric``) or any object with ``.eval``.
-
-    Parameters
-    ----------
-    fabric : str or object
-        A name in ``brdf.PRESETS`` or an object whose ``eval(wi, wo)`` returns (..., 3) f_r.
-    **options
-        Passed to ``brdf.fabric`` with a name, or to ``fabric.replace`` with an object.
-
-    Raises
-    ------
-    ValueError
-        For an unknown name or an object without ``eval``.
-    """
-    if isinstance(fabric, str):
-        return brdf.fabric(brdf.check_preset(fabric), **options)
-    if not isinstance(fabric, BRDF):
-        raise ValueError(f"fabric={fabric!r} must be a preset name or have an eval(wi, wo) method")
-    if options:
-        return fabric.replace(**options)
-    return fabric
 
 
 # --------------------------------------------------------------------------- shading
@@ -215,7 +163,7 @@ def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
     ((3, 4), 1.0)
     """
     check_size(width, height, spp)
-    return pixelsamples.coverage(_scene_of(scene, None, None), width, height, spp, seed, chunk)
+    return pixelsamples.coverage(scene_of(scene, None, None), width, height, spp, seed, chunk)
 
 
 def _tiles(width, height, tile):
@@ -332,21 +280,40 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     >>> bool(np.allclose(img, 0.5 / np.pi))   # f_r * E * cos(theta_i), E = 1, theta_i = 0
     True
     """
+    ctx, workers = _checked_context(scene, fabric, width, height, spp, light, camera, seed,
+                                    tile, workers, sky_spp)
+    image = _render_tiles(ctx, tile, workers, progress)
+    rgb = np.ascontiguousarray(image[..., :3])
+    return (rgb, np.ascontiguousarray(image[..., 3])) if mask else rgb
+
+
+def _checked_context(scene, fabric, width, height, spp, light, camera, seed, tile, workers,
+                     sky_spp) -> tuple[dict, int]:
+    """Check :func:`render`'s arguments, in its order, before any work; return the tiles'
+    shared context (scene, fabric, size, samples, seed) and the number of workers."""
     check_size(width, height, spp)
-    scene = _scene_of(scene, light, camera)
+    scene = scene_of(scene, light, camera)
     fabric = resolve_fabric(fabric)
-    workers = _check_workers(tile, workers)
-    _probe(fabric)
+    workers = check_workers(tile, workers)
+    probe(fabric)
     sky_spp = spp if sky_spp is None else sky_spp
     if isinstance(sky_spp, bool) or not isinstance(sky_spp, (int, np.integer)) \
             or not 1 <= sky_spp <= spp:
         raise ValueError(f"sky_spp={sky_spp!r} must be an integer from 1 to spp={spp}")
     ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
            "spp": int(spp), "seed": int(seed), "sky_spp": int(sky_spp)}
+    return ctx, workers
+
+
+def _render_tiles(ctx, tile, workers, progress) -> np.ndarray:
+    """The (height, width, 4) image of ``ctx``'s scene: RGB and cloth coverage, tile by tile,
+    in this process (``workers == 1``) or in a pool."""
+    width, height = ctx["width"], ctx["height"]
     tiles = _tiles(width, height, tile)
     image = np.zeros((height, width, 4), np.float32)
     workers = min(workers, len(tiles))
-    new_bar = functools.partial(progress_bar, len(tiles), desc=f"render {scene.name or 'scene'}",
+    new_bar = functools.partial(progress_bar, len(tiles),
+                                desc=f"render {ctx['scene'].name or 'scene'}",
                                 unit="tile", enabled=progress)
     if workers == 1:
         with new_bar() as bar:
@@ -355,43 +322,7 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
                 bar.update()
     else:
         _render_pool(image, tiles, ctx, workers, new_bar)
-    rgb = np.ascontiguousarray(image[..., :3])
-    return (rgb, np.ascontiguousarray(image[..., 3])) if mask else rgb
-
-
-def _scene_of(scene, light, camera) -> Scene:
-    """The Scene to render: ``scene`` (a name or a Scene) with ``light``/``camera`` replaced."""
-    if not isinstance(scene, Scene):
-        if not isinstance(scene, str):
-            raise ValueError(f"scene={scene!r} must be a scene name or a Scene")
-        scene = make_scene(scene)
-    if light is not None:
-        scene = scene.replace(light=light)
-    if camera is not None:
-        scene = scene.replace(camera=camera)
-    return scene
-
-
-def _check_workers(tile, workers) -> int:
-    """Check ``tile``; return ``workers`` (default: the usable cores), checked."""
-    if isinstance(tile, bool) or not isinstance(tile, (int, np.integer)) or tile < 1:
-        raise ValueError(f"tile={tile!r} must be a positive integer")
-    if workers is None:
-        try:
-            workers = len(os.sched_getaffinity(0))
-        except AttributeError:  # pragma: no cover
-            workers = os.cpu_count() or 1
-    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
-        raise ValueError(f"workers={workers!r} must be a positive integer")
-    return workers
-
-
-def _probe(fabric) -> None:
-    """One tiny evaluation: a broken BRDF fails now, not after the pool starts."""
-    z = np.array([[0.0, 0.0, 1.0]])
-    probe = np.asarray(fabric.eval(z, z))
-    if probe.shape != (1, 3):
-        raise ValueError(f"fabric.eval returned shape {probe.shape} for one pair; (1, 3) expected")
+    return image
 
 
 def _paste(image, done) -> None:

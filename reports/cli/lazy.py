@@ -1,0 +1,32 @@
+"""The costly modules the command line loads on use, each imported in one place.
+
+matplotlib, corner and colour-science cost ``microcyl --help`` and the verbs that do not draw
+about two seconds; the verbs that draw, render or write the report reach them through these
+accessors (imported on first call, cached by Python's module table after).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+
+def plots() -> SimpleNamespace:
+    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``, ``views``."""
+    # lazy: matplotlib, corner and colour-science (~2 s), which `microcyl --help` skips
+    from reports.plots import common, fit, fit_diagnostics, views
+    return SimpleNamespace(common=common, fit=fit, fit_diagnostics=fit_diagnostics,
+                           views=views)
+
+
+def report():
+    """:func:`reports.report.build_report` (the report's plots load matplotlib)."""
+    # lazy: matplotlib and colour-science (~2 s), which the other verbs skip
+    from reports.report import build_report
+    return build_report
+
+
+def renderer() -> SimpleNamespace:
+    """The built-in renderer's ``engine``, ``exposure`` and ``imageio`` modules."""
+    # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
+    from reports.render import engine, exposure, imageio
+    return SimpleNamespace(engine=engine, exposure=exposure, imageio=imageio)

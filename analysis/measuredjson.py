@@ -24,6 +24,7 @@ import math
 from pathlib import Path, PurePosixPath
 
 from gonio.safenames import check_component, check_inside
+from gonio.statefields import FileFields
 
 __all__ = ["load_measured_json", "check_measured_doc", "results_path"]
 
@@ -34,9 +35,8 @@ _QUALITY = ("rms_residual", "rms_normalized", "albedo_delta_e2000")
 
 
 def _bad(path, field: str, allowed: str, value) -> ValueError:
-    text = repr(value)
-    text = text if len(text) <= 60 else text[:57] + "..."
-    return ValueError(f"{path}: {field} must be {allowed}; got {text}")
+    """The one-line error of :class:`gonio.statefields.FileFields` (names escaped)."""
+    return FileFields(path).error(field, allowed, value)
 
 
 def _number(path, field: str, value) -> None:

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import gonio
 from gonio.safenames import check_component
+from gonio.statefields import FileFields
 
 __all__ = ["BatchSummary", "SUMMARY_CSV", "SUMMARY_JSON", "SCHEMA", "FIRST_COLUMNS",
            "STATUSES", "check_row"]
@@ -30,9 +31,8 @@ _STATS = ("_median", "_lo95", "_hi95")
 
 
 def _bad(path, field: str, allowed: str, value) -> ValueError:
-    text = repr(value)
-    text = text if len(text) <= 60 else text[:57] + "..."
-    return ValueError(f"{path}: {field} must be {allowed}; got {text}")
+    """The one-line error of :class:`gonio.statefields.FileFields` (names escaped)."""
+    return FileFields(path).error(field, allowed, value)
 
 
 def _count(v) -> bool:

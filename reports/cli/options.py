@@ -224,10 +224,10 @@ def split_ties(ties):
 def reader_options(path, **options) -> dict:
     """The reader options given (not None) for ``path``, each checked against its format:
     ``--sample`` for a CUReT abrdf.dat, ``--step`` for an RGL .bsdf, ``--stride`` for a MERL
-    .binary; another is refused by name (:func:`gonio.io.check_read_options`). A table whose
-    reading would exceed the memory limit, estimated from the file's size and header (its
-    line count, an OpenEXR or RGL header, the MERL stride: :func:`gonio.tablesize.check_table`),
-    is refused with its estimate, before anything is parsed."""
+    .binary; another is refused by name (:func:`gonio.io.check_read_options`). The table's
+    size is not estimated here: :func:`gonio.read` refuses a table whose reading would exceed
+    the memory limit before parsing it, and a verb that must know the size before other work
+    calls :func:`table_estimate` (each estimate counts a CSV's lines once)."""
     path = Path(path)
     given = {k: v for k, v in options.items() if v is not None}
     if given:
@@ -241,7 +241,6 @@ def reader_options(path, **options) -> dict:
         step = given["step"]
         if not (math.isfinite(step) and 0 < step <= 90):
             raise ValueError(f"--step must be in (0, 90] degrees; got {step}")
-    table_estimate(path, **given)
     return given
 
 

@@ -27,12 +27,13 @@ DEFAULT_CANDIDATES = "full:10:20"
 
 
 def reachable(instrument, wi, wo) -> np.ndarray:
-    """Which pairs (..., 3) the instrument reaches: :meth:`gonio.Instrument.reachable`, all
-    pairs above the horizon for an instrument without limits."""
+    """Which pairs (..., 3) ``instrument`` reaches (:meth:`gonio.Instrument.reachable`) above
+    the horizon; every pair above it when ``instrument`` is None."""
     wi, wo = np.asarray(wi, dtype=np.float64), np.asarray(wo, dtype=np.float64)
     above = (wi[..., 2] > 0) & (wo[..., 2] > 0)
-    check = getattr(instrument, "reachable", None)
-    return above if check is None else above & np.asarray(check(wi, wo), bool)
+    if instrument is None or wi.shape[0] == 0:
+        return above
+    return above & np.asarray(instrument.reachable(wi, wo), bool)
 
 
 class Candidates:

@@ -33,13 +33,8 @@ from analysis.planning.select import (exchange, expected_covariance, expected_lo
                                       greedy)
 from analysis.sources import Source, resolve
 from brdf.frames import to_angles
+from gonio.pairsfile import order_for_travel
 from gonio.progress import progress_bar
-
-try:                                    # TEMPORARY adapter until h-instrument is merged
-    from gonio.pairsfile import order_for_travel
-except ImportError:                     # pragma: no cover
-    def order_for_travel(angles):
-        return np.arange(len(angles))
 
 __all__ = ["Plan", "plan", "MAX_BUDGET", "DEFAULT_DRAWS"]
 
@@ -155,9 +150,10 @@ def _source(fabric_or_source) -> Source:
     return resolve(fabric_or_source, what="fabric")
 
 
-def _measured_pairs(measured, instrument):
-    """(wi, wo) of the pairs already measured: a table (rows with a missing value dropped)
-    or a (wi, wo) tuple; every pair must be reachable."""
+def _measured_pairs(measured):
+    """(wi, wo) of the pairs already measured: a table (rows with a missing value or a
+    direction below the horizon dropped, as the likelihood drops them) or a (wi, wo) tuple.
+    They count whatever instrument took them (its limits are not this one's business)."""
     if measured is None:
         return np.zeros((0, 3)), np.zeros((0, 3))
     if hasattr(measured, "values"):
@@ -165,7 +161,20 @@ def _measured_pairs(measured, instrument):
         wi, wo = np.asarray(measured.wi)[keep], np.asarray(measured.wo)[keep]
     else:
         wi, wo = (np.asarray(a, dtype=np.float64).reshape(-1, 3) for a in measured)
-    return wi, wo
+    keep = reachable(None, wi, wo)
+    return wi[keep], wo[keep]
+
+
+def _uniform(n: int, instrument, cands: Candidates, seed: int):
+    """A uniform design of ``n`` pairs (:func:`~analysis.planning.candidates.uniform_pairs`);
+    for an instrument that reaches too little of the hemisphere to draw them (in-plane
+    only), ``n`` of the candidates drawn at random (seeded)."""
+    try:
+        return uniform_pairs(n, instrument, max_theta=cands.max_theta, seed=seed)
+    except ValueError:
+        rng = np.random.default_rng([seed, 1])
+        pick = rng.choice(len(cands), size=n, replace=n > len(cands))
+        return cands.wi[pick], cands.wo[pick]
 
 
 def _natural_sd(spec, thetas, a0, jac_design) -> np.ndarray:
@@ -219,8 +228,7 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
     ------
     ValueError
         A bad budget or draw count, unknown free parameters, a noiseless instrument, a budget
-        above the reachable candidates, a measured pair the instrument cannot reach; before
-        any work.
+        above the reachable candidates; before any work.
 
     Examples
     --------
@@ -243,15 +251,11 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
         raise ValueError(f"budget {budget} exceeds the {len(cands)} candidate pairs the "
                          f"instrument reaches on {cands.spec}; give a finer --candidates "
                          f"grid or a smaller budget")
-    mwi, mwo = _measured_pairs(measured, instrument)
-    bad = ~reachable(instrument, mwi, mwo)
-    if np.any(bad):
-        raise ValueError(f"{int(bad.sum())} of the {len(mwi)} measured pairs lie beyond the "
-                         f"instrument's reach (horizon or limits)")
+    mwi, mwo = _measured_pairs(measured)
     rng = np.random.default_rng(seed)
     thetas = (posterior_draws(src.path, spec, draws, rng) if src.kind == "fit"
               else prior_draws(spec, draws, rng))
-    uwi, uwo = uniform_pairs(3 * budget, instrument, max_theta=cands.max_theta, seed=seed)
+    uwi, uwo = _uniform(3 * budget, instrument, cands, seed)
     total = 3 * draws + budget * (2 if exchange_pass else 1)
     with progress_bar(total, desc="plan", unit="step", enabled=progress) as bar:
         def jac(wi, wo):

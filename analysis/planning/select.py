@@ -102,8 +102,8 @@ def greedy(jac, a0, budget: int, *, progress=None) -> list[int]:
     Examples
     --------
     >>> jac = np.zeros((1, 3, 1, 2)); jac[0, :, 0] = [[1, 0], [0, 2], [1, 1]]
-    >>> greedy(jac, np.eye(2)[None], 2)
-    [1, 0]
+    >>> greedy(jac, np.eye(2)[None], 2)  # gains log 5; then log 2.2 (pair 2) over log 2
+    [1, 2]
     """
     a_inv = np.linalg.inv(np.asarray(a0, dtype=np.float64))
     chosen: list[int] = []

@@ -41,6 +41,7 @@ import numpy as np
 from gonio.atomic import atomic_write
 from gonio.csvtable import ANGLE_RANGES, ANGLES
 from gonio.errors import FormatError
+from gonio.geometry import HORIZON_EPS
 from gonio.statefields import one_line
 
 __all__ = ["order_for_travel", "travel", "write_pairs_csv", "read_pairs_header",
@@ -244,13 +245,21 @@ def _column_text(name, values, n: int) -> list[str]:
 
 
 def _check_ranges(a: np.ndarray) -> None:
+    """theta in [0, 90) above the horizon (where :func:`gonio.pairs_from_angles` keeps the
+    pair: a row at the horizon would be dropped by ``measure``), phi in [-360, 360]."""
     for k, name in enumerate(ANGLES):
-        lo, hi = (0.0, 90.0) if name.startswith("theta") else ANGLE_RANGES["phi"]
-        bad = (a[:, k] < lo) | (a[:, k] > hi)
+        if name.startswith("theta"):
+            lo, hi = 0.0, 90.0
+            bad = (a[:, k] < 0) | ~(np.cos(np.radians(a[:, k])) > HORIZON_EPS)
+            allowed = "[0, 90) (above the horizon, where measure keeps the pair)"
+        else:
+            lo, hi = ANGLE_RANGES["phi"]
+            bad = (a[:, k] < lo) | (a[:, k] > hi)
+            allowed = f"[{lo:g}, {hi:g}]"
         if bad.any():
             r = int(np.argmax(bad))
-            raise ValueError(f"angles_deg row {r + 1}: {name} {a[r, k]!r} outside "
-                             f"[{lo:g}, {hi:g}] degrees")
+            raise ValueError(f"angles_deg row {r + 1}: {name} {float(a[r, k])!r} outside "
+                             f"{allowed} degrees")
 
 
 def write_pairs_csv(path, angles_deg, header: Mapping[str, str] | None = None,
@@ -263,7 +272,8 @@ def write_pairs_csv(path, angles_deg, header: Mapping[str, str] | None = None,
     path : str or os.PathLike
         The CSV file to write.
     angles_deg : array_like, shape (n, 4)
-        theta_i, phi_i, theta_o, phi_o in degrees (theta in [0, 90], phi in [-360, 360]).
+        theta_i, phi_i, theta_o, phi_o in degrees (theta in [0, 90) above the horizon,
+        phi in [-360, 360]).
     header : mapping of str to str, optional
         ``# key: value`` lines, in this order: keys names of letters, digits, ``_.-``;
         values written with :func:`str`, one line (unprintable characters escaped,

@@ -18,12 +18,15 @@ from scipy.stats import qmc
 
 from brdf.frames import from_angles
 from gonio.geometry import Geometry
-from gonio.geomspec import from_spec
+from gonio.geomspec import from_spec, spec_pairs
 
-__all__ = ["DEFAULT_CANDIDATES", "Candidates", "candidates", "uniform_pairs", "reachable"]
+__all__ = ["DEFAULT_CANDIDATES", "MAX_CANDIDATES", "Candidates", "candidates",
+           "uniform_pairs", "reachable"]
 
 #: The default candidate geometry (a geometry spec, degrees).
 DEFAULT_CANDIDATES = "full:10:20"
+#: Most pairs a candidate geometry may hold (each costs K x r x d numbers of information).
+MAX_CANDIDATES = 200_000
 
 
 def reachable(instrument, wi, wo) -> np.ndarray:
@@ -63,7 +66,8 @@ def candidates(geometry=None, instrument=None) -> Candidates:
     Raises
     ------
     ValueError
-        A bad spec, or no reachable pair (naming the spec).
+        A bad spec, more than :data:`MAX_CANDIDATES` pairs, or no reachable pair (naming
+        the spec).
 
     Examples
     --------
@@ -71,6 +75,10 @@ def candidates(geometry=None, instrument=None) -> Candidates:
     25
     """
     geometry = DEFAULT_CANDIDATES if geometry is None else geometry
+    n = None if isinstance(geometry, Geometry) else spec_pairs(geometry)
+    if n is not None and n > MAX_CANDIDATES:
+        raise ValueError(f"candidates {geometry!r}: {n:.3g} pairs, at most "
+                         f"{MAX_CANDIDATES:,}: use a coarser step")
     geo = geometry if isinstance(geometry, Geometry) else from_spec(geometry)
     spec = geo.spec if isinstance(geometry, Geometry) else str(geometry)
     ok = reachable(instrument, geo.wi, geo.wo)

@@ -33,6 +33,7 @@ from analysis.planning.select import (exchange, expected_covariance, expected_lo
                                       greedy)
 from analysis.sources import Source, resolve
 from brdf.frames import to_angles
+from gonio.memory import check_memory
 from gonio.pairsfile import order_for_travel
 from gonio.progress import progress_bar
 
@@ -252,6 +253,9 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
                          f"instrument reaches on {cands.spec}; give a finer --candidates "
                          f"grid or a smaller budget")
     mwi, mwo = _measured_pairs(measured)
+    check_memory(f"a plan over {len(cands)} candidates x {draws} draws x {spec.ndim} free "
+                 f"parameters", 3 * draws * len(cands) * 3 * spec.ndim * 8.0,
+                 "give coarser --candidates or fewer --draws")
     rng = np.random.default_rng(seed)
     thetas = (posterior_draws(src.path, spec, draws, rng) if src.kind == "fit"
               else prior_draws(spec, draws, rng))

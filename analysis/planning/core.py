@@ -260,23 +260,32 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
     thetas = (posterior_draws(src.path, spec, draws, rng) if src.kind == "fit"
               else prior_draws(spec, draws, rng))
     uwi, uwo = _uniform(3 * budget, instrument, cands, seed)
-    total = 3 * draws + budget * (2 if exchange_pass else 1)
-    with progress_bar(total, desc="plan", unit="step", enabled=progress) as bar:
-        def jac(wi, wo):
-            return whitened_jacobians(fab, spec, thetas, wi, wo, instrument, grey=grey,
-                                      progress=bar.update)
-        j_cand = jac(cands.wi, cands.wo)
-        a0 = PRIOR_INFORMATION * np.eye(spec.ndim) + information(
-            whitened_jacobians(fab, spec, thetas, mwi, mwo, instrument, grey=grey))
-        j_uni = jac(uwi, uwo)
-        chosen = greedy(j_cand, a0, budget, progress=bar.update)
-        if exchange_pass:
-            chosen = exchange(j_cand, a0, chosen, progress=bar.update)
-        bar.update(draws)
+    chosen, a0, j_cand, j_uni = _choose(fab, spec, thetas, cands, (mwi, mwo), (uwi, uwo),
+                                        instrument, budget, grey, exchange_pass, progress)
     return _assemble(src, spec, cands, chosen, thetas, a0, j_cand, j_uni, (uwi, uwo),
                      dict(draws=draws, seed=seed, source="posterior" if src.kind == "fit"
                           else "prior", n_measured=len(mwi),
                           instrument=instrument.describe()))
+
+
+def _choose(fab, spec, thetas, cands, measured, uniform, instrument, budget, grey,
+            exchange_pass, progress):
+    """The information of the candidates, of the measured pairs (the start) and of the
+    uniform design; the choice. Returns (chosen, a0, j_cand, j_uni)."""
+    draws = thetas.shape[0]
+    total = 3 * draws + budget * (2 if exchange_pass else 1)
+    with progress_bar(total, desc="plan", unit="step", enabled=progress) as bar:
+        def jac(wi, wo, update=bar.update):
+            return whitened_jacobians(fab, spec, thetas, wi, wo, instrument, grey=grey,
+                                      progress=update)
+        j_cand = jac(cands.wi, cands.wo)
+        a0 = PRIOR_INFORMATION * np.eye(spec.ndim) + information(jac(*measured, None))
+        j_uni = jac(*uniform)
+        chosen = greedy(j_cand, a0, budget, progress=bar.update)
+        if exchange_pass:
+            chosen = exchange(j_cand, a0, chosen, progress=bar.update)
+        bar.update(draws)
+    return chosen, a0, j_cand, j_uni
 
 
 def _assemble(src, spec, cands, chosen, thetas, a0, j_cand, j_uni, uniform, extra) -> Plan:

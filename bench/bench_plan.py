@@ -66,6 +66,11 @@ def fit_widths(table, fab, seed):
     s = r.summary
     widths = np.array([s[n]["hi95"] - s[n]["lo95"] for n in spec.free])
     inside = [s[n]["lo95"] <= truth[n] <= s[n]["hi95"] for n in spec.free]
+    missed = [n for n, ok in zip(spec.free, inside) if not ok]
+    if missed:
+        print(f"    truth outside the 95% interval ({len(table)} pairs): "
+              + ", ".join(f"{n} = {truth[n]:.4g} not in [{s[n]['lo95']:.4g}, "
+                          f"{s[n]['hi95']:.4g}]" for n in missed), flush=True)
     return widths, inside, time.perf_counter() - t0, r.converged
 
 

@@ -116,6 +116,24 @@ def test_a_fit_folder_plans_over_its_posterior(fit_folder):
     assert p.source == "posterior" and p.fabric == "fit" and p.budget == 6
     again = plan(out, "gamma_s1,kd1", 6, instrument=ins, candidates=SMALL, draws=4, seed=2)
     assert np.array_equal(p.angles, again.angles)
+    own = plan(out, None, 4, instrument=ins, candidates=SMALL, draws=2)   # the fit's free set
+    assert own.free == ("gamma_s1", "kd1")
+
+
+def test_a_grey_instrument_counts_one_reading_a_pair():
+    """Grey: the information of a grey table (R = G = B, the channels' mean) by
+    analysis.fit.fisher, one row a pair."""
+    fab = brdf.fabric("velvet")
+    ins = Instrument(snr=25)
+    spec = fit_spec(fab, FREE, None)
+    wi, wo = uniform_pairs(40, ins, seed=4)
+    jac = whitened_jacobians(fab, spec, spec.start()[None], wi, wo, ins, grey=True)
+    assert jac.shape == (1, 40, 1, 3)
+    t = _truth_table(fab, wi, wo, Instrument())
+    grey = np.repeat(t.values.mean(axis=1, keepdims=True), 3, axis=1)
+    table = Table(t.wi, t.wo, grey, sigma=ins.sigma(grey))
+    ref = table_information(table, spec, FabricModel(fab, table.wi, table.wo)).information
+    assert np.allclose(information(jac)[0], ref, rtol=1e-5, atol=1e-8 * np.abs(ref).max())
 
 
 def test_laplace_validation_planned_beats_uniform():

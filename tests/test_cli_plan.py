@@ -57,11 +57,12 @@ def test_plan_writes_a_plan_that_measure_reads(tmp_path):
     assert r2.returncode == 0, r2.stderr
     assert (again / "plan.csv").read_bytes() == (out / "plan.csv").read_bytes()
     r3 = microcyl("plan", "velvet", "--free", "kd1,gamma_s1", "--budget", 6, "--snr", 25,
-                  "--candidates", "full:15:30", "--from", out / "measured.csv", "-q",
+                  "--candidates", "full:15:30", "--from", out / "measured.csv", "-q", "--grey",
                   "-o", tmp_path / "next.csv")
     assert r3.returncode == 0, r3.stderr
     assert "6 pairs after 12 measured" in r3.stdout
-    assert read_pairs_header(tmp_path / "next.csv")["measured_before"] == "12"
+    nxt = read_pairs_header(tmp_path / "next.csv")
+    assert nxt["measured_before"] == "12" and nxt["readings"].startswith("grey")
 
 
 def test_bad_options_are_one_line_before_any_work(tmp_path, capsys):

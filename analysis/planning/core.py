@@ -27,7 +27,8 @@ from analysis.fit.fisher import PRIOR_INFORMATION, STEP
 from analysis.fit.workflow import fit_spec
 from analysis.planning.candidates import Candidates, candidates as make_candidates, \
     reachable, uniform_pairs
-from analysis.planning.draws import check_draws, posterior_draws, prior_draws
+from analysis.planning.draws import (check_draws, fit_folder_spec, posterior_draws,
+                                     prior_draws)
 from analysis.planning.information import information, whitened_jacobians
 from analysis.planning.select import (exchange, expected_covariance, expected_log_det,
                                       greedy)
@@ -83,6 +84,8 @@ class Plan:
     n_candidates, n_measured : int
     instrument : dict
         :meth:`gonio.Instrument.describe`.
+    grey : bool
+        Whether the instrument reads one grey value a pair (else R, G and B).
     """
 
     fabric: str
@@ -109,6 +112,7 @@ class Plan:
     n_candidates: int
     n_measured: int
     instrument: dict
+    grey: bool = False
 
     @property
     def budget(self) -> int:
@@ -149,6 +153,15 @@ def _source(fabric_or_source) -> Source:
     if isinstance(fabric_or_source, brdf.Fabric):
         return Source("fabric", fabric_or_source.name or "fabric", fabric_or_source)
     return resolve(fabric_or_source, what="fabric")
+
+
+def _spec(src: Source, free, ties):
+    """The plan's ParamSpec: ``free`` and ``ties`` as ``microcyl fit`` takes them; neither
+    given, a fit folder's own."""
+    if free is None and ties is None and src.kind == "fit":
+        fitted, ties = fit_folder_spec(src.path)
+        free = list(fitted.free)
+    return fit_spec(src.fabric, free, ties)
 
 
 def _measured_pairs(measured):
@@ -198,8 +211,9 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
     fabric_or_source : brdf.Fabric, str, path or analysis.sources.Source
         A fabric, a preset's name, or a ``microcyl fit`` folder (plans over its posterior).
     free : str or sequence of str, optional
-        Free parameters (names of :mod:`analysis.paramnames`); default
-        :data:`analysis.params.DEFAULT_FREE` with :data:`~analysis.params.DEFAULT_TIES`.
+        Free parameters (names of :mod:`analysis.paramnames`); default a fit folder's own
+        free parameters and ties, else :data:`analysis.params.DEFAULT_FREE` with
+        :data:`~analysis.params.DEFAULT_TIES`.
     budget : int
         Pairs to choose.
     instrument : gonio.Instrument
@@ -245,7 +259,7 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
                          "floor, --snr or --floor)")
     src = _source(fabric_or_source)
     fab = src.fabric
-    spec = fit_spec(fab, free, ties)
+    spec = _spec(src, free, ties)
     cands = candidates if isinstance(candidates, Candidates) else make_candidates(
         candidates, instrument)
     if budget > len(cands):
@@ -265,7 +279,7 @@ def plan(fabric_or_source, free=None, budget: int = 60, *, instrument, candidate
     return _assemble(src, spec, cands, chosen, thetas, a0, j_cand, j_uni, (uwi, uwo),
                      dict(draws=draws, seed=seed, source="posterior" if src.kind == "fit"
                           else "prior", n_measured=len(mwi),
-                          instrument=instrument.describe()))
+                          instrument=instrument.describe(), grey=bool(grey)))
 
 
 def _choose(fab, spec, thetas, cands, measured, uniform, instrument, budget, grey,

@@ -31,7 +31,7 @@ import numpy as np
 from analysis.fit.checkpoint import CONFIG_FILE, FitFolder, read_config
 from analysis.params import ParamSpec
 
-__all__ = ["prior_draws", "posterior_draws", "LOCAL_SD", "MAX_DRAWS"]
+__all__ = ["prior_draws", "posterior_draws", "fit_folder_spec", "LOCAL_SD", "MAX_DRAWS"]
 
 #: Standard deviation of the local design prior in the internal (logit) coordinates.
 LOCAL_SD = 0.5
@@ -72,16 +72,23 @@ def prior_draws(spec: ParamSpec, draws: int, rng: np.random.Generator,
     return out
 
 
-def _fit_spec(folder: Path) -> ParamSpec:
+def fit_folder_spec(folder) -> tuple[ParamSpec, list[str]]:
     """The ParamSpec a fit folder's ``fit_config.json`` describes (free, ties, bounds,
-    priors, defaults), so that its stored internal coordinates mean what they meant."""
-    spec = read_config(folder / CONFIG_FILE)["config"]["spec"]
+    priors, defaults), so that its stored internal coordinates mean what they meant, and its
+    ties as ``--tie`` strings (``"a=b"``, ``"a=1-b"``).
+
+    Raises
+    ------
+    ValueError
+        A missing or corrupt file, named.
+    """
+    spec = read_config(Path(folder) / CONFIG_FILE)["config"]["spec"]
     params = spec["params"]
     ties = [f"{t}={s}" if kind == "equal" else f"{t}=1-{s}"
             for t, (s, kind) in spec.get("ties", {}).items()]
     return ParamSpec(spec["free"], defaults={n: p["default"] for n, p in params.items()},
                      ties=ties, bounds={n: (p["lo"], p["hi"]) for n, p in params.items()},
-                     priors={n: p["prior"] for n, p in params.items()})
+                     priors={n: p["prior"] for n, p in params.items()}), ties
 
 
 def posterior_draws(folder, spec: ParamSpec, draws: int,
@@ -97,7 +104,7 @@ def posterior_draws(folder, spec: ParamSpec, draws: int,
     draws = check_draws(draws)
     folder = Path(folder)
     try:
-        fit_spec = _fit_spec(folder)
+        fit_spec = fit_folder_spec(folder)[0]
     except ValueError as exc:
         raise ValueError(f"{folder}: cannot read the fit's parameters: {exc}") from None
     ckpt = FitFolder(folder).read_checkpoint() if (folder / "checkpoint.h5").is_file() \

@@ -47,6 +47,7 @@ def plan_header(p: Plan, ties=None) -> dict:
             "budget": str(p.budget),
             "measured_before": str(p.n_measured),
             "instrument": json.dumps(p.instrument, sort_keys=True),
+            "readings": "grey (one a pair)" if p.grey else "R, G, B (three a pair)",
             "candidates": f"{p.candidates} ({p.n_candidates} reachable pairs)",
             "criterion": "Bayesian D-optimality: expected log det of the posterior precision "
                          f"(Laplace approximation) over {p.draws} draws of the "
@@ -55,7 +56,7 @@ def plan_header(p: Plan, ties=None) -> dict:
 
 
 def plan_file(fabric, free, budget: int, out, *, instrument, ties=None, candidates=None,
-              measured=None, draws: int | None = None, seed: int = 0,
+              measured=None, draws: int | None = None, seed: int = 0, grey: bool = False,
               progress: bool = False) -> tuple[Plan, Path]:
     """Plan (:func:`analysis.planning.plan`) and write the plan file ``out``.
 
@@ -65,7 +66,7 @@ def plan_file(fabric, free, budget: int, out, *, instrument, ties=None, candidat
     """
     kw = {} if draws is None else {"draws": draws}
     p = plan(fabric, free, budget, instrument=instrument, candidates=candidates,
-             measured=measured, seed=seed, ties=ties, progress=progress, **kw)
+             measured=measured, seed=seed, ties=ties, grey=grey, progress=progress, **kw)
     path = write_pairs_csv(out, p.angles, header=plan_header(p, ties),
                            columns={"rank": p.rank}, order=False)
     return p, Path(path)

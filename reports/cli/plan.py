@@ -61,6 +61,8 @@ def register(sub):
                    help=f"draws of the parameters the criterion averages over (default "
                         f"{DEFAULT_DRAWS}, at most {MAX_DRAWS})")
     i = add_instrument_options(p)
+    i.add_argument("--grey", action="store_true",
+                   help="the instrument reads one grey (luminance) value a pair, not R, G, B")
     i.add_argument("--seed", type=int, default=0,
                    help="seed of the draws and of the uniform designs (default 0)")
     cliutil.add_quiet_options(p)
@@ -111,7 +113,7 @@ def run(args) -> int:
     ties = cliutil.split_ties(args.tie) if args.tie else None
     p, csv = plan_file(src, args.free, args.budget, out, instrument=instrument, ties=ties,
                        candidates=args.candidates, measured=measured, draws=args.draws,
-                       seed=args.seed, progress=cliutil.progress(args))
+                       seed=args.seed, grey=args.grey, progress=cliutil.progress(args))
     png = csv.with_suffix(".png")
     lazy.plots().plan.draw_plan(p, filename=png)
     _print(p, csv, png)

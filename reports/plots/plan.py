@@ -50,6 +50,9 @@ def _panel(ax, wi, wo, title, numbered: bool):
     ax.set_yticks([30, 60, 90])
     ax.set_yticklabels(["θ 30°", "60°", "90°"], fontsize=FONT["small"])
     ax.set_rlabel_position(157.5)
+    for label in ax.get_yticklabels():          # readable over the pairs
+        label.set_bbox({"facecolor": "white", "alpha": 0.8, "edgecolor": "none", "pad": 1.0})
+        label.set_zorder(6)
     ax.set_xticks(np.radians([0, 90, 180, 270]))
     ax.set_xticklabels(["φ 0° (warp)", "φ 90°", "180°", "270°"], fontsize=FONT["small"])
     ax.set_title(title, fontsize=FONT["title"])

@@ -4,8 +4,8 @@ The plan maximises the Bayesian D-optimality criterion of :mod:`analysis.plannin
 (the expected log determinant of the posterior precision, in the Laplace approximation,
 over draws of the parameters: :mod:`analysis.planning.draws`) with the information of
 :mod:`analysis.planning.information`. It reports the expected posterior covariance of its
-design and of uniform designs of N and 3N pairs (:func:`analysis.planning.candidates.
-uniform_pairs`), each the mean over the draws of :math:`(A_0 + I)^{-1}`.
+design and of uniform designs of N and 3N pairs
+(:func:`analysis.planning.candidates.uniform_pairs`), each the mean over the draws of :math:`(A_0 + I)^{-1}`.
 
 What the numbers are: the curvature of the log-likelihood linearised at each draw (Fisher
 information) with the fit's prior added; a posterior far from Gaussian in the internal

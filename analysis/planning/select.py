@@ -10,8 +10,8 @@ posterior precision in the Laplace approximation,
 
 with :math:`\tilde J_{kp}` the whitened Jacobian of pair p at draw k (r rows, r = 3 for RGB,
 1 for grey: :mod:`analysis.planning.information`) and :math:`A_{0,k}` the starting precision:
-the fit's prior information (1/3 per internal coordinate, :data:`analysis.fit.fisher.
-PRIOR_INFORMATION`) plus, with ``--from``, the information of the pairs already measured.
+the fit's prior information (1/3 per internal coordinate,
+:data:`analysis.fit.fisher.PRIOR_INFORMATION`) plus, with ``--from``, the information of the pairs already measured.
 
 **Greedy.** Each step adds the candidate of largest gain; by the matrix determinant lemma
 the gain of p is :math:`\frac1K\sum_k \log\det(I_r + \tilde J_{kp} A_k^{-1} \tilde J_{kp}^T)`,

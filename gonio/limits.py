@@ -182,10 +182,15 @@ _BROKEN = {"max_theta": "beyond max_theta", "min_separation": "closer than min_s
            "in_plane": "out of the plane of incidence"}
 
 
-def _angles(w: np.ndarray) -> tuple[float, float]:
-    """(theta, phi) in degrees of one direction (phi in [0, 360), 0 at the normal)."""
-    phi = math.degrees(math.atan2(w[1], w[0])) % 360.0 if np.hypot(w[0], w[1]) > 0 else 0.0
-    return float(_polar(w)), phi + 0.0
+def _deg(x: float) -> str:
+    """Degrees for a message: rounded to 1e-6, 7 significant digits, no ``-0``."""
+    return f"{round(float(x), 6) + 0.0:.7g}"
+
+
+def _angles(w: np.ndarray) -> tuple[str, str]:
+    """(theta, phi) of one direction in words (degrees; phi in [0, 360), 0 at the normal)."""
+    phi = math.degrees(math.atan2(w[1], w[0])) if np.hypot(w[0], w[1]) > 0 else 0.0
+    return _deg(_polar(w)), _deg(round(phi, 6) % 360.0)
 
 
 def check_reachable(wi, wo, what: str = "geometry", **limits) -> None:
@@ -222,12 +227,12 @@ def check_reachable(wi, wo, what: str = "geometry", **limits) -> None:
     b = np.broadcast_to(np.asarray(wo, float), shape + (3,)).reshape(-1, 3)[k]
     (ti, pi_), (to, po) = _angles(a), _angles(b)
     counts = ", ".join(f"{int(v.sum())} {_BROKEN[n]}" for n, v in flat.items() if v.any())
-    sep = float(_between(a, b))
+    sep = _deg(_between(a, b))
     limit_words = describe_limits(limits.get("max_theta"), limits.get("min_separation"),
                                   limits.get("in_plane", False),
                                   limits.get("cone_source", 0.0),
                                   limits.get("cone_detector", 0.0))
     raise ValueError(
         f"{what}: {n_bad} of {anyb.size} pairs out of the instrument's reach ({counts}); "
-        f"the first, pair {k + 1}: theta_i {ti:.6g}, phi_i {pi_:.6g}, theta_o {to:.6g}, "
-        f"phi_o {po:.6g} deg (separation {sep:.6g} deg); limits: {limit_words}")
+        f"the first, pair {k + 1}: theta_i {ti}, phi_i {pi_}, theta_o {to}, phi_o {po} deg "
+        f"(separation {sep} deg); limits: {limit_words}")

@@ -114,22 +114,25 @@ def limit_violations(wi, wo, *, max_theta=None, min_separation=None, in_plane=Fa
                      cone_source=0.0, cone_detector=0.0) -> dict[str, np.ndarray]:
     """Which pairs break each limit that is on: ``{name: bool array}`` (broadcast shape of
     ``wi[..., 0]`` and ``wo[..., 0]``), names in :data:`LIMIT_NAMES` order, a limit that is
-    off left out. Directions (..., 3) in the local frame (z up; need not be unit); cone
-    half-angles in degrees; see the module notes for the readings."""
+    off left out. Directions (..., 3) in the local frame (z up; need not be unit; one with a
+    NaN breaks every limit); cone half-angles in degrees; see the module notes for the
+    readings."""
     wi, wo = _directions("wi", wi), _directions("wo", wo)
     wi, wo = np.broadcast_arrays(wi, wo)
     out = {}
     if max_theta is not None:
-        out["max_theta"] = np.maximum(_polar(wi), _polar(wo)) > max_theta + ANGLE_TOLERANCE
+        top = np.maximum(_polar(wi), _polar(wo))                  # NaN stays NaN: refused
+        out["max_theta"] = ~(top <= max_theta + ANGLE_TOLERANCE)
     if min_separation is not None:
         gap = _between(wi, wo) - cone_source - cone_detector
-        out["min_separation"] = gap < min_separation - ANGLE_TOLERANCE
+        out["min_separation"] = ~(gap >= min_separation - ANGLE_TOLERANCE)
     if in_plane:
         ri, ro = np.hypot(wi[..., 0], wi[..., 1]), np.hypot(wo[..., 0], wo[..., 1])
         cross = wi[..., 0] * wo[..., 1] - wi[..., 1] * wo[..., 0]
         pole = ((ri <= IN_PLANE_TOLERANCE * np.linalg.norm(wi, axis=-1))
                 | (ro <= IN_PLANE_TOLERANCE * np.linalg.norm(wo, axis=-1)))
-        out["in_plane"] = ~(pole | (np.abs(cross) <= IN_PLANE_TOLERANCE * ri * ro))
+        finite = np.isfinite(wi).all(axis=-1) & np.isfinite(wo).all(axis=-1)
+        out["in_plane"] = ~(finite & (pole | (np.abs(cross) <= IN_PLANE_TOLERANCE * ri * ro)))
     return out
 
 

@@ -22,11 +22,13 @@ moves (degrees). Great-circle angles are a stand-in that needs no instrument's k
 theta/phi arm moving near the pole turns its azimuth stage further than this says).
 :func:`order_for_travel` groups the pairs by source position (the source is set once per
 group), sweeps the detector along a short open path within a group (nearest neighbour then
-2-opt; a set of detectors on one plane is swept monotonically along it), runs each group's
-sweep from the end nearer where the detector is (so consecutive sweeps alternate direction,
-boustrophedon), and orders the groups by the same heuristic on the source's move plus the
-move between the groups' mean detector directions. Beyond :data:`MAX_TOUR` nodes the
-heuristic gives way to a serpentine order (theta rows, azimuth alternating).
+2-opt; detectors on one great circle, such as an in-plane sweep, are swept monotonically
+along it), runs each group's sweep from the end nearer where the detector is (so
+consecutive sweeps alternate direction, boustrophedon), and orders the groups by the same
+heuristic on the source's move plus the move between the groups' mean detector directions.
+Beyond :data:`MAX_TOUR` nodes (source positions, or detectors of one source) 2-opt is
+left out, and beyond :data:`MAX_GREEDY` the heuristic gives way to a serpentine order (theta
+rows, azimuth alternating).
 """
 
 from __future__ import annotations
@@ -45,13 +47,15 @@ from gonio.geometry import HORIZON_EPS
 from gonio.statefields import one_line
 
 __all__ = ["order_for_travel", "travel", "write_pairs_csv", "read_pairs_header",
-           "PLAN_COLUMNS", "MAX_TOUR", "MAX_HEADER_BYTES", "MAX_HEADER_LINES"]
+           "PLAN_COLUMNS", "MAX_TOUR", "MAX_GREEDY", "MAX_HEADER_BYTES", "MAX_HEADER_LINES"]
 
 #: The leading columns of a plan file.
 PLAN_COLUMNS = ("index",) + ANGLES
 #: Largest number of source positions, or of detector positions of one source, ordered by
-#: nearest neighbour and 2-opt (O(n^2) memory and time); beyond, a serpentine order.
+#: nearest neighbour and 2-opt (O(n^2) memory and time); beyond, by nearest neighbour alone
+#: up to MAX_GREEDY (O(n) memory, O(n^2) time), then a serpentine order.
 MAX_TOUR = 2000
+MAX_GREEDY = 10000
 _MAX_PASSES = 100
 #: The comment lines of a plan file, in bytes and in lines, that :func:`read_pairs_header`
 #: reads (and :func:`write_pairs_csv` writes) at most.
@@ -154,16 +158,36 @@ def _serpentine(theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return np.lexsort((np.where(rows % 2 == 0, ph, -ph), rows))
 
 
+def _greedy(units: np.ndarray, extra, start: int) -> np.ndarray:
+    """Nearest-neighbour path from ``start``, each row of distances made when needed (O(m)
+    memory)."""
+    m = len(units)
+    seen = np.zeros(m, dtype=bool)
+    path = [start]
+    seen[start] = True
+    for _ in range(m - 1):
+        k = path[-1]
+        row = np.arccos(np.clip(units @ units[k], -1.0, 1.0))
+        if extra is not None:
+            row += np.arccos(np.clip(extra @ extra[k], -1.0, 1.0))
+        nxt = int(np.argmin(np.where(seen, np.inf, row)))
+        path.append(nxt)
+        seen[nxt] = True
+    return np.array(path)
+
+
 def _sequence(units: np.ndarray, theta, phi, extra=None) -> np.ndarray:
     """An order of the nodes at ``units`` (m, 3) that keeps moves short (see module notes);
     ``extra`` (m, 3) more unit directions whose moves count too."""
-    m = len(units)
-    if m > MAX_TOUR:
+    m, start = len(units), int(np.argmin(theta))
+    if m > MAX_GREEDY:
         return _serpentine(theta, phi)
+    if m > MAX_TOUR:
+        return _greedy(units, extra, start)
     dist = _arc(units[:, None, :], units[None, :, :])
     if extra is not None:
         dist = dist + _arc(extra[:, None, :], extra[None, :, :])
-    return _open_path(dist, int(np.argmin(theta)))
+    return _open_path(dist, start)
 
 
 def order_for_travel(angles_deg) -> np.ndarray:

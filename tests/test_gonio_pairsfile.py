@@ -1,4 +1,4 @@
-"""Tests of the plan file (gonio/pairsfile.py): the arm-travel order, the writer, the header
+"""Tests of the plan file (gonio/pairsfile.py) and its arm-travel order (gonio/travel.py): the writer, the header
 reader, and the file read back by gonio.geomspec.read_pairs_csv (``pairs:FILE``)."""
 
 import math
@@ -156,9 +156,9 @@ def test_read_pairs_header_is_bounded_and_says_what_is_wrong(tmp_path):
 def test_large_sets_fall_back_to_nearest_neighbour_then_serpentine(monkeypatch):
     """Beyond MAX_TOUR nodes no 2-opt (still far better than random on a uniform set),
     beyond MAX_GREEDY a serpentine over the sources (still a permutation, sources grouped)."""
-    import gonio.pairsfile as pairsfile
-    monkeypatch.setattr(pairsfile, "MAX_TOUR", 10)
-    monkeypatch.setattr(pairsfile, "MAX_GREEDY", 100)
+    import gonio.travel
+    monkeypatch.setattr(gonio.travel, "MAX_TOUR", 10)
+    monkeypatch.setattr(gonio.travel, "MAX_GREEDY", 100)
     a = _uniform(90, seed=7)
     o = order_for_travel(a)
     rng = np.random.default_rng(1)

@@ -118,7 +118,11 @@ def limit_violations(wi, wo, *, max_theta=None, min_separation=None, in_plane=Fa
     NaN breaks every limit); cone half-angles in degrees; see the module notes for the
     readings."""
     wi, wo = _directions("wi", wi), _directions("wo", wo)
-    wi, wo = np.broadcast_arrays(wi, wo)
+    try:
+        wi, wo = np.broadcast_arrays(wi, wo)
+    except ValueError:
+        raise ValueError(f"wi and wo must broadcast together; got shapes {wi.shape} and "
+                         f"{wo.shape}") from None
     out = {}
     if max_theta is not None:
         top = np.maximum(_polar(wi), _polar(wo))                  # NaN stays NaN: refused

@@ -105,6 +105,11 @@ def test_reachable_broadcasts_and_ignores_the_stage_rotation():
     R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
     assert np.array_equal(ins.reachable(wi @ R.T, wo @ R.T), ok)
     assert ins.reachable(wi[0, 0], wo[0, 0]).shape == ()
+    with pytest.raises(ValueError, match=r"^wi and wo must broadcast together; got shapes "
+                                         r"\(3, 3\) and \(2, 3\)$"):
+        ins.reachable(wi[:3, 0], wo[0, :2])
+    with pytest.raises(ValueError, match=r"^wo must be directions of shape \(\.\.\., 3\)"):
+        ins.reachable(wi, [1.0, 0.0])
 
 
 @pytest.mark.parametrize("kw, match", [

@@ -19,7 +19,8 @@ from gonio.geomspec import from_spec
 from gonio.instrument import Instrument
 from gonio.io import read, write
 from gonio.measure import measure
-from gonio.pairsfile import order_for_travel, read_pairs_header, write_pairs_csv
+from gonio.pairsfile import read_pairs_header, write_pairs_csv
+from gonio.travel import order_for_travel
 from gonio.merl import MerlBRDF, load_merl, merl_table, read_merl, write_merl
 from gonio.rgl import RGLBRDF, load_rgl
 from gonio.table import Table

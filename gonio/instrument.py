@@ -162,6 +162,10 @@ def cone_directions(axis, points) -> np.ndarray:
 class Instrument:
     """Source and detector cones and a noise model; see the module notes for the equations.
 
+    The limits ``max_theta``, ``min_separation`` and ``in_plane`` (gonio/limits.py: their
+    readings with open cones) say which pairs :meth:`reachable` accepts and
+    :func:`gonio.measure` measures; they change no value.
+
     Parameters
     ----------
     cone_source, cone_detector : float
@@ -190,9 +194,6 @@ class Instrument:
     in_plane : bool
         Measures in the plane of incidence only (phi_o = phi_i or phi_i + 180 within
         1e-6 rad; normal incidence is in every plane).
-
-    The limits (:mod:`gonio.limits`: their readings with open cones) say which pairs
-    :meth:`reachable` accepts and :func:`gonio.measure` measures; they change no value.
 
     Examples
     --------

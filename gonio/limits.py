@@ -114,22 +114,29 @@ def limit_violations(wi, wo, *, max_theta=None, min_separation=None, in_plane=Fa
                      cone_source=0.0, cone_detector=0.0) -> dict[str, np.ndarray]:
     """Which pairs break each limit that is on: ``{name: bool array}`` (broadcast shape of
     ``wi[..., 0]`` and ``wo[..., 0]``), names in :data:`LIMIT_NAMES` order, a limit that is
-    off left out. Directions (..., 3) in the local frame (z up; need not be unit); cone
-    half-angles in degrees; see the module notes for the readings."""
+    off left out. Directions (..., 3) in the local frame (z up; need not be unit; one with a
+    NaN breaks every limit); cone half-angles in degrees; see the module notes for the
+    readings."""
     wi, wo = _directions("wi", wi), _directions("wo", wo)
-    wi, wo = np.broadcast_arrays(wi, wo)
+    try:
+        wi, wo = np.broadcast_arrays(wi, wo)
+    except ValueError:
+        raise ValueError(f"wi and wo must broadcast together; got shapes {wi.shape} and "
+                         f"{wo.shape}") from None
     out = {}
     if max_theta is not None:
-        out["max_theta"] = np.maximum(_polar(wi), _polar(wo)) > max_theta + ANGLE_TOLERANCE
+        top = np.maximum(_polar(wi), _polar(wo))                  # NaN stays NaN: refused
+        out["max_theta"] = ~(top <= max_theta + ANGLE_TOLERANCE)
     if min_separation is not None:
         gap = _between(wi, wo) - cone_source - cone_detector
-        out["min_separation"] = gap < min_separation - ANGLE_TOLERANCE
+        out["min_separation"] = ~(gap >= min_separation - ANGLE_TOLERANCE)
     if in_plane:
         ri, ro = np.hypot(wi[..., 0], wi[..., 1]), np.hypot(wo[..., 0], wo[..., 1])
         cross = wi[..., 0] * wo[..., 1] - wi[..., 1] * wo[..., 0]
         pole = ((ri <= IN_PLANE_TOLERANCE * np.linalg.norm(wi, axis=-1))
                 | (ro <= IN_PLANE_TOLERANCE * np.linalg.norm(wo, axis=-1)))
-        out["in_plane"] = ~(pole | (np.abs(cross) <= IN_PLANE_TOLERANCE * ri * ro))
+        finite = np.isfinite(wi).all(axis=-1) & np.isfinite(wo).all(axis=-1)
+        out["in_plane"] = ~(finite & (pole | (np.abs(cross) <= IN_PLANE_TOLERANCE * ri * ro)))
     return out
 
 
@@ -182,10 +189,15 @@ _BROKEN = {"max_theta": "beyond max_theta", "min_separation": "closer than min_s
            "in_plane": "out of the plane of incidence"}
 
 
-def _angles(w: np.ndarray) -> tuple[float, float]:
-    """(theta, phi) in degrees of one direction (phi in [0, 360), 0 at the normal)."""
-    phi = math.degrees(math.atan2(w[1], w[0])) % 360.0 if np.hypot(w[0], w[1]) > 0 else 0.0
-    return float(_polar(w)), phi + 0.0
+def _deg(x: float) -> str:
+    """Degrees for a message: rounded to 1e-6, 7 significant digits, no ``-0``."""
+    return f"{round(float(x), 6) + 0.0:.7g}"
+
+
+def _angles(w: np.ndarray) -> tuple[str, str]:
+    """(theta, phi) of one direction in words (degrees; phi in [0, 360), 0 at the normal)."""
+    phi = math.degrees(math.atan2(w[1], w[0])) if np.hypot(w[0], w[1]) > 0 else 0.0
+    return _deg(_polar(w)), _deg(round(phi, 6) % 360.0)
 
 
 def check_reachable(wi, wo, what: str = "geometry", **limits) -> None:
@@ -222,12 +234,12 @@ def check_reachable(wi, wo, what: str = "geometry", **limits) -> None:
     b = np.broadcast_to(np.asarray(wo, float), shape + (3,)).reshape(-1, 3)[k]
     (ti, pi_), (to, po) = _angles(a), _angles(b)
     counts = ", ".join(f"{int(v.sum())} {_BROKEN[n]}" for n, v in flat.items() if v.any())
-    sep = float(_between(a, b))
+    sep = _deg(_between(a, b))
     limit_words = describe_limits(limits.get("max_theta"), limits.get("min_separation"),
                                   limits.get("in_plane", False),
                                   limits.get("cone_source", 0.0),
                                   limits.get("cone_detector", 0.0))
     raise ValueError(
         f"{what}: {n_bad} of {anyb.size} pairs out of the instrument's reach ({counts}); "
-        f"the first, pair {k + 1}: theta_i {ti:.6g}, phi_i {pi_:.6g}, theta_o {to:.6g}, "
-        f"phi_o {po:.6g} deg (separation {sep:.6g} deg); limits: {limit_words}")
+        f"the first, pair {k + 1}: theta_i {ti}, phi_i {pi_}, theta_o {to}, phi_o {po} deg "
+        f"(separation {sep} deg); limits: {limit_words}")

@@ -105,6 +105,11 @@ def test_reachable_broadcasts_and_ignores_the_stage_rotation():
     R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
     assert np.array_equal(ins.reachable(wi @ R.T, wo @ R.T), ok)
     assert ins.reachable(wi[0, 0], wo[0, 0]).shape == ()
+    with pytest.raises(ValueError, match=r"^wi and wo must broadcast together; got shapes "
+                                         r"\(3, 3\) and \(2, 3\)$"):
+        ins.reachable(wi[:3, 0], wo[0, :2])
+    with pytest.raises(ValueError, match=r"^wo must be directions of shape \(\.\.\., 3\)"):
+        ins.reachable(wi, [1.0, 0.0])
 
 
 @pytest.mark.parametrize("kw, match", [
@@ -184,3 +189,11 @@ def test_limits_change_no_value():
     free = Instrument(cone_detector=2, snr=30)
     a, b = measure(Lambert(), g, limited, seed=4), measure(Lambert(), g, free, seed=4)
     assert np.array_equal(a.values, b.values) and a.meta["instrument"]["in_plane"] is True
+
+
+def test_a_direction_with_a_nan_is_out_of_reach_of_every_limit():
+    bad = np.array([np.nan, 0.0, 1.0])
+    for kw in ({"max_theta": 80}, {"min_separation": 1}, {"in_plane": True}):
+        assert not Instrument(**kw).reachable(bad, [0.0, 0.0, 1.0])
+        assert not Instrument(**kw).reachable([0.0, 0.0, 1.0], bad)
+    assert Instrument().reachable(bad, bad)                      # no limit: nothing checked

@@ -1,4 +1,4 @@
-"""Tests of the plan file (gonio/pairsfile.py): the arm-travel order, the writer, the header
+"""Tests of the plan file (gonio/pairsfile.py) and its arm-travel order (gonio/travel.py): the writer, the header
 reader, and the file read back by gonio.geomspec.read_pairs_csv (``pairs:FILE``)."""
 
 import math
@@ -151,3 +151,22 @@ def test_read_pairs_header_is_bounded_and_says_what_is_wrong(tmp_path):
         read_pairs_header(tmp_path)
     with pytest.raises(OSError, match="cannot read plan file"):
         read_pairs_header(tmp_path / "missing.csv")
+
+
+def test_large_sets_fall_back_to_nearest_neighbour_then_serpentine(monkeypatch):
+    """Beyond MAX_TOUR nodes no 2-opt (still far better than random on a uniform set),
+    beyond MAX_GREEDY a serpentine over the sources (still a permutation, sources grouped)."""
+    import gonio.travel
+    monkeypatch.setattr(gonio.travel, "MAX_TOUR", 10)
+    monkeypatch.setattr(gonio.travel, "MAX_GREEDY", 100)
+    a = _uniform(90, seed=7)
+    o = order_for_travel(a)
+    rng = np.random.default_rng(1)
+    assert sorted(o.tolist()) == list(range(90))
+    assert travel(a, o) < 0.5 * min(travel(a, rng.permutation(90)) for _ in range(10))
+    b = np.repeat(_uniform(150, seed=8)[:, :2], 2, axis=0)            # 150 sources, 2 each
+    b = np.column_stack([b, _uniform(300, seed=9)[:, 2:]])
+    o = order_for_travel(b)
+    assert sorted(o.tolist()) == list(range(300))
+    src = [tuple(r) for r in b[o, :2]]
+    assert sum(src[k] != src[k - 1] for k in range(1, 300)) == 149   # each source once

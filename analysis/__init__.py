@@ -1,4 +1,5 @@
-"""analysis package of microcyl: physical checks and Bayesian fitting (emcee)."""
+"""analysis package of microcyl: physical checks, Bayesian fitting (emcee) and measurement
+planning (:func:`plan`)."""
 
 from analysis.albedo import (AlbedoCurve, AlbedoResult, HemisphericalAlbedo, albedo,
                              albedo_curve, albedo_hemispherical)
@@ -11,6 +12,7 @@ from analysis.diagnostics import autocorr_time, ess, interval_summary, split_rha
 from analysis.fit import FabricModel, FitResult, LogPosterior, fit_fabric, write_results
 from analysis.likelihood import Likelihood
 from analysis.measured import MEASURED, MeasuredDataset, load_measured, measured_spec
+from analysis.planning import Plan, plan
 from analysis.params import (DEFAULT_FREE, DEFAULT_TIES, PARAM_NAMES, ParamSpec,
                              defaults_from_fabric)
 
@@ -22,4 +24,4 @@ __all__ += ["albedo", "albedo_curve", "albedo_hemispherical", "AlbedoResult", "A
 __all__ += ["ParamSpec", "PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric",
             "Likelihood", "fit_fabric", "FitResult", "FabricModel", "LogPosterior", "write_results",
             "autocorr_time", "split_rhat", "ess", "interval_summary",
-            "MEASURED", "MeasuredDataset", "load_measured", "measured_spec"]
+            "MEASURED", "MeasuredDataset", "load_measured", "measured_spec", "plan", "Plan"]

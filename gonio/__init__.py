@@ -19,6 +19,8 @@ from gonio.geomspec import from_spec
 from gonio.instrument import Instrument
 from gonio.io import read, write
 from gonio.measure import measure
+from gonio.pairsfile import read_pairs_header, write_pairs_csv
+from gonio.travel import order_for_travel
 from gonio.merl import MerlBRDF, load_merl, merl_table, read_merl, write_merl
 from gonio.rgl import RGLBRDF, load_rgl
 from gonio.table import Table
@@ -29,5 +31,6 @@ __all__ = [
     "read_exr", "write_exr", "read_csv", "write_csv", "read_alta", "write_alta",
     "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "json_line", "meta_text", "progress_bar",
     "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",
-    "pairs", "pairs_from_angles", "from_spec",
+    "pairs", "pairs_from_angles", "from_spec", "write_pairs_csv", "read_pairs_header",
+    "order_for_travel",
 ]

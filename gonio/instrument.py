@@ -38,6 +38,8 @@ import math
 
 import numpy as np
 
+from gonio.limits import check_limits, check_reachable, describe_limits, reachable
+
 __all__ = ["Instrument", "cap_quadrature", "cone_directions", "NOISE_MODELS",
            "MAX_CONE_POINTS", "MAX_EVALUATIONS_PER_PAIR"]
 
@@ -160,6 +162,10 @@ def cone_directions(axis, points) -> np.ndarray:
 class Instrument:
     """Source and detector cones and a noise model; see the module notes for the equations.
 
+    The limits ``max_theta``, ``min_separation`` and ``in_plane`` (gonio/limits.py: their
+    readings with open cones) say which pairs :meth:`reachable` accepts and
+    :func:`gonio.measure` measures; they change no value.
+
     Parameters
     ----------
     cone_source, cone_detector : float
@@ -178,6 +184,16 @@ class Instrument:
         1..:data:`MAX_CONE_POINTS` (so a pair costs (rings * azimuths)^2 evaluations with
         both cones open, at most :data:`MAX_EVALUATIONS_PER_PAIR`). Checked on construction,
         before any quadrature is built.
+    max_theta : float or None
+        Largest polar angle of the source and the detector (their nominal directions),
+        degrees in (0, 90]; None for no limit.
+    min_separation : float or None
+        Smallest angle between the source and detector cones, edge to edge (the angle
+        between the nominal directions less both half-angles), degrees in [0, 180); None
+        for no limit. Any value > 0 makes retro-reflection unreachable.
+    in_plane : bool
+        Measures in the plane of incidence only (phi_o = phi_i or phi_i + 180 within
+        1e-6 rad; normal incidence is in every plane).
 
     Examples
     --------
@@ -196,6 +212,9 @@ class Instrument:
     snr_reference: float = 1.0
     rings: int = 2
     azimuths: int = 6
+    max_theta: float | None = None
+    min_separation: float | None = None
+    in_plane: bool = False
 
     def __post_init__(self):
         for name in ("cone_source", "cone_detector"):
@@ -238,6 +257,9 @@ class Instrument:
                              f"[{REFERENCE_RANGE[0]:g}, {REFERENCE_RANGE[1]:g}]; "
                              f"got {self.snr_reference!r}")
         object.__setattr__(self, "snr_reference", ref)
+        limits = check_limits(self.max_theta, self.min_separation, self.in_plane)
+        for name, v in zip(("max_theta", "min_separation", "in_plane"), limits):
+            object.__setattr__(self, name, v)
         self._check_size()
 
     def _check_size(self) -> None:
@@ -334,10 +356,42 @@ class Instrument:
             out = out + self.floor * rng.standard_normal(v.shape)
         return np.where(finite, out, v)
 
+    # ------------------------------------------------------------------------- limits
+
+    def _limits(self) -> dict:
+        return {"max_theta": self.max_theta, "min_separation": self.min_separation,
+                "in_plane": self.in_plane, "cone_source": self.cone_source,
+                "cone_detector": self.cone_detector}
+
+    @property
+    def has_limits(self) -> bool:
+        """True when some limit is on (``max_theta``, ``min_separation`` or ``in_plane``)."""
+        return self.max_theta is not None or self.min_separation is not None or self.in_plane
+
+    def reachable(self, wi, wo) -> np.ndarray:
+        """Whether the instrument can take each pair: bool array of the broadcast shape of
+        directions ``wi``, ``wo`` (..., 3) in the local frame (z up); see :mod:`gonio.limits`.
+
+        >>> ins = Instrument(min_separation=5.0)
+        >>> ins.reachable([0.0, 0.0, 1.0], [[0.0, 0.0, 1.0], [0.6, 0.0, 0.8]]).tolist()
+        [False, True]
+        """
+        return reachable(wi, wo, **self._limits())
+
+    def check_reachable(self, wi, wo, what: str = "geometry") -> None:
+        """Raise a one-line ValueError naming ``what`` when some pair is out of reach: how
+        many pairs break which limit, the first one's angles in degrees, and the limits."""
+        check_reachable(wi, wo, what, **self._limits())
+
+    def describe_limits(self) -> str:
+        """The limits in words, e.g. ``'max_theta 80 deg, in the plane of incidence only'``."""
+        return describe_limits(**self._limits())
+
     def describe(self) -> dict:
         """A JSON-serializable description (what :func:`gonio.measure` puts in ``meta``)."""
         d = dataclasses.asdict(self)
         d["cone_unit"] = "deg"
         d["floor_unit"] = "1/sr"
+        d["limit_unit"] = "deg"
         d["evaluations_per_pair"] = self.n_source * self.n_detector
         return d

@@ -13,6 +13,7 @@ from gonio.geomspec import from_spec
 from gonio.instrument import Instrument, cone_directions
 from gonio.jsonplain import plain
 from gonio.progress import progress_bar
+from gonio.statefields import one_line
 from gonio.table import Table
 
 __all__ = ["measure", "toolkit_version", "describe_brdf"]
@@ -119,8 +120,9 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
     Raises
     ------
     ValueError
-        If ``brdf`` has no ``eval`` method, the geometry spec is bad, or ``eval`` returns a
-        wrong shape.
+        If ``brdf`` has no ``eval`` method, the geometry spec is bad, a pair is out of the
+        instrument's reach (:meth:`Instrument.check_reachable`, before any evaluation), or
+        ``eval`` returns a wrong shape.
 
     Notes
     -----
@@ -147,6 +149,7 @@ def measure(brdf, geometry, instrument: Instrument | None = None, seed=None, *,
     if not callable(getattr(brdf, "eval", None)):
         raise ValueError(f"brdf must have an eval(wi, wo) method; got {type(brdf).__name__}")
     geometry, instrument = _geometry_of(geometry), _instrument_of(instrument)
+    _check_reach(geometry, instrument)
     rng, seed_meta = _rng_of(seed)
     values = _cone_averages(brdf, geometry, instrument, _chunk_of(chunk), progress)
     sigma = instrument.sigma(values)
@@ -188,6 +191,13 @@ def _instrument_of(instrument) -> Instrument:
         raise ValueError(f"instrument must be a gonio.Instrument or None; "
                          f"got {type(instrument).__name__}")
     return instrument
+
+
+def _check_reach(geometry: Geometry, instrument: Instrument) -> None:
+    """Refuse, before any work, a geometry with pairs out of the instrument's reach."""
+    if instrument.has_limits:
+        instrument.check_reachable(geometry.wi, geometry.wo,
+                                   f"geometry {one_line(geometry.spec or geometry.kind)}")
 
 
 def _chunk_of(chunk) -> int:

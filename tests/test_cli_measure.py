@@ -1,6 +1,7 @@
 """Tests of the ``microcyl measure`` verb (reports/cli/measure.py)."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -151,3 +152,57 @@ def test_progress_shows_on_a_pipe_unless_turned_off(tmp_path):
         runs[bool(flag)] = r.stderr
     assert "measure:" in runs[False] and "625" in runs[False] and "pair" in runs[False]
     assert "measure:" not in runs[True] and "%|" not in runs[True]
+
+
+def _run_measure(*args):
+    """``microcyl measure ...`` as a user runs it: a subprocess, progress on."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    return subprocess.run([sys.executable, "-m", "reports", "measure", *map(str, args)],
+                          env=env, capture_output=True, text=True, timeout=300)
+
+
+def test_measure_refuses_a_plan_with_a_pair_out_of_reach(tmp_path):
+    """A plan file (gonio.write_pairs_csv) with a retro-reflection pair: with
+    --min-separation 5 the verb fails in one line naming the pair, and writes nothing;
+    without the pair it measures the plan, the limits in the table's metadata."""
+    angles = [[30, 0, 30, 180], [40, 90, 40, 90], [20, 0, 60, 180]]   # row 2: retro
+    plan = gonio.write_pairs_csv(tmp_path / "plan.csv", angles, {"fabric": "velvet"})
+    out = tmp_path / "t.csv"
+    r = _run_measure("velvet", "--geometry", f"pairs:{plan}", "--min-separation", "5",
+                     "--tangent-samples", "4", "-o", out)
+    err = r.stderr.strip()
+    assert r.returncode == 1 and "\n" not in err, err
+    assert err.startswith(f"microcyl measure: error: geometry pairs:{plan}: 1 of 3 pairs out "
+                          f"of the instrument's reach (1 closer than min_separation)")
+    assert "theta_i 40, phi_i 90, theta_o 40, phi_o 90 deg" in err
+    assert err.endswith("limits: min_separation 5 deg")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plan.csv"]
+    gonio.write_pairs_csv(plan, [angles[0], angles[2]])
+    r = _run_measure("velvet", "--geometry", f"pairs:{plan}", "--min-separation", "5",
+                     "--max-theta", "80", "--in-plane", "--cone-detector", "1",
+                     "--tangent-samples", "4", "-o", out)
+    assert r.returncode == 0, r.stderr
+    t = gonio.read(out)
+    assert len(t) == 2 and np.allclose(np.degrees(t.angles[:, 0]), [20, 30])  # travel order
+    ins = t.meta["instrument"]
+    assert (ins["min_separation"], ins["max_theta"], ins["in_plane"]) == (5, 80, True)
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--max-theta", "0"], r"--max-theta must be an angle in \(0, 90\] degrees; got 0.0"),
+    (["--max-theta", "nan"], r"--max-theta must be an angle in \(0, 90\]"),
+    (["--min-separation", "180"], r"--min-separation must be an angle in \[0, 180\) degrees"),
+    (["--in-plane", "--geometry", "full:30"], r"505 of 625 pairs out of the instrument's reach"
+                                              r" \(25 closer than min_separation, 480 out of "
+                                              r"the plane of incidence\)"),
+])
+def test_bad_limits_are_refused_naming_the_option(tmp_path, written, capsys, args, match):
+    status = main(["measure", "velvet", "--min-separation", "1", *args,
+                   "-o", str(tmp_path / "t.exr")])
+    err = capsys.readouterr().err.strip()
+    assert status == 1 and "\n" not in err and re.search(match, err), err
+    assert not written

@@ -20,6 +20,7 @@ from reports.cli import fit as cmd_fit
 from reports.cli import measure as cmd_measure
 from reports.cli import model as cmd_model
 from reports.cli import build_parser
+from reports.cli.instrument import instrument_from_args
 
 PARSER = build_parser()
 SETTINGS = settings(max_examples=700, deadline=None, derandomize=True,
@@ -58,7 +59,8 @@ MEASURE_OPTS = {"--geometry": st.one_of(
                         ["full", "rus", "merl", "plane:warp", "full:10:10:5"]), NUMBERS), JUNK),
                 "--snr": NUMBERS, "--floor": NUMBERS, "--cone-source": NUMBERS,
                 "--cone-detector": NUMBERS, "--cone-rings": NUMBERS,
-                "--cone-azimuths": NUMBERS, "--seed": NUMBERS, "--rotation": NUMBERS,
+                "--cone-azimuths": NUMBERS, "--max-theta": NUMBERS,
+                "--min-separation": NUMBERS, "--seed": NUMBERS, "--rotation": NUMBERS,
                 "--tangent-samples": NUMBERS,
                 "--masking": st.sampled_from(["on", "off", "x"])}
 READ_OPTS = {"--sample": NUMBERS, "--step": NUMBERS, "--stride": NUMBERS}
@@ -117,7 +119,7 @@ def _measure_checks(ns):
         raise ValueError("--rotation must be finite")
     if ns.seed is not None and ns.seed < 0:
         raise ValueError("--seed must be >= 0")
-    inst = cmd_measure._instrument(ns)
+    inst = instrument_from_args(ns)
     fab = cliutil.source_from_args(cliutil.fabric_argument(ns), ns).brdf
     cmd_measure._check_size(ns, inst, fab)
 

@@ -248,6 +248,9 @@ instrument_kwargs = st.fixed_dictionaries({}, optional={
     "snr_reference": st.one_of(st.floats(0.1, 10), any_float, junk),
     "rings": st.one_of(st.integers(1, 3), st.integers(-2, 0), junk),
     "azimuths": st.one_of(st.integers(1, 6), junk),
+    "max_theta": st.one_of(st.none(), st.floats(1, 90), any_float, junk),
+    "min_separation": st.one_of(st.none(), st.floats(0, 30), any_float, junk),
+    "in_plane": st.one_of(st.booleans(), junk),
 })
 
 
@@ -260,6 +263,8 @@ def test_instrument(kw):
         assert pts.shape[1] == 3 and math.isclose(w.sum(), 1.0, rel_tol=1e-9)
         sig = ins.sigma(np.array([[0.1, 0.2, 0.0]]))
         assert sig is None or (np.isfinite(sig).all() and (sig >= 0).all())
+        ok = ins.reachable(np.array([[0.0, 0.0, 1.0], [np.nan, 0.0, 1.0]]), [0.6, 0.0, 0.8])
+        assert ok.dtype == bool and ok.shape == (2,) and (not ins.has_limits or not ok[1])
 
 
 @fast(120)

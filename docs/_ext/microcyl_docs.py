@@ -23,7 +23,7 @@ from pathlib import Path
 #: Packages whose ``__all__`` the API reference documents, in order; every module below
 #: ``reports`` with an ``__all__`` follows (whatever subpackages it is moved into).
 API_PACKAGES = ("brdf", "gonio", "analysis", "analysis.fit", "analysis.batch",
-                "analysis.albedo")
+                "analysis.albedo", "analysis.planning")
 WALKED = ("reports",)
 
 _RST_SPECIAL = re.compile(r"([\\*`|_\[\]<>])")

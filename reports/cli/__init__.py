@@ -25,6 +25,7 @@ __all__ = ["main", "build_parser", "COMMAND_MODULES"]
 COMMAND_MODULES = (
     "reports.cli.model",
     "reports.cli.measure",
+    "reports.cli.plan",
     "reports.cli.tables",
     "reports.cli.render",
     "reports.cli.physics",

@@ -11,11 +11,12 @@ from types import SimpleNamespace
 
 
 def plots() -> SimpleNamespace:
-    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``, ``views``."""
+    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``, ``plan``,
+    ``views``."""
     # lazy: matplotlib, corner and colour-science (~2 s), which `microcyl --help` skips
-    from reports.plots import common, fit, fit_diagnostics, views
+    from reports.plots import common, fit, fit_diagnostics, plan, views
     return SimpleNamespace(common=common, fit=fit, fit_diagnostics=fit_diagnostics,
-                           views=views)
+                           plan=plan, views=views)
 
 
 def report():

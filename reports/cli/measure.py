@@ -4,6 +4,10 @@ Example::
 
     microcyl measure velvet --geometry full:10 --snr 50 --seed 1 -o velvet.exr
     microcyl measure silk_shot --geometry plane:weft:5 --cone-detector 1.5 --masking off -o s.csv
+    microcyl measure velvet --geometry pairs:plan.csv --max-theta 80 --min-separation 5 -o v.csv
+
+The instrument's options (noise, cones, limits) are :mod:`reports.cli.instrument`'s; a
+geometry with pairs out of the instrument's reach is refused before any work.
 
 Angles on the command line are in degrees (cone half-angles, ``--rotation``, geometry specs).
 """
@@ -19,11 +23,11 @@ import gonio.io
 from analysis.budget import (MEASURE_BYTES_PER_PAIR, check_memory, format_bytes,
                              format_seconds, spec_pairs)
 from analysis.folderlock import output_lock
-from gonio import Instrument, measure
+from gonio import measure
 from gonio.geometry import SPEC_HELP
 from gonio.geomspec import from_spec
-from gonio.instrument import NOISE_MODELS
 from reports.cli import options as cliutil
+from reports.cli.instrument import add_instrument_options, instrument_from_args
 
 __all__ = ["register", "run"]
 
@@ -46,54 +50,11 @@ def register(sub):
                    help=f"default full:10; one of {SPEC_HELP}")
     g.add_argument("--rotation", type=float, default=0.0, metavar="DEG",
                    help="sample azimuth on the stage, degrees (the warp points there)")
-    i = p.add_argument_group("instrument")
-    i.add_argument("--snr", type=float, default=None,
-                   help="signal-to-noise ratio of the signal-dependent noise (default none)")
-    i.add_argument("--noise", choices=NOISE_MODELS, default="multiplicative",
-                   help="noise model (default multiplicative; shot = Poisson)")
-    i.add_argument("--snr-reference", type=float, default=1.0, metavar="FR",
-                   help="for --noise shot: the f_r (1/sr) at which the SNR is --snr")
-    i.add_argument("--floor", type=float, default=0.0,
-                   help="std of the additive Gaussian noise floor, 1/sr (default 0)")
-    i.add_argument("--cone-source", type=float, default=0.0, metavar="DEG",
-                   help="source cone half-angle, degrees (default 0: a point)")
-    i.add_argument("--cone-detector", type=float, default=0.0, metavar="DEG",
-                   help="detector cone half-angle, degrees (default 0: a point)")
-    i.add_argument("--cone-rings", type=int, default=2, metavar="N",
-                   help="cone quadrature rings (default 2)")
-    i.add_argument("--cone-azimuths", type=int, default=6, metavar="N",
-                   help="cone quadrature azimuths per ring (default 6)")
+    i = add_instrument_options(p)
     i.add_argument("--seed", type=int, default=None, help="seed of the noise")
     cliutil.add_quiet_options(p)
     cliutil.add_fabric_options(p, rotation=False)
     p.set_defaults(func=run, fabric_rotation=False)     # --rotation turns the stage
-
-
-#: The instrument's parameters and their options, longest name first (messages name them).
-_INSTRUMENT_OPTIONS = (("rings x azimuths", "--cone-rings x --cone-azimuths"),
-                       ("snr_reference", "--snr-reference"), ("cone_detector", "--cone-detector"),
-                       ("cone_source", "--cone-source"), ("azimuths", "--cone-azimuths"),
-                       ("rings", "--cone-rings"), ("floor", "--floor"), ("noise", "--noise"),
-                       ("snr", "--snr"))
-
-
-def _instrument(args) -> Instrument:
-    """The instrument of the options; a bad value is refused naming its option."""
-    if not 0 <= args.cone_source < 90 or not 0 <= args.cone_detector < 90:
-        bad = "--cone-source" if not 0 <= args.cone_source < 90 else "--cone-detector"
-        value = args.cone_source if bad == "--cone-source" else args.cone_detector
-        raise ValueError(f"{bad} must be a half-angle in [0, 90) degrees; got {value}")
-    try:
-        return Instrument(cone_source=args.cone_source, cone_detector=args.cone_detector,
-                          snr=args.snr, floor=args.floor, noise=args.noise,
-                          snr_reference=args.snr_reference, rings=args.cone_rings,
-                          azimuths=args.cone_azimuths)
-    except ValueError as exc:
-        msg = str(exc)
-        for name, option in _INSTRUMENT_OPTIONS:
-            if name in msg:
-                raise ValueError(f"{option}: {msg}") from None
-        raise ValueError(f"instrument options (--snr, --floor, --cone-*): {msg}") from None
 
 
 #: Seconds per BRDF evaluation with 32 tangent samples (about 10 us measured on 2 cores).
@@ -123,7 +84,7 @@ def run(args) -> int:
         raise ValueError(f"--rotation must be a finite angle in degrees; got {args.rotation}")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed must be a non-negative integer; got {args.seed}")
-    instrument = _instrument(args)
+    instrument = instrument_from_args(args)
     src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
     fabric = src.brdf
     _check_size(args, instrument, fabric)

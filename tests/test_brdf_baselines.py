@@ -241,6 +241,26 @@ def test_zeltner_energy_and_its_albedo_fit():
     assert -3e-5 < fit.min() < 0.0 and 0.74 < fit.max() < 0.75
 
 
+#: Zeltner et al.'s reference albedo of the volumetric sheen the LTC approximates, typed from
+#: tizian/ltc-sheen fitting/python/data/ltc_table_sheen_volume.cpp at 344d95b8 (third
+#: component R of _ltcParamTableVolume[j][i], roughness max(0.01, j / 31), cos max(0.01, i / 31))
+LTC_SHEEN_VOLUME_R = {
+    4: {0: 0.63273, 1: 0.42999, 4: 0.05910, 10: 0.00062, 31: 0.00001},
+    8: {0: 0.69794, 1: 0.60100, 4: 0.31773, 10: 0.05252, 31: 0.00030},
+    22: {0: 0.70253, 1: 0.67808, 4: 0.59306, 10: 0.44072, 31: 0.11016},
+    31: {0: 0.74973, 1: 0.73527, 4: 0.68291, 10: 0.58226, 31: 0.34187},
+}
+
+
+def test_zeltner_albedo_fit_against_the_published_table():
+    # MaterialX's Gaussian fit of R against the table it fits: within 0.01 at most points,
+    # 0.084 at most (near grazing, cos 0.01, roughness 4/31); documented in the guide
+    err = np.array([dir_albedo(max(0.01, i / 31), max(0.01, j / 31)) - r
+                    for j, row in LTC_SHEEN_VOLUME_R.items() for i, r in row.items()])
+    assert np.median(np.abs(err)) < 0.006
+    assert 0.08 < np.abs(err).max() < 0.085
+
+
 def test_ashikhmin_energy_documented_excess():
     r = [0.045, 0.2, 0.5, 1.0]
     lobe = _albedo_grid(Ashikhmin, r, base=0.0)

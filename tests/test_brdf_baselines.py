@@ -67,15 +67,21 @@ def gltf_lambda(cos_theta, alpha_g):
     return math.exp(2.0 * gltf_l(0.5, alpha_g) - gltf_l(1.0 - cos_theta, alpha_g))
 
 
-def gltf_sheen(ndotl, ndotv, ndoth, sheen_roughness):
-    # "Sheen distribution" and "Sheen visibility": D_s * V_s, colour 1
+def gltf_distribution(ndoth, sheen_roughness):
+    # "Sheen distribution"
     alpha_g = sheen_roughness * sheen_roughness
-    inv_r = 1.0 / alpha_g
-    sin2h = 1.0 - ndoth * ndoth
-    dist = (2.0 + inv_r) * sin2h ** (inv_r * 0.5) / (2.0 * math.pi)
+    inv_r = 1 / alpha_g
+    cos2h = ndoth * ndoth
+    sin2h = 1 - cos2h
+    return (2 + inv_r) * sin2h ** (inv_r * 0.5) / (2 * math.pi)
+
+
+def gltf_sheen(ndotl, ndotv, ndoth, sheen_roughness):
+    # "Sheen distribution" times "Sheen visibility", colour 1
+    alpha_g = sheen_roughness * sheen_roughness
     vis = 1.0 / ((1.0 + gltf_lambda(ndotv, alpha_g) + gltf_lambda(ndotl, alpha_g))
                  * (4.0 * ndotv * ndotl))
-    return dist * vis
+    return gltf_distribution(ndoth, sheen_roughness) * vis
 
 
 def ref_charlie(wi, wo, base, sheen, roughness):
@@ -207,6 +213,37 @@ def _albedo_grid(cls, roughness, base=1.0, sheen=1.0, n=96):
         f = cls(base=base, sheen=sheen).prepare(wi, wo).eval(roughness=np.array(roughness))
         out.append((f[..., 0] * wi[:, 2]) @ w)
     return np.array(out)
+
+
+def filament_d_ashikhmin(roughness, noh):
+    # Filament docs, listing clothBRDF (D_Ashikhmin) without its fp16 clamp of sin2h
+    a2 = roughness * roughness
+    cos2h = noh * noh
+    sin2h = 1.0 - cos2h
+    sin4h = sin2h * sin2h
+    cot2 = -cos2h / (a2 * sin2h)
+    return 1.0 / (math.pi * (4.0 * a2 + 1.0) * sin4h) * (4.0 * math.exp(cot2) + sin4h)
+
+
+@pytest.mark.parametrize("r", [0.045, 0.2, 0.6, 1.0])
+def test_distributions_are_normalized(r):
+    # the integral of D(h) cos(theta_h) over the hemisphere of h is 1 (analytic for both)
+    x, w = np.polynomial.legendre.leggauss(400)
+    th = 0.25 * math.pi * (x + 1.0)                          # theta_h in [0, pi/2]
+    jac = 2.0 * math.pi * np.sin(th) * np.cos(th) * 0.25 * math.pi * w
+    a = r * r
+    charlie = [gltf_distribution(math.cos(t), r) for t in th]
+    velvet = [filament_d_ashikhmin(a, math.cos(t)) for t in th]
+    assert float(np.dot(charlie, jac)) == pytest.approx(1.0, abs=2e-3)
+    assert float(np.dot(velvet, jac)) == pytest.approx(1.0, abs=2e-3)
+    # and the models' lobes at normal incidence (theta_h = 0) and at a grazing pair
+    for wi, wo in [([0.0, 0.0, 1.0], [0.0, 0.0, 1.0]), ([0.9, 0.1, 0.3], [-0.8, 0.2, 0.4])]:
+        wi, wo = np.array(wi) / np.linalg.norm(wi), np.array(wo) / np.linalg.norm(wo)
+        ch = _cos_h(wi, wo)
+        v = 1.0 / (4.0 * (wi[2] + wo[2] - wi[2] * wo[2]))
+        if ch < 1.0:
+            got = Ashikhmin(base=0.0, sheen=1.0, roughness=r).eval(wi, wo)[0]
+            assert got == pytest.approx(filament_d_ashikhmin(a, ch) * v, rel=1e-10)
 
 
 def test_quadrature_rule_against_an_independent_one():

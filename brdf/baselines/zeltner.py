@@ -39,6 +39,7 @@ mx_zeltner_sheen_importance_sample does); pdf = p cos(theta_i) / pi + (1 - p) D(
 Examples
 --------
 >>> import numpy as np
+>>> from brdf.baselines.sheen import hemisphere_rule
 >>> m = Zeltner(base=0.0, sheen=1.0, roughness=0.5)
 >>> wo = np.array([0.6, 0.0, 0.8])
 >>> wi, w = hemisphere_rule(0.8, 64, 64)             # the sheen lobe's albedo is R(0.8, 0.5)
@@ -53,12 +54,11 @@ import math
 
 import numpy as np
 
-from brdf.baselines.sheen import SheenModel, hemisphere_rule
+from brdf.baselines.sheen import SheenModel
 from brdf.frames import flat_pairs
 from brdf.schema import ParamInfo
 
-__all__ = ["Zeltner", "ROUGHNESS_ZELTNER", "dir_albedo", "ltc_ainv", "ltc_binv", "ltc_d",
-           "hemisphere_rule"]
+__all__ = ["Zeltner", "ROUGHNESS_ZELTNER", "dir_albedo", "ltc_ainv", "ltc_binv", "ltc_d"]
 
 #: MaterialX's M_FLOAT_EPS: the least NdotV.
 EPS = 1e-8

@@ -139,7 +139,7 @@ def ref_zeltner(wi, wo, base, sheen, roughness):
     # throughput = 1 - dirAlbedo
     ndotv = min(max(wo[2], 1e-8), 1.0)
     r = min(max(roughness, 0.01), 1.0)
-    alb = mx_dir_albedo(ndotv, r)
+    alb = max(mx_dir_albedo(ndotv, r), 0.0)           # our reading: R clamped at 0
     d = mx_brdf(wi, wo, ndotv, r)
     return [alb * sheen[k] * d / wi[2] + (1.0 - alb) * base[k] / math.pi for k in range(3)]
 
@@ -157,6 +157,13 @@ def test_eval_matches_transliteration(cls):
         want = [REFERENCES[cls](list(a), list(b), p["base"], p["sheen"], p["roughness"])
                 for a, b in zip(wi[k:k + 6], wo[k:k + 6])]
         np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-14)
+
+
+def test_zeltner_never_negative():
+    # MaterialX's R dips below 0 at roughness 0.04 to 0.13; clamped, f_r stays >= 0
+    wi, wo = _pairs(20000, _seed("negative"))
+    f = Zeltner(base=0.0, sheen=1.0).prepare(wi, wo).eval(roughness=np.linspace(0.04, 0.14, 11))
+    assert f.min() >= 0.0
 
 
 def test_zeltner_at_normal_view_and_grazing():
@@ -271,7 +278,8 @@ def test_zeltner_energy_and_its_albedo_fit():
     assert np.all(np.abs(total - 1.0) < 1e-6)               # R + (1 - R) with D normalized
     lobe = _albedo_grid(Zeltner, r, base=0.0)
     want = dir_albedo(np.clip(np.array(COS_O), 1e-8, 1)[:, None], np.array(r)[None, :])
-    np.testing.assert_allclose(lobe, want, atol=2e-5)       # f_r = R D / cos: its albedo is R
+    np.testing.assert_allclose(lobe, np.maximum(want, 0.0), atol=2e-5)   # f_r = R D / cos:
+    # its albedo is R (clamped at 0)
     # MaterialX's Gaussian fit of R itself dips below 0 (documented in docs/guide/baselines.rst)
     x, y = np.meshgrid(np.linspace(0, 1, 201), np.linspace(0.01, 1, 199), indexing="ij")
     fit = dir_albedo(x, y)

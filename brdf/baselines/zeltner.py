@@ -29,9 +29,10 @@ the base scaled by ``throughput = 1 - dirAlbedo * weight`` (weight 1), colourles
 sheen still darkens the base, as a black fuzz absorbs. R+ is a reading: MaterialX's fit of R
 dips to -2.1e-5 at roughness 0.04 to 0.13 (MaterialX clamps the Imageworks albedo in the same
 file, not this one), which would make f_r negative (to -2.8e-3 1/sr over a black base); the
-clamp changes the albedo by at most 2.1e-5 and keeps f_r >= 0. The sheen lobe's own albedo is R exactly
-(D integrates to 1), so white sheen over a white base reflects R+ + (1 - R+) = 1. MaterialX clamps roughness to [0.01, 1] ("the range of original impl."), the
-validated range here.
+clamp changes the albedo by at most 2.1e-5 and keeps f_r >= 0. The sheen lobe's own albedo
+is R+ exactly (D integrates to 1), so white sheen over a white base reflects R+ + (1 - R+) = 1.
+MaterialX clamps roughness to [0.01, 1] ("the range of original impl."), the validated range
+here.
 
 Not reciprocal: the lobe's shape and R follow wo alone (``reciprocal = False``).
 

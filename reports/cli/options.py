@@ -14,6 +14,7 @@ import gonio
 import gonio.io
 import gonio.tablesize
 from analysis import sources
+from analysis.fit.driver import MAX_ENSEMBLES, FitOptions  # MAX_ENSEMBLES: re-exported
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
@@ -29,8 +30,6 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
 MAX_TANGENT_SAMPLES = brdf.MAX_TANGENT_SAMPLES
-#: Largest --ensembles: R-hat needs a few; each is a group of the one checkpoint.
-MAX_ENSEMBLES = 64
 
 
 def _on_off(value: str) -> bool:
@@ -185,33 +184,14 @@ def check_tangent_samples(n) -> None:
                          f"got {n}")
 
 
-def check_fit_options(args: argparse.Namespace) -> None:
-    """The options of :func:`add_fit_options`, each checked by name before any work."""
-    checks = [
-        (args.seed >= 0, "--seed", args.seed, "a non-negative integer"),
-        (2 <= args.ensembles <= MAX_ENSEMBLES, "--ensembles", args.ensembles,
-         f"an integer in 2..{MAX_ENSEMBLES} (R-hat is computed across them)"),
-        (args.walkers is None or args.walkers >= 2, "--walkers", args.walkers,
-         "an even integer >= 2 x the number of free parameters"),
-        (args.max_steps >= 1, "--max-steps", args.max_steps, "a positive integer"),
-        (args.check_every >= 1, "--check-every", args.check_every, "a positive integer"),
-        (args.time_limit is None or (math.isfinite(args.time_limit) and args.time_limit > 0),
-         "--time-limit", args.time_limit, "a positive finite number of seconds"),
-        (math.isfinite(args.nu) and args.nu > 0, "--nu", args.nu,
-         "a positive finite number of degrees of freedom"),
-    ]
-    for ok, option, value, allowed in checks:
-        if not ok:
-            raise ValueError(f"{option} must be {allowed}; got {value}")
-
-
 def fit_kwargs(args: argparse.Namespace) -> dict:
-    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`
-    (checked first: :func:`check_fit_options`)."""
-    check_fit_options(args)
-    return {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
-            "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
-            "check_every": args.check_every, "time_limit": args.time_limit}
+    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`, each
+    checked by name before any work (:meth:`analysis.fit.FitOptions.check`)."""
+    kw = {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
+          "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
+          "check_every": args.check_every, "time_limit": args.time_limit}
+    FitOptions(**kw).check()
+    return kw
 
 
 def split_ties(ties):

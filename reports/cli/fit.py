@@ -15,8 +15,8 @@ from pathlib import Path
 
 import brdf
 from analysis.budget import check_fit_rows
-from analysis.fit import FabricModel, FitOptions, fit_fabric, fit_spec
-from analysis.fit.fisher import suggest_free
+from analysis.fit import FitOptions, fit_fabric, fit_spec
+from analysis.fit.fisher import suggest_for_file
 from analysis.fit.loo import HIGH_K
 from reports.cli import lazy
 from reports.cli import options as cliutil
@@ -108,17 +108,13 @@ def run(args) -> int:
 
 
 def _suggest(args, fit_kw) -> int:
-    """``--suggest``: the Fisher information of the table at the start, printed; no
-    sampling, nothing written."""
+    """``--suggest``: :func:`analysis.fit.fisher.suggest_for_file`, printed; no sampling,
+    nothing written."""
     fab = cliutil.fabric_from_args(args.fabric, args)
-    ties = cliutil.split_ties(args.tie)
-    if args.free is not None or args.spec is not None:
-        _spec_from_args(args, fab)              # a bad --free, --tie or --spec: before reading
-    cliutil.reader_options(args.table, sample=args.sample)
-    table = read_table(args.table, args.sample)
-    report, kept = suggest_free(table, fab, FabricModel(fab, table.wi, table.wo), args.free,
-                                ties, args.spec, likelihood=fit_kw["likelihood"],
-                                nu=fit_kw["nu"])
+    given = cliutil.reader_options(args.table, sample=args.sample)
+    report, kept = suggest_for_file(args.table, fab, args.free, cliutil.split_ties(args.tie),
+                                    args.spec, read_options=given,
+                                    likelihood=fit_kw["likelihood"], nu=fit_kw["nu"])
     print(format_information(report, kept, args.table))
     return 0
 

@@ -19,7 +19,13 @@ def plots() -> SimpleNamespace:
 
 
 def report():
-    """:func:`reports.report.build_report` (the report's plots load matplotlib)."""
+    """:func:`reports.report.build_report` (the report's plots load matplotlib).
+
+    Examples
+    --------
+    >>> report().__module__, plots().views.__name__, renderer().engine.__name__
+    ('reports.report.build', 'reports.plots.views', 'reports.render.engine')
+    """
     # lazy: matplotlib and colour-science (~2 s), which the other verbs skip
     from reports.report import build_report
     return build_report

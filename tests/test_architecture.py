@@ -294,3 +294,49 @@ def test_every_module_has_a_doctest_or_a_named_test():
     assert not unnamed, ("modules with no doctest, no test importing them by name and (verb "
                          "modules) no test running their verbs: add an Example or a test:\n  "
                          + "\n  ".join(unnamed))
+
+
+#: Calls that write or remove files themselves: the builtin ``open``, gonio's atomic writer,
+#: pathlib's and json's and csv's writers, numpy's savers, and os/shutil file operations.
+WRITERS = {"open", "atomic_write", "write_text", "write_bytes", "dump", "writer", "save",
+           "savez", "savez_compressed", "savetxt", "mkdir", "makedirs", "touch", "unlink",
+           "rmtree", "replace", "rename", "remove", "copyfile", "copy", "move",
+           "NamedTemporaryFile", "mkstemp"}
+#: Of those, the names that are also ordinary methods (``str.replace``,
+#: ``dataclasses.replace``, ``dict.copy``): writers only as ``os.X`` / ``shutil.X``.
+AMBIGUOUS = {"replace", "rename", "remove", "copy", "move", "save"}
+
+
+def _verb_modules() -> list[str]:
+    """The modules of ``reports.cli.COMMAND_MODULES`` (read from its source)."""
+    for node in TREES["reports.cli"].body:
+        if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == \
+                "COMMAND_MODULES":
+            return [e.value for e in node.value.elts]
+    raise AssertionError("reports/cli/__init__.py has no COMMAND_MODULES")
+
+
+def test_verb_modules_write_no_file_themselves():
+    """CONTRIBUTING.md: a verb module parses, calls one workflow and prints. It opens,
+    writes, renames or removes no file itself (the workflows in analysis/, gonio's writers
+    and the report's and renderer's functions do), so every file a verb leaves is written
+    where the rules of writing (atomic, locked, never through a link) are kept."""
+    bad = []
+    for name in _verb_modules():
+        for node in ast.walk(TREES[name]):
+            if not isinstance(node, ast.Call):
+                continue
+            f = node.func
+            called = f.id if isinstance(f, ast.Name) else f.attr if isinstance(
+                f, ast.Attribute) else ""
+            owner = f.value.id if isinstance(f, ast.Attribute) and isinstance(
+                f.value, ast.Name) else None
+            if called not in WRITERS:
+                continue
+            if called in AMBIGUOUS and owner not in ("os", "shutil", "np", "numpy"):
+                continue
+            if called == "writer" and owner != "csv":
+                continue
+            bad.append(f"{MODULES[name].relative_to(ROOT)}:{node.lineno} {called}(")
+    assert not bad, ("verb modules writing files themselves (move the writing into a "
+                     "workflow of analysis/):\n" + "\n".join(bad))

@@ -14,8 +14,8 @@ import sys
 from pathlib import Path
 
 import brdf
-from analysis.budget import check_fit_rows
-from analysis.fit import FitOptions, fit_fabric, fit_spec
+from analysis.fit import fit_fabric, fit_spec
+from analysis.fit.workflow import check_fit_size
 from analysis.fit.fisher import suggest_for_file
 from analysis.fit.loo import HIGH_K
 from reports.cli import lazy
@@ -62,16 +62,6 @@ def _spec_from_args(args, fab):
     return fit_spec(fab, args.free, cliutil.split_ties(args.tie), args.spec)
 
 
-def _check_size(args, spec) -> None:
-    """The table's reading, then the fit's evaluations at the table's size estimated from
-    the file, against the memory limit: before the table is parsed."""
-    given = cliutil.reader_options(args.table, sample=args.sample)
-    est = cliutil.table_estimate(args.table, **given)
-    if est is not None:
-        opts = FitOptions(walkers=args.walkers).resolve(spec.ndim)
-        check_fit_rows(Path(args.table).name, est.rows, opts.walkers, opts.threads)
-
-
 def run(args) -> int:
     """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
     brdf.check_preset(args.fabric)
@@ -82,7 +72,8 @@ def run(args) -> int:
         raise ValueError("-o/--output DIR is required (unless --suggest)")
     fab = cliutil.fabric_from_args(args.fabric, args)
     spec = _spec_from_args(args, fab)
-    _check_size(args, spec)
+    check_fit_size(args.table, spec, args.walkers,
+                   **cliutil.reader_options(args.table, sample=args.sample))
     out = cliutil.check_writable_dir(Path(args.output))
     table = read_table(args.table, args.sample)
     plots = None

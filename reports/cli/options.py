@@ -12,7 +12,6 @@ from pathlib import Path
 import brdf
 import gonio
 import gonio.io
-import gonio.tablesize
 from analysis import sources
 from analysis.fit.driver import MAX_ENSEMBLES, FitOptions  # MAX_ENSEMBLES: re-exported
 from analysis.folderlock import missing_folders, remove_empty_folders
@@ -25,7 +24,6 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
            "check_output_suffix", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
-           "table_estimate",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
@@ -206,8 +204,9 @@ def reader_options(path, **options) -> dict:
     ``--sample`` for a CUReT abrdf.dat, ``--step`` for an RGL .bsdf, ``--stride`` for a MERL
     .binary; another is refused by name (:func:`gonio.io.check_read_options`). The table's
     size is not estimated here: :func:`gonio.read` refuses a table whose reading would exceed
-    the memory limit before parsing it, and a verb that must know the size before other work
-    calls :func:`table_estimate` (each estimate counts a CSV's lines once)."""
+    the memory limit before parsing it, and a fit, which must know the size before other
+    work, calls :func:`analysis.fit.workflow.check_fit_size` (each estimate counts a CSV's
+    lines once)."""
     path = Path(path)
     given = {k: v for k, v in options.items() if v is not None}
     if given:
@@ -222,17 +221,6 @@ def reader_options(path, **options) -> dict:
         if not (math.isfinite(step) and 0 < step <= 90):
             raise ValueError(f"--step must be in (0, 90] degrees; got {step}")
     return given
-
-
-def table_estimate(path, **options):
-    """The size of the table ``path`` (:class:`gonio.tablesize.Estimate`), refused when its
-    reading would exceed the memory limit (:func:`gonio.tablesize.check_table`); None when
-    it cannot be told (the reader then says what is wrong)."""
-    path = Path(path)
-    kind = gonio.io.table_kind(path, quiet=True)
-    if kind is None or not path.is_file():
-        return None
-    return gonio.tablesize.check_table(path, kind, **options)
 
 
 def read_table(path, **options):

@@ -1,6 +1,6 @@
 """The built-in renderer's small parts, each against an answer worked out by hand: vec3's
 bases, the cameras' rays, the lights' irradiance (inverse square, the disc's mean), the
-pixel samples' strata, and a worker that dies with its parent."""
+pixel samples' strata, a worker that dies with its parent; and a render written as files."""
 
 import math
 import os
@@ -11,7 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from reports.render import cameras, lights, pixelsamples, vec3, workerexit
+import brdf
+from reports.render import (cameras, files, imageio, lights, pixelsamples, scenes, vec3,
+                            workerexit)
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -116,3 +118,21 @@ def test_a_worker_dies_with_its_killed_parent(tmp_path):
         if p.poll() is None:
             p.kill()
     assert callable(workerexit.exit_with_parent)
+
+
+def test_render_to_files_writes_the_exr_and_its_png_with_the_exposure(tmp_path):
+    """reports.render.files: a tiny built-in render of the patch; out.exr is linear with the
+    PNG's exposure in its header, out.png beside it; a given exposure is kept, else it is
+    automatic; ``out.png`` alone is written without an EXR."""
+    fab = brdf.fabric("velvet")
+    scene = scenes.make_scene("patch")
+    expo, written = files.render_to_files(scene, fab, tmp_path / "a.exr", stops=1.5, width=32,
+                                          height=18, spp=1, workers=1)
+    assert [p.name for p in written] == ["a.exr", "a.png"] and expo.stops == 1.5
+    assert imageio.read_exr_attributes(tmp_path / "a.exr")["microcyl_exposure_stops"] == 1.5
+    linear = imageio.read_exr(tmp_path / "a.exr")
+    assert linear.shape == (18, 32, 3) and linear.max() > 0
+    auto, written = files.render_to_files(scene, fab, tmp_path / "b.png", width=32, height=18,
+                                          spp=1, workers=1)
+    assert [p.name for p in written] == ["b.png"] and not (tmp_path / "b.exr").exists()
+    assert auto.mode == "auto" and auto.stops != 1.5

@@ -32,7 +32,7 @@ def report():
 
 
 def renderer() -> SimpleNamespace:
-    """The built-in renderer's ``engine``, ``exposure`` and ``imageio`` modules."""
+    """The built-in renderer's ``engine``, ``exposure``, ``files`` and ``imageio`` modules."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
-    from reports.render import engine, exposure, imageio
-    return SimpleNamespace(engine=engine, exposure=exposure, imageio=imageio)
+    from reports.render import engine, exposure, files, imageio
+    return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio)

@@ -13,6 +13,7 @@ without a document type (no entity is ever expanded) and every value checked by
 
 from __future__ import annotations
 
+import json
 import math
 import numbers
 import os
@@ -24,10 +25,12 @@ from xml.sax.saxutils import quoteattr
 
 import brdf
 from brdf.fabric import OPTIONS
+from gonio.atomic import atomic_write
+from gonio.jsonplain import plain
 from gonio.statefields import MAX_MAGNITUDE, loads_json
 
 __all__ = ["plugin_dict", "plugin_xml", "fabric_from_dict", "fabric_from_xml",
-           "read_fabric_file", "PLUGIN_NAME", "THREAD_KEYS", "OPTION_KEYS", "MAX_FILE_BYTES",
+           "read_fabric_file", "write_fabric_file", "PLUGIN_NAME", "THREAD_KEYS", "OPTION_KEYS", "MAX_FILE_BYTES",
            "SUFFIXES"]
 
 #: The plugin's name in Mitsuba's registry.
@@ -347,3 +350,28 @@ def read_fabric_file(path) -> brdf.Fabric:
         return fabric_from_dict(doc)
     except (ValueError, TypeError) as exc:
         raise ValueError(f"{path}: {exc}") from None
+
+
+def write_fabric_file(path, fabric: brdf.Fabric, preset: str | None = None) -> Path:
+    """Write ``fabric`` (what ``microcyl export`` does): as :func:`plugin_xml`'s element where
+    ``path`` ends in ``.xml``, else as :func:`plugin_dict`'s dictionary in indented JSON;
+    atomically (:func:`gonio.atomic_write`). Returns the path; :func:`read_fabric_file`
+    reads it back.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> fab = brdf.fabric("velvet", masking=False)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     back = read_fabric_file(write_fabric_file(Path(tmp) / "v.xml", fab, "velvet"))
+    >>> back.options["masking"], back.threads[0].eta == fab.threads[0].eta
+    (False, True)
+    """
+    path = Path(path)
+    if path.suffix.lower() == ".xml":
+        text = plugin_xml(fabric, preset)
+    else:
+        text = json.dumps(plain(plugin_dict(fabric, preset)), indent=2) + "\n"
+    with atomic_write(path, "w") as fh:
+        fh.write(text)
+    return path

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 import brdf
+from analysis.colour import luminance
 
-__all__ = ["STANDARD_GEOMETRIES", "standard_values"]
+__all__ = ["STANDARD_GEOMETRIES", "standard_values", "standard_luminance"]
 
 #: (label, theta_i, phi_i, theta_o, phi_o), degrees; phi from the warp (+x).
 STANDARD_GEOMETRIES = (
@@ -33,3 +34,17 @@ def standard_values(fab) -> dict[str, list[float]]:
     wo = brdf.directions.from_angles(angles[:, 2], angles[:, 3])
     f = np.asarray(fab.eval(wi, wo))
     return {g[0]: [float(v) for v in row] for g, row in zip(STANDARD_GEOMETRIES, f)}
+
+
+def standard_luminance(fab) -> list[float]:
+    """The luminance of :func:`standard_values` (1/sr), in the order of
+    :data:`STANDARD_GEOMETRIES`.
+
+    Examples
+    --------
+    >>> lum = standard_luminance(brdf.fabric("linen_plain"))
+    >>> rgb = standard_values(brdf.fabric("linen_plain"))["normal"]
+    >>> len(lum), min(rgb) <= lum[0] <= max(rgb)
+    (6, True)
+    """
+    return luminance(np.array(list(standard_values(fab).values()), dtype=np.float64)).tolist()

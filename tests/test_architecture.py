@@ -3,8 +3,9 @@
 Fails on what issue 26 requires: no upward import (brdf <- gonio <- analysis <- reports), no
 import circle, at most 25 modules directly in reports/ (once it is split by concern), at most
 10 imports inside functions, each of a costly library or with a comment saying which one it
-defers, no module over 400 lines and no function over 80. Prints, without failing, the modules
-no test imports by name.
+defers, no module over 400 lines and no function over 80, every module with a doctest or a
+test that names it (a verb module: a test that runs its verb), and no verb module of
+reports/cli/ writing a file itself.
 """
 
 from __future__ import annotations
@@ -201,18 +202,141 @@ def test_sizes():
         f"{FUNCTION_LINES} lines: {long_functions or 'none'} (split them: CONTRIBUTING.md)")
 
 
-def test_test_layout_reported():
-    """CONTRIBUTING.md's Tests: tests by topic; printed, not failed: the modules that no test
-    module imports by name and that have no doctest (exercised only through other modules or
-    the command line's end-to-end tests)."""
-    tests = "\n".join(p.read_text() for p in (ROOT / "tests").glob("*.py"))
+def _verbs_run_by_tests() -> set[str]:
+    """The verbs the tests run as a user would: the first argument of ``main([...])`` or of
+    a ``microcyl(...)`` helper, and the word after ``"reports"`` in an argument list
+    (``[sys.executable, "-m", "reports", VERB, ...]``)."""
+    verbs = set()
+    for path in (ROOT / "tests").glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            words = []
+            if isinstance(node, ast.Call) and node.args:
+                name = getattr(node.func, "id", getattr(node.func, "attr", ""))
+                first = node.args[0]
+                if name == "main" and isinstance(first, ast.List) and first.elts:
+                    words = first.elts[:1]
+                elif name.endswith("microcyl"):
+                    words = [first]
+            elif isinstance(node, ast.List):
+                items = [e.value if isinstance(e, ast.Constant) else None for e in node.elts]
+                words = [node.elts[i + 1] for i, v in enumerate(items[:-1]) if v == "reports"]
+            verbs.update(w.value for w in words
+                         if isinstance(w, ast.Constant) and isinstance(w.value, str))
+    return verbs
+
+
+def _verbs_of(name: str) -> set[str]:
+    """The verbs a ``reports.cli`` module registers (``sub.add_parser("VERB", ...)``)."""
+    return {n.args[0].value for n in ast.walk(TREES[name])
+            if isinstance(n, ast.Call) and getattr(n.func, "attr", "") == "add_parser"
+            and n.args and isinstance(n.args[0], ast.Constant)}
+
+
+def _public(name: str) -> list[str]:
+    """The names of a module's ``__all__`` (a literal list or tuple), else none."""
+    for node in TREES[name].body:
+        if (isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "__all__"
+                                                 for t in node.targets)
+                and isinstance(node.value, (ast.List, ast.Tuple))):
+            return [e.value for e in node.value.elts if isinstance(e, ast.Constant)]
+    return []
+
+
+def _public_name_used(name: str, tests: list[str]) -> bool:
+    """Whether a test module uses a public name of module ``name`` through a package above
+    it, which re-exports it (``gonio.read_alta``; ``from analysis.fit import (...,
+    LockStep)``; ``from reports import plots`` then ``plots.plot_albedo``): the test
+    exercises this module."""
+    parts = name.split(".")
+    names = "|".join(_public(name))
+    if not names:
+        return False
+    for k in range(1, len(parts)):
+        pkg, parent, leaf = ".".join(parts[:k]), ".".join(parts[:k - 1]), parts[k - 1]
+        used = [rf"(?<![\w.]){re.escape(pkg)}\.({names})\b",
+                rf"from {re.escape(pkg)} import (\([^)]*|[^\n]*)\b({names})\b"]
+        for text in tests:
+            if any(re.search(u, text) for u in used):
+                return True
+            if (parent and re.search(rf"from {re.escape(parent)} import [^\n]*\b{leaf}\b",
+                                     text)
+                    and re.search(rf"(?<![\w.]){leaf}\.({names})\b", text)):
+                return True
+    return False
+
+
+def _untested_modules() -> list[str]:
+    """The modules with no doctest that no test imports by name and, for a verb module of
+    ``reports.cli``, none of whose verbs a test runs."""
+    texts = [p.read_text() for p in (ROOT / "tests").glob("*.py")]
+    tests = "\n".join(texts)
+    run = _verbs_run_by_tests()
     unnamed = []
     for name, path in MODULES.items():
         pkg, _, leaf = name.rpartition(".")
         if path.name in ("__init__.py", "__main__.py") or ">>> " in path.read_text():
             continue
-        if not (re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", tests) or
-                re.search(rf"from {re.escape(pkg)} import [^\n]*\b{leaf}\b", tests)):
-            unnamed.append(name)
-    print(f"\n{len(unnamed)} modules with no doctest that no test imports by name:",
-          *unnamed or ["none"], sep="\n  ")
+        if (re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", tests) or
+                re.search(rf"from {re.escape(pkg)} import [^\n]*\b{leaf}\b", tests) or
+                _public_name_used(name, texts)):
+            continue
+        if name.startswith("reports.cli.") and _verbs_of(name) & run:
+            continue
+        unnamed.append(name)
+    return unnamed
+
+
+def test_every_module_has_a_doctest_or_a_named_test():
+    """CONTRIBUTING.md's Tests: every module is exercised by a doctest (an Example in its
+    docstrings), a test that imports it by name, or, for a verb module of ``reports.cli``, a
+    test that runs one of its verbs as a user would."""
+    unnamed = _untested_modules()
+    assert not unnamed, ("modules with no doctest, no test importing them by name and (verb "
+                         "modules) no test running their verbs: add an Example or a test:\n  "
+                         + "\n  ".join(unnamed))
+
+
+#: Calls that write or remove files themselves: the builtin ``open``, gonio's atomic writer,
+#: pathlib's and json's and csv's writers, numpy's savers, and os/shutil file operations.
+WRITERS = {"open", "atomic_write", "write_text", "write_bytes", "dump", "writer", "save",
+           "savez", "savez_compressed", "savetxt", "mkdir", "makedirs", "touch", "unlink",
+           "rmtree", "replace", "rename", "remove", "copyfile", "copy", "move",
+           "NamedTemporaryFile", "mkstemp"}
+#: Of those, the names that are also ordinary methods (``str.replace``,
+#: ``dataclasses.replace``, ``dict.copy``): writers only as ``os.X`` / ``shutil.X``.
+AMBIGUOUS = {"replace", "rename", "remove", "copy", "move", "save"}
+
+
+def _verb_modules() -> list[str]:
+    """The modules of ``reports.cli.COMMAND_MODULES`` (read from its source)."""
+    for node in TREES["reports.cli"].body:
+        if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == \
+                "COMMAND_MODULES":
+            return [e.value for e in node.value.elts]
+    raise AssertionError("reports/cli/__init__.py has no COMMAND_MODULES")
+
+
+def test_verb_modules_write_no_file_themselves():
+    """CONTRIBUTING.md: a verb module parses, calls one workflow and prints. It opens,
+    writes, renames or removes no file itself (the workflows in analysis/, gonio's writers
+    and the report's and renderer's functions do), so every file a verb leaves is written
+    where the rules of writing (atomic, locked, never through a link) are kept."""
+    bad = []
+    for name in _verb_modules():
+        for node in ast.walk(TREES[name]):
+            if not isinstance(node, ast.Call):
+                continue
+            f = node.func
+            called = f.id if isinstance(f, ast.Name) else f.attr if isinstance(
+                f, ast.Attribute) else ""
+            owner = f.value.id if isinstance(f, ast.Attribute) and isinstance(
+                f.value, ast.Name) else None
+            if called not in WRITERS:
+                continue
+            if called in AMBIGUOUS and owner not in ("os", "shutil", "np", "numpy"):
+                continue
+            if called == "writer" and owner != "csv":
+                continue
+            bad.append(f"{MODULES[name].relative_to(ROOT)}:{node.lineno} {called}(")
+    assert not bad, ("verb modules writing files themselves (move the writing into a "
+                     "workflow of analysis/):\n" + "\n".join(bad))

@@ -504,3 +504,26 @@ def test_export_xml_loads_in_a_scene_file(fit_folder, scalar, tmp_path):
     ref = med.fabric.eval(light.astype(float), view.astype(float)) * light[:, 2:3]
     assert _worst(got, ref) < RTOL
     assert not med.fabric.options["masking"]        # the fit's variant came through
+
+
+@needs_mitsuba
+def test_kernel_on_its_consts_matches_fabric_without_the_plugin(scalar):
+    """reports.mitsuba.kernel.eval_cos on reports.mitsuba.consts.consts, called directly (no
+    BSDF object): f_r cos(theta_i) of brdf.Fabric in float64 at random pairs; the constants
+    carry the fabric's options and gap area, the sampler's cdf ends at 1; and
+    reports.mitsuba.bsdf.bsdf_class() is one mi.BSDF subclass per variant."""
+    mi = scalar
+    from reports.mitsuba import bsdf as mbsdf, consts as mconsts, kernel as mkernel
+    fab = brdf.fabric("silk_shot", masking=False, gap="outgoing")
+    k = mconsts.consts(fab)
+    assert k.masking is False and k.reweighting is True and str(k.gap) == "outgoing"
+    assert k.gap_area == pytest.approx(1 - fab.threads[0].area - fab.threads[1].area)
+    assert k.comp_cdf[-1] == 1.0 and len(k.comp_cdf) == k.comp_size
+    rng = np.random.default_rng(7)
+    light, view = _hemi(rng, 40), _hemi(rng, 40)
+    out = np.array([mkernel.eval_cos(k, mi.Vector3f(*map(float, l)), mi.Vector3f(*map(float, v)),
+                                     1.0, 0.0) for l, v in zip(light, view)], dtype=np.float64)
+    ref = fab.eval(light.astype(np.float64), view.astype(np.float64)) * light[:, 2:3]
+    assert _worst(out, ref) < RTOL
+    cls = mbsdf.bsdf_class()
+    assert cls is mbsdf.bsdf_class() and issubclass(cls, mi.BSDF)

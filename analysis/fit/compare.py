@@ -157,7 +157,15 @@ def compare_fits(folders, names=None) -> list[dict]:
 
 def difference_in_se(row: dict) -> float:
     """``d_elpd / d_se`` of a row of :func:`compare_fits` (inf when d_se is 0 and d_elpd is
-    not; 0 for the best)."""
+    not; 0 for the best).
+
+    Examples
+    --------
+    >>> difference_in_se({"d_elpd": 6.0, "d_se": 1.5})
+    4.0
+    >>> [difference_in_se({"d_elpd": d, "d_se": 0.0}) for d in (0.0, 2.0)]
+    [0.0, inf]
+    """
     if row["d_se"] > 0:
         return row["d_elpd"] / row["d_se"]
     return 0.0 if row["d_elpd"] == 0 else math.inf

@@ -8,6 +8,7 @@ the EM fits) fights them for the cores.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import time
 from typing import Callable, Mapping
@@ -27,13 +28,16 @@ from analysis.fit.trust import assess
 from analysis.likelihood import Likelihood
 from analysis.params import INTERNAL_LIMIT, ParamSpec
 
-__all__ = ["fit", "FitOptions", "CONFIG_VERSION", "estimate_time", "estimate_fit_time",
+__all__ = ["fit", "FitOptions", "MAX_ENSEMBLES", "CONFIG_VERSION", "estimate_time", "estimate_fit_time",
            "with_nuisance"]
 
 #: A fit that may take this many seconds or more says so before it starts (``notify``).
 ESTIMATE_MIN_S = 10.0
 #: Version of the sampler's configuration; a folder fitted by another version is refused.
 CONFIG_VERSION = 7
+
+#: Most ensembles of a fit: R-hat needs a few; each is a group of the one checkpoint.
+MAX_ENSEMBLES = 64
 
 #: The precisions the model may shade in while sampling (``fit(shading=...)``).
 SHADINGS = ("float32", "float64")
@@ -58,9 +62,41 @@ class FitOptions:
     time_limit: float | None = None
     shading: str = "float32"
 
+    def check(self) -> "FitOptions":
+        """The options that need no free set checked, each by its command-line name (the one
+        rule of ``microcyl fit``, ``fit-batch`` and :meth:`resolve`); ``self`` when all hold,
+        else a ValueError naming the first bad option, its value and what is allowed.
+
+        Examples
+        --------
+        >>> FitOptions(ensembles=3, walkers=10).check().ensembles
+        3
+        >>> FitOptions(ensembles=1).check()
+        Traceback (most recent call last):
+        ...
+        ValueError: --ensembles must be an integer in 2..64 (R-hat is computed across them); got 1
+        """
+        checks = [
+            (self.seed >= 0, "--seed", self.seed, "a non-negative integer"),
+            (2 <= self.ensembles <= MAX_ENSEMBLES, "--ensembles", self.ensembles,
+             f"an integer in 2..{MAX_ENSEMBLES} (R-hat is computed across them)"),
+            (self.walkers is None or self.walkers >= 2, "--walkers", self.walkers,
+             "an even integer >= 2 x the number of free parameters"),
+            (self.max_steps >= 1, "--max-steps", self.max_steps, "a positive integer"),
+            (self.check_every >= 1, "--check-every", self.check_every, "a positive integer"),
+            (self.time_limit is None or 0 < self.time_limit < math.inf, "--time-limit",
+             self.time_limit, "a positive finite number of seconds"),
+            (0 < self.nu < math.inf, "--nu", self.nu,
+             "a positive finite number of degrees of freedom"),
+        ]
+        for ok, option, value, allowed in checks:
+            if not ok:
+                raise ValueError(f"{option} must be {allowed}; got {value}")
+        return self
+
     def resolve(self, ndim: int) -> "FitOptions":
-        """Defaults filled in for ``ndim`` free parameters; a ValueError naming the first bad
-        option otherwise."""
+        """Checked (:meth:`check`, then for ``ndim`` free parameters), defaults filled in."""
+        self.check()
         walkers = self.walkers
         if walkers is None:
             walkers = 2 * ndim + 2
@@ -69,23 +105,14 @@ class FitOptions:
         if adapt is None:
             adapt = 2 * self.check_every if self.laplace_move > 0 else 0
         checks = [
-            (self.ensembles >= 2, f"ensembles (--ensembles) must be >= 2 (R-hat is computed "
-                                  f"across them); got {self.ensembles}"),
             (walkers >= 2 * ndim and walkers % 2 == 0,
              f"walkers (--walkers) must be an even number >= 2 x ndim = {2 * ndim} ({ndim} "
              f"free parameters, log_noise and scale included); got {walkers}"),
-            (self.max_steps >= 1, f"max_steps (--max-steps) must be >= 1; got "
-                                  f"{self.max_steps}"),
-            (self.check_every >= 1, f"check_every (--check-every) must be >= 1; got "
-                                    f"{self.check_every}"),
             (0 <= self.laplace_move <= 1, f"laplace_move must be in [0, 1]; got "
                                           f"{self.laplace_move}"),
             (adapt >= 0 and not (adapt and self.laplace_move <= 0),
              f"adapt must be >= 0, and 0 when laplace_move is 0; got {adapt}"),
             (self.n_starts >= 1, f"n_starts must be >= 1; got {self.n_starts}"),
-            (self.time_limit is None or (self.time_limit > 0 and np.isfinite(self.time_limit)),
-             f"time_limit (--time-limit) must be a finite number of seconds > 0; got "
-             f"{self.time_limit}"),
             (self.threads is None or self.threads >= 1,
              f"threads must be >= 1; got {self.threads}"),
             (self.shading in SHADINGS,

@@ -35,13 +35,15 @@ import math
 
 import numpy as np
 
+import gonio
 from analysis.fit.driver import with_nuisance
-from analysis.fit.posterior import LogPosterior
+from analysis.fit.posterior import FabricModel, LogPosterior
 from analysis.fit.workflow import fit_spec
 from analysis.likelihood import Likelihood, is_grey
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec
 
 __all__ = ["FisherReport", "fisher_information", "table_information", "suggest_free",
+           "suggest_for_file",
            "candidate_spec", "PRIOR_SD", "INFORMED_RATIO", "CONFOUNDED"]
 
 #: Standard deviation of the flat prior in the internal (logit) coordinates: the standard
@@ -295,3 +297,22 @@ def suggest_free(table, fabric, model, free=None, ties=None, toml=None, *,
     kept = {t: (src if kind == "equal" else f"1-{src}")
             for t, (src, kind) in spec.ties.items() if src in report.suggested}
     return report, kept
+
+
+def suggest_for_file(path, fabric, free=None, ties=None, toml=None, *, read_options=None,
+                     likelihood: str = "gaussian", nu: float = 4.0) -> tuple[FisherReport, dict]:
+    """What ``microcyl fit --suggest`` does: the free set given (``free``, ``ties``, ``toml``
+    as :func:`analysis.fit.fit_spec` takes them) checked before the table is read, the table
+    ``path`` read (``gonio.read(path, **read_options)``), then :func:`suggest_free` with
+    ``fabric``'s model at the table's pairs. Nothing is written.
+
+    Returns
+    -------
+    (FisherReport, dict)
+        As :func:`suggest_free`.
+    """
+    if free is not None or toml is not None:
+        fit_spec(fabric, free, ties, toml)      # a bad free set, tie or spec: before reading
+    table = gonio.read(path, **dict(read_options or {}))
+    return suggest_free(table, fabric, FabricModel(fabric, table.wi, table.wo), free, ties,
+                        toml, likelihood=likelihood, nu=nu)

@@ -6,8 +6,11 @@ import time
 from pathlib import Path
 from typing import Callable
 
+import gonio.io
+import gonio.tablesize
+from analysis.budget import check_fit_rows
 from analysis.fit.checkpoint import table_digest
-from analysis.fit.driver import fit
+from analysis.fit.driver import FitOptions, fit
 from analysis.fit.loo import psis_loo
 from analysis.fit.posterior import FabricModel
 from analysis.fit.quality import fit_quality
@@ -15,7 +18,7 @@ from analysis.fit.results import FitResult, write_results
 from analysis.folderlock import output_lock
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
 
-__all__ = ["fit_fabric", "fit_spec"]
+__all__ = ["fit_fabric", "fit_spec", "check_fit_size"]
 
 
 def fit_spec(fabric, free=None, ties=None, toml=None) -> ParamSpec:
@@ -57,6 +60,23 @@ def fit_spec(fabric, free=None, ties=None, toml=None) -> ParamSpec:
         return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties)
     return ParamSpec(free if free is not None else DEFAULT_FREE, defaults=defaults,
                      ties=ties or ())
+
+
+def check_fit_size(path, spec: ParamSpec, walkers: int | None = None, **read_options) -> None:
+    """Before the table ``path`` is parsed: its size estimated from the file and refused when
+    its reading would exceed the memory limit (:func:`gonio.tablesize.check_table`), then the
+    fit's batched evaluations at that size (:func:`analysis.budget.check_fit_rows`, walkers
+    and threads as :meth:`FitOptions.resolve` makes them for ``spec``). Nothing is refused
+    when the size cannot be told (the reader then says what is wrong).
+    """
+    path = Path(path)
+    kind = gonio.io.table_kind(path, quiet=True)
+    if kind is None or not path.is_file():
+        return
+    est = gonio.tablesize.check_table(path, kind, **read_options)
+    if est is not None:
+        opts = FitOptions(walkers=walkers).resolve(spec.ndim)
+        check_fit_rows(path.name, est.rows, opts.walkers, opts.threads)
 
 
 def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,

@@ -14,7 +14,19 @@ __all__ = ["PosteriorLobe", "compute_posterior_lobes", "posterior_draws"]
 
 
 def posterior_draws(result, n: int = 64, seed: int = 0) -> np.ndarray:
-    """``n`` posterior draws in the sampler's internal coordinates, shape (n, ndim)."""
+    """``n`` posterior draws in the sampler's internal coordinates, shape (n, ndim): the
+    samples of every chain, drawn without replacement (all of them when there are fewer).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> r = SimpleNamespace(chains_internal=np.arange(24.0).reshape(2, 4, 3), names="abc")
+    >>> d = posterior_draws(r, n=5)
+    >>> d.shape, all(row in r.chains_internal.reshape(-1, 3).tolist() for row in d.tolist())
+    ((5, 3), True)
+    >>> len({tuple(row) for row in posterior_draws(r, n=100)})
+    8
+    """
     flat = result.chains_internal.reshape(-1, len(result.names))
     idx = np.random.default_rng(seed).choice(flat.shape[0], min(n, flat.shape[0]), False)
     return flat[idx]

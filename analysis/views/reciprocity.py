@@ -61,6 +61,19 @@ def compute_reciprocity(brdf, phi_i_deg=180.0, phi_o_deg=0.0, resolution=45,
     Returns
     -------
     ReciprocityView
+
+    Examples
+    --------
+    f_r = cos theta_i is reciprocal on the diagonal only; off it the error is
+    |cos a - cos b| / max(cos a, cos b):
+
+    >>> class CosineOfLight:
+    ...     def eval(self, wi, wo):
+    ...         f = np.asarray(wi)[..., 2:3] + 0 * np.asarray(wo)[..., :1]
+    ...         return np.repeat(f, 3, axis=-1)
+    >>> v = compute_reciprocity(CosineOfLight(), resolution=2)
+    >>> v.theta_deg.tolist(), np.round(v.error, 4).tolist()
+    ([22.5, 67.5], [[0.0, 0.5858], [0.5858, 0.0]])
     """
     if quantity not in ("luminance", "rgb"):
         raise ValueError(f"quantity must be 'luminance' or 'rgb'; got {quantity!r}")

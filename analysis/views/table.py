@@ -6,17 +6,20 @@ plane; each evaluated once, for the figure and the CSV of ``microcyl plot table`
 
 from __future__ import annotations
 
+import csv
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from analysis import colour
 from analysis.views.common import check_quantity, eval_brdf, reduce_quantity
 from analysis.views.lobes import plane_directions
+from gonio.atomic import atomic_write
 
 __all__ = ["plane_points", "plane_lights", "plane_incidences", "table_panels", "table_points",
            "plane_data", "reduce_sigma", "TablePanelView", "compute_table_panel",
-           "FitOverlayView", "compute_fit_overlay"]
+           "FitOverlayView", "compute_fit_overlay", "write_table_data", "DATA_COLUMNS"]
 
 
 def _signed(theta, phi, phi_plane, tol):
@@ -297,3 +300,30 @@ def compute_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity=
                        "x": to[sel], "measured": reduce_quantity(values[sel], quantity),
                        "sigma": None if sigma is None else reduce_sigma(sigma[sel], quantity)})
     return FitOverlayView(float(phi_deg), quantity, x_model, tuple(groups))
+
+
+#: The columns of ``microcyl plot table --data`` (:func:`write_table_data`).
+DATA_COLUMNS = ("curve", "theta_i", "phi_i", "theta_o", "phi_o", "f_r")
+
+
+def write_table_data(path, rows) -> Path:
+    """Write rows ``(curve, theta_i, phi_i, theta_o, phi_o, f_r)`` (what a table's figure drew
+    at the measured points: angles in degrees, f_r in 1/sr) as CSV, a header of
+    :data:`DATA_COLUMNS`, numbers with 17 significant digits, atomically; returns the path.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     out = write_table_data(Path(tmp) / "d.csv", [("measured", 30, 0, 45, 180, 0.1)])
+    ...     print(out.read_text(), end="")
+    curve,theta_i,phi_i,theta_o,phi_o,f_r
+    measured,30.0,0.0,45.0,180.0,0.1
+    """
+    path = Path(path)
+    with atomic_write(path, "w") as fh:
+        out = csv.writer(fh, lineterminator="\n")
+        out.writerow(DATA_COLUMNS)
+        for name, *numbers in rows:
+            out.writerow([name, *(repr(float(v)) for v in numbers)])
+    return path

@@ -7,7 +7,8 @@ FABRIC is any fabric source (:func:`analysis.sources.resolve`); for a fit folder
 ``results.json`` and ``fit_config.json`` (:func:`analysis.fit.medians.median_fabric`). Writes
 the ``microcylinder`` BSDF's dictionary (:func:`analysis.fabricfile.plugin_dict`: every
 thread parameter and option spelled out) as JSON, or as a Mitsuba XML ``<bsdf>`` element
-where FILE ends in ``.xml`` (:func:`analysis.fabricfile.plugin_xml`), atomically; the suffix
+where FILE ends in ``.xml`` (:func:`analysis.fabricfile.plugin_xml`), atomically
+(:func:`analysis.fabricfile.write_fabric_file`); the suffix
 and folder are checked before anything is read. ``microcyl render SCENE FILE`` and every
 other FABRIC argument read either back. After ``reports.mitsuba.register()``,
 ``mi.load_dict(json.load(open("fabric.json")))`` loads the first, and a scene file holding the
@@ -16,13 +17,10 @@ second refers to it by ``<ref id="fabric"/>``. Needs no Mitsuba.
 
 from __future__ import annotations
 
-import json
 import logging
 
-from analysis.fabricfile import SUFFIXES, plugin_dict, plugin_xml
+from analysis.fabricfile import SUFFIXES, write_fabric_file
 from analysis.fit.medians import median_fabric
-from gonio import atomic_write
-from gonio.jsonplain import plain
 from reports.cli import options as cliutil
 
 __all__ = ["register", "run"]
@@ -50,12 +48,7 @@ def run(args) -> int:
     """Check the output, resolve the fabric, write its plugin dictionary, print a summary."""
     out = cliutil.check_output_suffix(args.output, SUFFIXES)
     src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
-    if out.suffix.lower() == ".xml":
-        text = plugin_xml(src.brdf, src.preset)
-    else:
-        text = json.dumps(plain(plugin_dict(src.brdf, src.preset)), indent=2) + "\n"
-    with atomic_write(out, "w") as fh:
-        fh.write(text)
+    write_fabric_file(out, src.brdf, src.preset)
     log.info("wrote %s", out)
     if src.kind == "fit":
         med = median_fabric(src.path)

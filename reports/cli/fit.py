@@ -14,9 +14,9 @@ import sys
 from pathlib import Path
 
 import brdf
-from analysis.budget import check_fit_rows
-from analysis.fit import FabricModel, FitOptions, fit_fabric, fit_spec
-from analysis.fit.fisher import suggest_free
+from analysis.fit import fit_fabric, fit_spec
+from analysis.fit.workflow import check_fit_size
+from analysis.fit.fisher import suggest_for_file
 from analysis.fit.loo import HIGH_K
 from reports.cli import lazy
 from reports.cli import options as cliutil
@@ -62,16 +62,6 @@ def _spec_from_args(args, fab):
     return fit_spec(fab, args.free, cliutil.split_ties(args.tie), args.spec)
 
 
-def _check_size(args, spec) -> None:
-    """The table's reading, then the fit's evaluations at the table's size estimated from
-    the file, against the memory limit: before the table is parsed."""
-    given = cliutil.reader_options(args.table, sample=args.sample)
-    est = cliutil.table_estimate(args.table, **given)
-    if est is not None:
-        opts = FitOptions(walkers=args.walkers).resolve(spec.ndim)
-        check_fit_rows(Path(args.table).name, est.rows, opts.walkers, opts.threads)
-
-
 def run(args) -> int:
     """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
     brdf.check_preset(args.fabric)
@@ -82,7 +72,8 @@ def run(args) -> int:
         raise ValueError("-o/--output DIR is required (unless --suggest)")
     fab = cliutil.fabric_from_args(args.fabric, args)
     spec = _spec_from_args(args, fab)
-    _check_size(args, spec)
+    check_fit_size(args.table, spec, args.walkers,
+                   **cliutil.reader_options(args.table, sample=args.sample))
     out = cliutil.check_writable_dir(Path(args.output))
     table = read_table(args.table, args.sample)
     plots = None
@@ -108,17 +99,13 @@ def run(args) -> int:
 
 
 def _suggest(args, fit_kw) -> int:
-    """``--suggest``: the Fisher information of the table at the start, printed; no
-    sampling, nothing written."""
+    """``--suggest``: :func:`analysis.fit.fisher.suggest_for_file`, printed; no sampling,
+    nothing written."""
     fab = cliutil.fabric_from_args(args.fabric, args)
-    ties = cliutil.split_ties(args.tie)
-    if args.free is not None or args.spec is not None:
-        _spec_from_args(args, fab)              # a bad --free, --tie or --spec: before reading
-    cliutil.reader_options(args.table, sample=args.sample)
-    table = read_table(args.table, args.sample)
-    report, kept = suggest_free(table, fab, FabricModel(fab, table.wi, table.wo), args.free,
-                                ties, args.spec, likelihood=fit_kw["likelihood"],
-                                nu=fit_kw["nu"])
+    given = cliutil.reader_options(args.table, sample=args.sample)
+    report, kept = suggest_for_file(args.table, fab, args.free, cliutil.split_ties(args.tie),
+                                    args.spec, read_options=given,
+                                    likelihood=fit_kw["likelihood"], nu=fit_kw["nu"])
     print(format_information(report, kept, args.table))
     return 0
 

@@ -20,14 +20,20 @@ def plots() -> SimpleNamespace:
 
 
 def report():
-    """:func:`reports.report.build_report` (the report's plots load matplotlib)."""
+    """:func:`reports.report.build_report` (the report's plots load matplotlib).
+
+    Examples
+    --------
+    >>> report().__module__, plots().views.__name__, renderer().engine.__name__
+    ('reports.report.build', 'reports.plots.views', 'reports.render.engine')
+    """
     # lazy: matplotlib and colour-science (~2 s), which the other verbs skip
     from reports.report import build_report
     return build_report
 
 
 def renderer() -> SimpleNamespace:
-    """The built-in renderer's ``engine``, ``exposure`` and ``imageio`` modules."""
+    """The built-in renderer's ``engine``, ``exposure``, ``files`` and ``imageio`` modules."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
-    from reports.render import engine, exposure, imageio
-    return SimpleNamespace(engine=engine, exposure=exposure, imageio=imageio)
+    from reports.render import engine, exposure, files, imageio
+    return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio)

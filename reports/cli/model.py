@@ -13,13 +13,12 @@ import numpy as np
 import brdf
 import gonio
 from analysis import sources
-from analysis.colour import luminance
 from analysis.folderlock import output_lock
 from analysis.fit.results import read_results
 from reports.cli import lazy
 from reports.cli import options as cliutil
 from reports.report_batch import write_batch_page
-from reports.standard import STANDARD_GEOMETRIES, standard_values
+from reports.standard import STANDARD_GEOMETRIES, standard_luminance
 
 log = logging.getLogger("microcyl")
 
@@ -152,8 +151,7 @@ def run_report(args):
     labels = [g[0] for g in STANDARD_GEOMETRIES]
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name, src in zip(names, chosen):
-        vals = standard_values(src.brdf)
-        lum = luminance(np.array(list(vals.values()), dtype=np.float64)).tolist()
+        lum = standard_luminance(src.brdf)
         print(f"{name:31s} " + " ".join(f"{x:19.6g}" for x in lum))
     log.info(f"wrote {index} (data: {index.parent / 'summary.json'})")
     return 0

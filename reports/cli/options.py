@@ -12,8 +12,8 @@ from pathlib import Path
 import brdf
 import gonio
 import gonio.io
-import gonio.tablesize
 from analysis import sources
+from analysis.fit.driver import MAX_ENSEMBLES, FitOptions  # MAX_ENSEMBLES: re-exported
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
 from analysis.measured import default_data_dir
@@ -24,13 +24,10 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
            "check_output_suffix", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
-           "table_estimate",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
 MAX_TANGENT_SAMPLES = brdf.MAX_TANGENT_SAMPLES
-#: Largest --ensembles: R-hat needs a few; each is a group of the one checkpoint.
-MAX_ENSEMBLES = 64
 
 
 def _on_off(value: str) -> bool:
@@ -185,33 +182,14 @@ def check_tangent_samples(n) -> None:
                          f"got {n}")
 
 
-def check_fit_options(args: argparse.Namespace) -> None:
-    """The options of :func:`add_fit_options`, each checked by name before any work."""
-    checks = [
-        (args.seed >= 0, "--seed", args.seed, "a non-negative integer"),
-        (2 <= args.ensembles <= MAX_ENSEMBLES, "--ensembles", args.ensembles,
-         f"an integer in 2..{MAX_ENSEMBLES} (R-hat is computed across them)"),
-        (args.walkers is None or args.walkers >= 2, "--walkers", args.walkers,
-         "an even integer >= 2 x the number of free parameters"),
-        (args.max_steps >= 1, "--max-steps", args.max_steps, "a positive integer"),
-        (args.check_every >= 1, "--check-every", args.check_every, "a positive integer"),
-        (args.time_limit is None or (math.isfinite(args.time_limit) and args.time_limit > 0),
-         "--time-limit", args.time_limit, "a positive finite number of seconds"),
-        (math.isfinite(args.nu) and args.nu > 0, "--nu", args.nu,
-         "a positive finite number of degrees of freedom"),
-    ]
-    for ok, option, value, allowed in checks:
-        if not ok:
-            raise ValueError(f"{option} must be {allowed}; got {value}")
-
-
 def fit_kwargs(args: argparse.Namespace) -> dict:
-    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`
-    (checked first: :func:`check_fit_options`)."""
-    check_fit_options(args)
-    return {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
-            "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
-            "check_every": args.check_every, "time_limit": args.time_limit}
+    """The keyword arguments of :func:`analysis.fit.fit` from :func:`add_fit_options`, each
+    checked by name before any work (:meth:`analysis.fit.FitOptions.check`)."""
+    kw = {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
+          "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
+          "check_every": args.check_every, "time_limit": args.time_limit}
+    FitOptions(**kw).check()
+    return kw
 
 
 def split_ties(ties):
@@ -226,8 +204,9 @@ def reader_options(path, **options) -> dict:
     ``--sample`` for a CUReT abrdf.dat, ``--step`` for an RGL .bsdf, ``--stride`` for a MERL
     .binary; another is refused by name (:func:`gonio.io.check_read_options`). The table's
     size is not estimated here: :func:`gonio.read` refuses a table whose reading would exceed
-    the memory limit before parsing it, and a verb that must know the size before other work
-    calls :func:`table_estimate` (each estimate counts a CSV's lines once)."""
+    the memory limit before parsing it, and a fit, which must know the size before other
+    work, calls :func:`analysis.fit.workflow.check_fit_size` (each estimate counts a CSV's
+    lines once)."""
     path = Path(path)
     given = {k: v for k, v in options.items() if v is not None}
     if given:
@@ -242,17 +221,6 @@ def reader_options(path, **options) -> dict:
         if not (math.isfinite(step) and 0 < step <= 90):
             raise ValueError(f"--step must be in (0, 90] degrees; got {step}")
     return given
-
-
-def table_estimate(path, **options):
-    """The size of the table ``path`` (:class:`gonio.tablesize.Estimate`), refused when its
-    reading would exceed the memory limit (:func:`gonio.tablesize.check_table`); None when
-    it cannot be told (the reader then says what is wrong)."""
-    path = Path(path)
-    kind = gonio.io.table_kind(path, quiet=True)
-    if kind is None or not path.is_file():
-        return None
-    return gonio.tablesize.check_table(path, kind, **options)
 
 
 def read_table(path, **options):

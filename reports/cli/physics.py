@@ -2,28 +2,18 @@
 
 from __future__ import annotations
 
-import json
 import logging
 import math
-import os
 from pathlib import Path
 
-import numpy as np
-
-import analysis.sanity
 import brdf
-import gonio
 from analysis import sources
-from analysis.energy import VARIANTS, EnergyReport, energy_report
-from analysis.reciprocity import reciprocity_report
-from gonio.atomic import atomic_write
+from analysis.energy import VARIANTS, EnergyReport
+from analysis.plausibility import energy_document, reciprocity_document, sanity_results
 from reports.cli import options as cliutil
 from reports.prose import energy_statements, energy_summary, reciprocity_statements
 
 log = logging.getLogger("microcyl")
-
-FELTS = ("acrylic_felt_white_rgb.bsdf", "acrylic_felt_pink_rgb.bsdf",
-         "acrylic_felt_purple_rgb.bsdf")
 
 
 def _sources(args, tables: bool = False) -> list:
@@ -61,37 +51,6 @@ def _floats(text: str, what: str) -> tuple[float, ...]:
     if not vals or not all(math.isfinite(v) for v in vals):
         raise ValueError(f"{what} must be comma-separated finite numbers; got {text!r}")
     return vals
-
-
-def _finite(x):
-    """Replace NaN and infinities (not valid JSON) by None, recursively."""
-    if isinstance(x, float):
-        return x if math.isfinite(x) else None
-    if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_finite(v) for v in x]
-    return x
-
-
-def write_json(path, data) -> None:
-    """Write ``data`` as indented JSON (NaN and inf as null) through a temporary file
-    renamed into place."""
-    with atomic_write(path, "w") as fh:
-        json.dump(_finite(data), fh, indent=2, allow_nan=False)
-        fh.write("\n")
-
-
-def _check_json_target(path):
-    if path is None:
-        return None
-    p = Path(path)
-    parent = p.parent if str(p.parent) else Path(".")
-    if not parent.is_dir():
-        raise OSError(f"--json: folder {str(parent)!r} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise OSError(f"--json: folder {str(parent)!r} is not writable")
-    return p
 
 
 def register(sub):
@@ -154,18 +113,8 @@ def register(sub):
     p.set_defaults(func=run_sanity)
 
 
-def document(rep, statements) -> dict:
-    """The JSON document of an energy or reciprocity report: its ``to_dict()`` with the
-    findings (:mod:`reports.prose`) as ``statements`` before ``seconds``."""
-    doc = rep.to_dict()
-    seconds = doc.pop("seconds")
-    doc["statements"] = list(statements)
-    doc["seconds"] = seconds
-    return doc
-
-
 def format_energy(rep) -> str:
-    """The energy report (its :func:`document`) as text tables."""
+    """The energy report (its :func:`analysis.plausibility.document`) as text tables."""
     d = rep.to_dict() if isinstance(rep, EnergyReport) else rep
     lines = ["Directional albedo maxima (value +- error bound; theta, phi of the fixed "
              "direction in degrees)",
@@ -222,25 +171,23 @@ def run_energy(args) -> int:
         raise ValueError(f"--tol must be > 0; got {args.tol}")
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be >= 1; got {args.workers}")
-    target = _check_json_target(args.json)
-    theta = sorted(set(np.arange(0.0, 89.0 + 1e-9, args.theta_step).round(9).tolist())
-                   | {85.0, 89.0})
-    rep = energy_report(presets, variants, theta_deg=theta, phi_deg=phi, tol=args.tol,
-                        hemispherical=not args.no_hemispherical, furnace=not args.no_furnace,
-                        workers=args.workers, progress=cliutil.progress(args))
-    doc = document(rep, energy_statements(rep))
+    doc = energy_document(presets, variants, theta_step=args.theta_step, phi_deg=phi,
+                          tol=args.tol, hemispherical=not args.no_hemispherical,
+                          furnace=not args.no_furnace, workers=args.workers,
+                          progress=cliutil.progress(args), statements=energy_statements,
+                          json_path=args.json)
     print(format_energy_summary(doc))
     if args.verbose:
         print()
         print(format_energy(doc))
-    if target is not None:
-        write_json(target, doc)
-        log.info(f"wrote {target}")
+    if args.json is not None:
+        log.info(f"wrote {Path(args.json)}")
     return 0
 
 
 def format_reciprocity(rep: dict) -> str:
-    """The reciprocity report (its :func:`document`, with ``notes``) as a text table."""
+    """The reciprocity report (its :func:`analysis.plausibility.document`, with ``notes``)
+    as a text table."""
     lines = [f"Reciprocity error r = |f(wi,wo) - f(wo,wi)| / max(...), on "
              f"{rep['settings']['channel']}; {rep['settings']['n']} random pairs"
              + (", and a gonio full grid" if rep['settings']['geometry'] else ""),
@@ -286,25 +233,13 @@ def run_reciprocity(args) -> int:
         raise ValueError(f"-n must be >= 1; got {args.n}")
     if not (0 <= args.grid_step <= 90):
         raise ValueError(f"--grid-step must be in [0, 90] degrees (0 skips); got {args.grid_step}")
-    target = _check_json_target(args.json)
-    geometry = gonio.full_grid(args.grid_step) if args.grid_step > 0 else None
-    notes, felts = [], []
-    if not args.no_felts:
-        data = cliutil.data_dir(args.data)
-        for name in FELTS:
-            path = data / "rgl" / name
-            if path.is_file():
-                felts.append(path)
-            else:
-                notes.append(f"measured felt {path} not found: skipped")
-    rep = reciprocity_report(presets, variants, n=args.n, seed=args.seed, geometry=geometry,
-                             felts=tables + felts, channel=args.channel)
-    doc = document(rep, reciprocity_statements(rep))
-    doc["notes"] = notes
+    doc = reciprocity_document(
+        presets, variants, tables=tables, n=args.n, seed=args.seed, grid_step=args.grid_step,
+        channel=args.channel, data_dir=None if args.no_felts else cliutil.data_dir(args.data),
+        statements=reciprocity_statements, json_path=args.json)
     print(format_reciprocity(doc))
-    if target is not None:
-        write_json(target, doc)
-        log.info(f"wrote {target}")
+    if args.json is not None:
+        log.info(f"wrote {Path(args.json)}")
     return 0
 
 
@@ -322,14 +257,13 @@ def format_sanity(name: str, result) -> list[str]:
 
 
 def run_sanity(args) -> int:
-    """``microcyl sanity``: :func:`analysis.sanity_scan` of each fabric."""
+    """``microcyl sanity``: :func:`analysis.plausibility.sanity_results` of each fabric,
+    printed."""
     chosen = _sources(args, tables=True)
-    target = _check_json_target(args.json)
-    results = {s.label: analysis.sanity.sanity_scan(s.label if s.kind == "preset" else s.brdf)
-               for s in chosen}
+    results = sanity_results({s.label: s.label if s.kind == "preset" else s.brdf
+                              for s in chosen}, json_path=args.json)
     for name, r in results.items():
         print("\n".join(format_sanity(name, r)))
-    if target is not None:
-        write_json(target, {name: r.to_dict() for name, r in results.items()})
-        log.info(f"wrote {target}")
+    if args.json is not None:
+        log.info(f"wrote {Path(args.json)}")
     return 0 if all(r.ok for r in results.values()) else 1

@@ -10,7 +10,6 @@ FILE (PNG at ``--dpi``, PDF and SVG as vector graphics).
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 from pathlib import Path
 
@@ -20,11 +19,11 @@ import brdf
 import gonio
 from analysis import sources
 from analysis.fit.medians import median_fabric
+from analysis.views.table import write_table_data
 from reports.cli import lazy
 from reports.cli import options as cliutil
 
-__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes",
-           "write_table_data", "DATA_COLUMNS"]
+__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes"]
 
 #: The views of ``microcyl plot``.
 VIEWS = ("lobes", "slices", "hemisphere", "masking", "albedo", "reciprocity", "table")
@@ -243,16 +242,3 @@ def run_plot(args):
         print(f"wrote {args.data} (the points drawn)")
     return 0
 
-
-#: The columns of ``plot table --data``.
-DATA_COLUMNS = ("curve", "theta_i", "phi_i", "theta_o", "phi_o", "f_r")
-
-
-def write_table_data(path, rows) -> None:
-    """Write the rows of :func:`reports.plots.views.table_view_data` as CSV (a header of
-    :data:`DATA_COLUMNS`; numbers with 17 significant digits), atomically."""
-    with gonio.atomic_write(Path(path), "w") as fh:
-        out = csv.writer(fh, lineterminator="\n")
-        out.writerow(DATA_COLUMNS)
-        for name, *numbers in rows:
-            out.writerow([name, *(repr(float(v)) for v in numbers)])

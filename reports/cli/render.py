@@ -108,9 +108,8 @@ def run(args):
     """Check every argument, render, write the files; return 0."""
     built_in = lazy.renderer()
     exposure, imageio = built_in.exposure, built_in.imageio
-    check_size, render = built_in.engine.check_size, built_in.engine.render
     scene = make_scene(args.scene)
-    check_size(args.width, args.height, args.spp)
+    built_in.engine.check_size(args.width, args.height, args.spp)
     stops = exposure.parse_exposure(args.exposure)
     if args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be a non-negative integer")
@@ -129,22 +128,9 @@ def run(args):
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers {args.workers}: must be at least 1")
     variant, max_depth = _engine_options(args, fabric)
-    if args.engine == "mitsuba":
-        image = mitsuba_render.render_mitsuba(scene, fabric, width=args.width, height=args.height,
-                               spp=args.spp, seed=args.seed, max_depth=max_depth,
-                               variant=variant, workers=args.workers,
-                               progress=cliutil.progress(args), mask=True)
-    else:
-        image = render(scene, fabric, width=args.width, height=args.height, spp=args.spp,
-                       seed=args.seed, progress=cliutil.progress(args), workers=args.workers,
-                       mask=True)
-    image, cloth = image
-    expo = exposure.auto_exposure(image, cloth) if stops is None else exposure.Exposure(stops)
-    written = []
-    if suffix == ".exr":
-        written.append(imageio.write_exr(out, image, exposure.exr_attributes(expo)))
-        written.append(imageio.write_png(out.with_suffix(".png"), image, expo.stops))
-    else:
-        written.append(imageio.write_png(out, image, expo.stops))
+    expo, written = built_in.files.render_to_files(
+        scene, fabric, out, stops=stops, engine=args.engine, width=args.width,
+        height=args.height, spp=args.spp, seed=args.seed, workers=args.workers,
+        progress=cliutil.progress(args), variant=variant, max_depth=max_depth)
     log.info(f"{expo.describe()}; wrote " + ", ".join(str(w) for w in written))
     return 0

@@ -6,10 +6,9 @@ import json
 import logging
 from pathlib import Path
 
-import numpy as np
-
 import gonio
 from analysis.folderlock import output_lock
+from analysis.tablefacts import table_facts
 from reports.cli import options as cliutil
 
 log = logging.getLogger("microcyl")
@@ -61,39 +60,9 @@ def run_convert(args):
     return 0
 
 
-def table_facts(table) -> dict:
-    """What a table holds, as plain data (``microcyl info --json``): its source as the
-    table's metadata has it (a text, or the JSON object of what was measured), angles in
-    degrees over the rows with data, value ranges per channel (f_r in the table's units),
-    missing counts."""
-    ang = np.degrees(table.angles)
-    valid = table.valid
-    data = valid.any(axis=1)          # a MERL file lists its empty bins below the horizon too
-    sel = ang[data] if data.any() else ang
-    values = {}
-    for c, name in enumerate("RGB"):
-        v = table.values[valid[:, c], c]
-        values[name] = [float(v.min()), float(v.max())] if v.size else None
-    return {
-        "source": gonio.plain(table.meta.get("source", "unknown"), nonfinite="null"),
-        "format": str(table.meta.get("file_format", "unknown")),
-        "rows": len(table), "units": str(table.meta.get("units", "1/sr")),
-        "angles_deg": {name: [float(sel[:, k].min()), float(sel[:, k].max())]
-                       for k, name in enumerate(("theta_i", "phi_i", "theta_o", "phi_o"))},
-        "angles_over": "all rows" if data.all() else "rows with data",
-        "values": values,
-        "missing": {"values": int(np.count_nonzero(~valid)), "of": int(valid.size),
-                    "nan": int(np.count_nonzero(np.isnan(table.values))),
-                    "negative": int(np.count_nonzero(table.values < 0)),
-                    "infinite": int(np.count_nonzero(np.isinf(table.values))),
-                    "rows_with_any": int(np.count_nonzero(~valid.all(axis=1)))},
-        "sigma": None if table.sigma is None else [float(np.nanmin(table.sigma)),
-                                                   float(np.nanmax(table.sigma))],
-    }
-
-
 def describe(table) -> str:
-    """A few lines on what a table holds (used by ``microcyl info``)."""
+    """A few lines on what a table holds (:func:`analysis.tablefacts.table_facts`, used by
+    ``microcyl info``)."""
     f = table_facts(table)
     note = "" if f["angles_over"] == "all rows" else " (rows with data)"
     lines = [f"source: {gonio.meta_text(f['source'])}", f"format: {f['format']}",

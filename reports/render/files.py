@@ -1,0 +1,58 @@
+"""A render written as image files: what ``microcyl render`` does once its arguments are
+checked. The built-in engine (:func:`reports.render.engine.render`) or Mitsuba 3
+(:func:`reports.mitsuba.render.render_mitsuba`) renders the scene with the cloth's coverage;
+the PNG's exposure is automatic from the cloth's pixels (:func:`reports.render.exposure.
+auto_exposure`) or given in stops; ``out.exr`` gets the linear float32 image with the exposure
+in its header and an sRGB PNG beside it, ``out.png`` the PNG alone (each written atomically).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from reports.mitsuba.render import render_mitsuba
+from reports.render.engine import render
+from reports.render.exposure import Exposure, auto_exposure, exr_attributes
+from reports.render.imageio import write_exr, write_png
+
+__all__ = ["render_to_files"]
+
+
+def render_to_files(scene, fabric, out, *, stops=None, engine: str = "builtin", width: int,
+                    height: int, spp: int, seed: int = 0, workers=None, progress=False,
+                    variant=None, max_depth=None) -> tuple[Exposure, list[Path]]:
+    """Render ``scene`` with cloth of ``fabric`` and write the images (module notes).
+
+    Parameters
+    ----------
+    scene : reports.render.scenes.Scene
+    fabric : brdf.Fabric or any BRDF (the built-in engine)
+    out : path
+        ``*.exr`` (and the PNG beside it) or ``*.png``.
+    stops : float, optional
+        The PNG's exposure in stops; automatic when None.
+    engine : {"builtin", "mitsuba"}
+        Checked by the caller (``microcyl render --engine``).
+    width, height, spp, seed, workers, progress
+        As the engine takes them (pixels, samples per pixel).
+    variant, max_depth
+        Mitsuba's variant and longest path (``engine="mitsuba"`` only).
+
+    Returns
+    -------
+    (Exposure, list of Path)
+        The PNG's exposure and the files written.
+    """
+    if engine == "mitsuba":
+        image, cloth = render_mitsuba(scene, fabric, width=width, height=height, spp=spp,
+                                      seed=seed, max_depth=max_depth, variant=variant,
+                                      workers=workers, progress=progress, mask=True)
+    else:
+        image, cloth = render(scene, fabric, width=width, height=height, spp=spp, seed=seed,
+                              progress=progress, workers=workers, mask=True)
+    expo = auto_exposure(image, cloth) if stops is None else Exposure(stops)
+    out = Path(out)
+    if out.suffix.lower() == ".exr":
+        return expo, [write_exr(out, image, exr_attributes(expo)),
+                      write_png(out.with_suffix(".png"), image, expo.stops)]
+    return expo, [write_png(out, image, expo.stops)]

@@ -151,3 +151,28 @@ def test_laplace_validation_planned_beats_uniform():
 
     ratio = np.exp(np.mean(np.log(sd(p.wi, p.wo) / sd(p.uniform_wi, p.uniform_wo))))
     assert ratio < 0.9
+
+
+def test_plan_file_reads_back_and_its_figure_shows_every_pair(tmp_path):
+    """analysis.planning.workflow.plan_file writes a file gonio reads back pair for pair, with
+    the header naming the fabric, the free parameters and one expected sd each;
+    reports.plots.plan.draw_plan writes a PNG."""
+    import matplotlib.image
+
+    from analysis.planning.workflow import plan_file
+    from gonio.geomspec import read_pairs_csv
+    from gonio.pairsfile import read_pairs_header
+    from reports.plots.plan import draw_plan
+
+    fab = brdf.fabric("velvet")
+    p, path = plan_file(fab, FREE, 12, tmp_path / "plan.csv", instrument=Instrument(snr=25),
+                        candidates=SMALL, draws=1, seed=1)
+    geo = read_pairs_csv(path)
+    assert np.allclose(geo.wi, p.wi, atol=1e-12) and np.allclose(geo.wo, p.wo, atol=1e-12)
+    head = read_pairs_header(path)
+    assert head["free"] == "kd1,gamma_s1,gamma_v1" and head["budget"] == "12"
+    assert [s.split("=")[0] for s in head["expected_sd"].split(", ")] == FREE.split(",")
+    fig, (ax1, ax2) = draw_plan(p, filename=tmp_path / "plan.png")
+    assert len(ax1.texts) >= p.budget            # each chosen pair numbered in its order
+    img = matplotlib.image.imread(tmp_path / "plan.png")
+    assert img.shape[0] > 200 and img.shape[1] > 400

@@ -200,6 +200,15 @@ class PreparedBaseline:
     model : BaselineModel
     wi, wo : array_like, shape (..., 3)
         Direction pairs (broadcast, flattened to n, normalized).
+
+    Examples
+    --------
+    >>> from brdf.baselines import Lambert
+    >>> wi = np.array([[0.0, 0.0, 1.0], [0.0, 0.6, -0.8]])       # the second below the horizon
+    >>> prep = PreparedBaseline(Lambert(base=0.5), wi, [0.0, 0.0, 1.0])
+    >>> f = prep.eval(base=np.array([[0.1, 0.2, 0.3], [np.pi, 0, 0]]) / np.pi)
+    >>> f.shape, np.round(f[:, 0] * np.pi**2, 12).tolist(), float(f[:, 1].max())
+    ((2, 2, 3), [[0.1, 0.2, 0.3], [3.14159265359, 0.0, 0.0]], 0.0)
     """
 
     def __init__(self, model: BaselineModel, wi, wo):

@@ -17,7 +17,7 @@ import brdf
 from analysis.paramnames import PARAM_NAMES
 from reports.cli import options as cliutil
 from reports.cli import fit as cmd_fit
-from reports.cli import measure as cmd_measure
+from analysis.measurejob import measure_estimate
 from reports.cli import model as cmd_model
 from reports.cli import build_parser
 from reports.cli.instrument import instrument_from_args
@@ -121,7 +121,7 @@ def _measure_checks(ns):
         raise ValueError("--seed must be >= 0")
     inst = instrument_from_args(ns)
     fab = cliutil.source_from_args(cliutil.fabric_argument(ns), ns).brdf
-    cmd_measure._check_size(ns, inst, fab)
+    measure_estimate(ns.geometry, inst, fab)
 
 
 @SETTINGS

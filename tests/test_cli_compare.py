@@ -48,7 +48,8 @@ def test_compare_ranks_the_generating_fabric_first_by_more_than_4_se(fits, tmp_p
     assert r.returncode == 0, r.stderr
     rows = json.loads(r.stdout)
     assert [row["fit"] for row in rows] == [str(fits["right"]), str(fits["wrong"])]
-    assert all(set(row) == {"fit", "elpd", "se", "d_elpd", "d_se"} for row in rows)
+    assert all(set(row) == {"fit", "model", "elpd", "se", "d_elpd", "d_se"} for row in rows)
+    assert all(row["model"] == "microcylinder" for row in rows)
     best, wrong = rows
     assert best["d_elpd"] == 0 and best["d_se"] == 0
     assert wrong["d_elpd"] == pytest.approx(best["elpd"] - wrong["elpd"])

@@ -35,6 +35,7 @@ import math
 
 import numpy as np
 
+from analysis.families import family_of
 from analysis.fit.driver import with_nuisance
 from analysis.fit.posterior import LogPosterior
 from analysis.fit.workflow import fit_spec
@@ -269,9 +270,13 @@ def _noise_at_start(spec: ParamSpec, lik: Likelihood, logpost: LogPosterior) -> 
 
 def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
     """The candidates of :func:`suggest_free`: ``free`` / ``ties`` / ``toml`` as
-    :func:`analysis.fit.fit_spec` takes them when given; otherwise the default free set
-    (:data:`analysis.params.DEFAULT_FREE` and its ties) plus both threads' albedos for an
-    RGB table (a grey table cannot tell the channels apart)."""
+    :func:`analysis.fit.fit_spec` takes them when given; otherwise for the microcylinder the
+    default free set (:data:`analysis.params.DEFAULT_FREE` and its ties) plus both threads'
+    albedos for an RGB table (a grey table cannot tell the channels apart), for a baseline
+    model its default free set for the table (every parameter, with
+    :meth:`analysis.families.ModelFamily.default_free`'s identifiability choices)."""
+    if not family_of(fabric).is_microcylinder:
+        return fit_spec(fabric, free, ties, toml, table=table)
     if free is None and toml is None:
         free = list(DEFAULT_FREE)
         ties = list(DEFAULT_TIES) if ties is None else ties

@@ -216,22 +216,21 @@ class BaselineFamily(ModelFamily):
     def default_free(self, grey=False, relative=False):
         free = list(self.model_names)
         ties, notes = [], []
-        if grey:
-            for q in self.rgb:
-                ties += [f"{q}_g={q}_r", f"{q}_b={q}_r"]
-            if self.rgb:
-                tied = ", ".join(f"{q}_g and {q}_b tied to {q}_r" for q in self.rgb)
-                notes.append(f"grey table: {tied} (the channels are not separately "
-                             f"informed)")
         base = self.base_param if relative else None
         if base is not None:
             fixed = list(self.aliases[base]) if grey else [f"{base}_r"]
             free = [n for n in free if n not in fixed]
-            ties = [t for t in ties if not t.startswith(f"{base}_")]
             notes.append(f"relative table: {', '.join(fixed)} fixed at the start value and "
                          f"scale free (f_r is linear in the colours together, so scale and "
-                         f"colours would form a ridge; the other colours are relative to "
-                         f"{base})")
+                         f"colours would form a ridge; any other colour is fitted relative "
+                         f"to {base})")
+        tied = [q for q in self.rgb if not (grey and q == base)] if grey else []
+        for q in tied:
+            ties += [f"{q}_g={q}_r", f"{q}_b={q}_r"]
+        if tied:
+            notes.insert(0, "grey table: " + ", ".join(f"{q}_g and {q}_b tied to {q}_r"
+                                                       for q in tied)
+                         + " (the channels are not separately informed)")
         if relative:
             free.append("scale")
         return tuple(free), tuple(ties), tuple(notes)

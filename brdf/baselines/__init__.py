@@ -7,19 +7,25 @@ model's name to its class.
 
 Examples
 --------
->>> sorted(MODELS)[:1], model_class("lambert").__name__
-(['lambert'], 'Lambert')
+>>> list(MODELS), model_class("zeltner").__name__
+(['lambert', 'charlie', 'ashikhmin', 'zeltner'], 'Zeltner')
 """
 
 from __future__ import annotations
 
+from brdf.baselines.ashikhmin import Ashikhmin
+from brdf.baselines.charlie import Charlie
 from brdf.baselines.lambert import BASE, Lambert
 from brdf.baselines.model import BaselineModel, PreparedBaseline
+from brdf.baselines.sheen import SHEEN, SheenModel
+from brdf.baselines.zeltner import Zeltner
 
-__all__ = ["BaselineModel", "PreparedBaseline", "Lambert", "MODELS", "model_class", "BASE"]
+__all__ = ["BaselineModel", "PreparedBaseline", "SheenModel", "Lambert", "Charlie", "Ashikhmin",
+           "Zeltner", "MODELS", "model_class", "BASE", "SHEEN"]
 
 #: The baseline models by name.
-MODELS: dict[str, type[BaselineModel]] = {cls.name: cls for cls in (Lambert,)}
+MODELS: dict[str, type[BaselineModel]] = {cls.name: cls for cls in (Lambert, Charlie,
+                                                                     Ashikhmin, Zeltner)}
 
 
 def model_class(name: str) -> type[BaselineModel]:

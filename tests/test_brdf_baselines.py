@@ -153,6 +153,17 @@ def test_eval_matches_transliteration(cls):
         np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-14)
 
 
+def test_zeltner_at_normal_view_and_grazing():
+    # wo = n: MaterialX's fallback frame (bInv = 0 there); wo at the clamp of NdotV
+    p = dict(base=(0.2, 0.4, 0.6), sheen=(0.9, 0.5, 0.1), roughness=0.45)
+    wi, _ = _pairs(20, _seed("normal view"))
+    for wo in ([0.0, 0.0, 1.0], [1.0, 0.0, 1e-9]):
+        got = Zeltner(**p).eval(wi, np.array(wo) / np.linalg.norm(wo))
+        want = [ref_zeltner(list(a), list(np.array(wo) / np.linalg.norm(wo)), p["base"],
+                            p["sheen"], p["roughness"]) for a in wi]
+        np.testing.assert_allclose(got, want, rtol=1e-9)
+
+
 def test_registry_and_sheen_param():
     assert list(MODELS) == ["lambert", "charlie", "ashikhmin", "zeltner"]
     for cls in SHEENS:
@@ -267,7 +278,10 @@ def test_charlie_table_against_quadrature():
 
 
 # -- sampling --------------------------------------------------------------------------------
-CHI2_CASES = [(cls, r, th) for cls in SHEENS for r in (0.3, 0.6, 0.9) for th in (10.0, 75.0)]
+# charlie and ashikhmin share the cosine / uniform mixture (its roughness plays no part);
+# zeltner's LTC lobe follows wo and the roughness, down to MaterialX's 0.01
+CHI2_CASES = ([(cls, 0.5, th) for cls in (Charlie, Ashikhmin) for th in (10.0, 75.0)]
+              + [(Zeltner, r, th) for r in (0.01, 0.1, 0.3, 0.6, 0.9) for th in (0.0, 45.0, 85.0)])
 N_CHI2 = 40_000
 
 

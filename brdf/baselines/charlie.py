@@ -80,9 +80,9 @@ def _l(x, alpha):
 def charlie_lambda(cos, alpha):
     """The spec's Lambda(cos theta) for alpha; broadcasts."""
     cos = np.asarray(cos, dtype=np.float64)
-    low = np.exp(_l(np.minimum(np.abs(cos), 0.5), alpha))
-    high = np.exp(2.0 * _l(0.5, alpha) - _l(np.clip(1.0 - cos, 0.0, 0.5), alpha))
-    return np.where(np.abs(cos) < 0.5, low, high)
+    low = np.abs(cos) < 0.5
+    lx = _l(np.where(low, np.abs(cos), np.clip(1.0 - cos, 0.0, 0.5)), alpha)
+    return np.exp(np.where(low, lx, 2.0 * _l(0.5, alpha) - lx))
 
 
 def charlie_v(cos_i, cos_o, alpha):
@@ -109,7 +109,8 @@ class Charlie(SheenModel):
     def geometry(cls, wi, wo):
         h = wi + wo
         return {"cos_h": h[:, 2] / np.linalg.norm(h, axis=-1), "cos_i": wi[:, 2],
-                "cos_o": wo[:, 2]}
+                "cos_o": wo[:, 2], "nodes_i": charlietable.cos_nodes(wi[:, 2]),
+                "nodes_o": charlietable.cos_nodes(wo[:, 2])}
 
     @classmethod
     def lobe(cls, geom, roughness):
@@ -119,8 +120,8 @@ class Charlie(SheenModel):
     @classmethod
     def layer(cls, geom, roughness, sheen):
         m = np.max(sheen, axis=-1)[..., None]
-        e_o = np.minimum(sheen_albedo(geom["cos_o"], roughness), 1.0)
-        e_i = np.minimum(sheen_albedo(geom["cos_i"], roughness), 1.0)
+        e_o = np.minimum(charlietable.interpolate_nodes(*geom["nodes_o"], roughness), 1.0)
+        e_i = np.minimum(charlietable.interpolate_nodes(*geom["nodes_i"], roughness), 1.0)
         return np.minimum(1.0 - m * e_o, 1.0 - m * e_i)
 
 

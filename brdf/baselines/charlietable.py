@@ -26,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["N_U", "N_R", "R_MIN", "U", "R", "PATH", "table", "interpolate", "write"]
+__all__ = ["N_U", "N_R", "R_MIN", "U", "R", "PATH", "table", "interpolate", "cos_nodes",
+           "interpolate_nodes", "write"]
 
 N_U, N_R = 64, 33
 #: The least roughness tabulated (Filament's MIN_PERCEPTUAL_ROUGHNESS).
@@ -55,17 +56,37 @@ def table() -> np.ndarray:
     return values
 
 
+def cos_nodes(cos) -> tuple[np.ndarray, np.ndarray]:
+    """The table row below each cos theta and the fraction toward the next, ``(i, fx)``: the
+    direction-dependent half of :func:`interpolate`, computed once for fixed pairs."""
+    u = np.sqrt(np.clip(np.asarray(cos, dtype=np.float64), 0.0, 1.0))
+    x = np.clip(u * N_U - 1.0, 0.0, N_U - 1.0)
+    i = np.minimum(x.astype(int), N_U - 2)
+    return i, x - i
+
+
+def _columns(roughness):
+    v = np.sqrt(np.maximum(np.asarray(roughness, dtype=np.float64), 0.0))
+    y = np.clip((v - _V0) / (1.0 - _V0) * (N_R - 1), 0.0, N_R - 1.0)
+    j = np.minimum(y.astype(int), N_R - 2)
+    return j, y - j
+
+
+def interpolate_nodes(i, fx, roughness) -> np.ndarray:
+    """E from :func:`cos_nodes`' ``(i, fx)`` (n,) and roughness (B..., 1): (B..., n). The
+    table is first interpolated along roughness (B..., N_U), then gathered at the rows."""
+    j, fy = _columns(np.asarray(roughness)[..., 0])
+    t = table()
+    rows = t[:, j] * (1.0 - fy) + t[:, j + 1] * fy                  # (N_U, B...)
+    rows = np.moveaxis(rows, 0, -1)[..., None, :]                    # (B..., 1, N_U)
+    return (1.0 - fx) * rows[..., 0, i] + fx * rows[..., 0, i + 1]
+
+
 def interpolate(cos, roughness) -> np.ndarray:
     """Bilinear E at (cos theta, roughness) (broadcast) in (sqrt(cos theta), sqrt(roughness)),
     the arguments clamped to the grid."""
-    u = np.sqrt(np.clip(np.asarray(cos, dtype=np.float64), 0.0, 1.0))
-    x = np.clip(u * N_U - 1.0, 0.0, N_U - 1.0)
-    v = np.sqrt(np.maximum(np.asarray(roughness, dtype=np.float64), 0.0))
-    y = np.clip((v - _V0) / (1.0 - _V0) * (N_R - 1), 0.0, N_R - 1.0)
-    x, y = np.broadcast_arrays(x, y)
-    i = np.minimum(x.astype(int), N_U - 2)
-    j = np.minimum(y.astype(int), N_R - 2)
-    fx, fy = x - i, y - j
+    i, fx = cos_nodes(cos)
+    j, fy = _columns(roughness)
     t = table()
     return ((1 - fx) * ((1 - fy) * t[i, j] + fy * t[i, j + 1])
             + fx * ((1 - fy) * t[i + 1, j] + fy * t[i + 1, j + 1]))

@@ -281,15 +281,8 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
         # read just before writing: another fit-measured run may have added its datasets
         doc = _read_summary(spath)
         for n in names:
-            old = doc["datasets"].get(n, {})
-            if MICROCYLINDER in models:
-                entry = _entry(n, tables[n], summary.rows[n], out)
-            else:           # the microcylinder's fields stay as an earlier run wrote them
-                entry = {**_base_entry(n, tables[n]), **old}
-            if compare or "models" in old:
-                entry.pop("compare_error", None)
-                entry.update(models_entry(out, n, models, summary.rows, old.get("models")))
-            doc["datasets"][n] = entry
+            doc["datasets"][n] = _dataset_entry(n, tables[n], summary.rows, out, models,
+                                                compare, doc["datasets"].get(n, {}))
         with atomic_write(spath, "w") as fh:
             # strict JSON: a non-finite number is written null (the schema refuses NaN)
             fh.write(json.dumps(plain(doc, nonfinite="null"), indent=2) + "\n")
@@ -309,6 +302,20 @@ def _job(n: str, root: Path, rgl_step: float, plots, fit: dict,
     return BatchJob(n, str(root / d.path), d.sample, d.preset, d.free, d.ties, fit=fit,
                     loader=loader, plots=plots,
                     config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
+
+
+def _dataset_entry(n: str, table, rows: dict, out: Path, models, compare: bool,
+                   old: dict) -> dict:
+    """Dataset ``n``'s new entry: the microcylinder's fields (from this run, else ``old``'s),
+    and its ``models`` ranked where several models are or were fitted."""
+    if MICROCYLINDER in models:
+        entry = _entry(n, table, rows[n], out)
+    else:               # the microcylinder's fields stay as an earlier run wrote them
+        entry = {**_base_entry(n, table), **old}
+    if compare or "models" in old:
+        entry.pop("compare_error", None)
+        entry.update(models_entry(out, n, models, rows, old.get("models")))
+    return entry
 
 
 def _base_entry(n: str, table) -> dict:

@@ -227,6 +227,7 @@ class BaselineFamily(ModelFamily):
         tied = [q for q in self.rgb if not (grey and q == base)] if grey else []
         for q in tied:
             ties += [f"{q}_g={q}_r", f"{q}_b={q}_r"]
+            free = [n for n in free if n not in (f"{q}_g", f"{q}_b")]
         if tied:
             notes.insert(0, "grey table: " + ", ".join(f"{q}_g and {q}_b tied to {q}_r"
                                                        for q in tied)

@@ -55,6 +55,7 @@ def test_default_free_sets_are_identifiable_on_grey_and_relative_tables(name):
     assert free == fam.model_names and ties == () and notes == ()
     free, ties, notes = fam.default_free(grey=True)
     assert set(ties) == {f"{q}_{c}={q}_r" for q in rgb for c in "gb"}
+    assert set(free) == set(fam.model_names) - {f"{q}_{c}" for q in rgb for c in "gb"}
     assert "grey table" in notes[0]
     # relative: the base colour is fixed (the scale carries the level); grey: and tied
     free, ties, notes = fam.default_free(grey=True, relative=True)
@@ -62,8 +63,15 @@ def test_default_free_sets_are_identifiable_on_grey_and_relative_tables(name):
     assert not any(t.startswith("base_") for t in ties)
     free, _, _ = fam.default_free(relative=True)
     assert "base_r" not in free and {"base_g", "base_b", "scale"} <= set(free)
-    # every choice leaves a valid spec
-    ParamSpec(free, family=fam)
+    # every choice leaves a valid spec, whose values follow the ties
+    for grey in (False, True):
+        for relative in (False, True):
+            free, ties, _ = fam.default_free(grey=grey, relative=relative)
+            spec = ParamSpec(free, ties=ties, family=fam)
+            v = spec.values(np.full((1, spec.ndim), 0.3))
+            if grey:
+                for q in rgb:
+                    assert v[f"{q}_g"] == v[f"{q}_b"] == v[f"{q}_r"]
 
 
 def _table(brdf_obj, n=120, seed=0, rel=0.05, meta=None, grey=False):

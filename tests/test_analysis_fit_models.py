@@ -184,3 +184,27 @@ def test_a_spec_and_start_of_different_models_are_refused(tmp_path):
                                          "model lambert"):
         fit_fabric(t, Lambert(), spec, tmp_path / "x", max_steps=10, progress=False)
     assert not (tmp_path / "x" / "fit_config.json").exists()
+
+
+def test_folders_written_before_models_read_as_microcylinder_and_resume(tmp_path):
+    """A fit_config.json and results.json without "model" (written before models were named)
+    read as microcylinder: the same fit resumes there, another model is refused in one line."""
+    from analysis.fit.results import read_results
+    fab = brdf.fabric("silk_crepe_de_chine")
+    table = _table(fab, n=60, seed=31)
+    spec = fit_spec(fab, "kd1", ("none",))
+    out = tmp_path / "old"
+    fit_fabric(table, fab, spec, out, max_steps=20, check_every=10, progress=False)
+    for name in ("fit_config.json", "results.json"):
+        doc = json.loads((out / name).read_text())
+        (doc["config"] if name == "fit_config.json" else doc).pop("model")
+        (out / name).write_text(json.dumps(doc))
+    assert read_results(out / "results.json")["model"] == MICROCYLINDER
+    assert median_fabric(out, preset="silk_crepe_de_chine").model_name == MICROCYLINDER
+    r = fit_fabric(table, fab, spec, out, max_steps=40, check_every=10, progress=False)
+    assert r.timing.get("resumed_from") == 20
+    lam = fit_spec(Lambert(), table=table)
+    with pytest.raises(ValueError) as info:
+        fit_fabric(table, Lambert(), lam, out, max_steps=40, progress=False)
+    assert "holds a fit of model microcylinder, not lambert" in str(info.value)
+    assert "\n" not in str(info.value)

@@ -134,3 +134,35 @@ def test_fit_measured_ranks_the_models_of_a_dataset(tmp_path, shared_data):
     assert "<h3>Models</h3>" in text and "best − this" in text
     assert ("is preferred over" in text) or ("cannot separate" in text)
     assert summary["curet_07_velvet"]["models"]["lambert"]["rank"] in (1, 2)
+
+
+def test_a_hostile_models_entry_is_escaped_or_refused(tmp_path):
+    from reports.report_measured import measured_page, read_measured
+    evil = "<script>alert(1)</script>"
+    models = {"lambert": {"rank": 1, "elpd": 10.0, "se": 1.0, "d_elpd": 0.0, "d_se": 0.0,
+                          "converged": True, "adequate": None, "error": evil,
+                          "identifiability": [evil]},
+              "charlie": {"rank": 2, "elpd": 2.0, "se": 1.0, "d_elpd": 8.0, "d_se": 2.0,
+                        "converged": False}}
+    doc = {"datasets": {"curet_07_velvet": {"title": evil, "models": models}}}
+    (tmp_path / "measured.json").write_text(json.dumps(doc))
+    body, _ = measured_page(tmp_path / "page", read_measured(tmp_path))
+    text = str(body)
+    assert "<script>" not in text and "&lt;script&gt;" in text
+    assert "lambert is preferred over charlie by 8.0 ± 2.0 (4.0 se)" in text
+    for field, value, allowed in (("elpd", "x", "a finite number or null"),
+                                  ("rank", -1, "an integer >= 0 or null"),
+                                  ("identifiability", [1], "a list of strings")):
+        bad = json.loads(json.dumps(doc))
+        bad["datasets"]["curet_07_velvet"]["models"]["lambert"][field] = value
+        (tmp_path / "measured.json").write_text(json.dumps(bad))
+        with pytest.raises(ValueError) as info:
+            read_measured(tmp_path)
+        msg = str(info.value)
+        assert f"datasets.curet_07_velvet.models.lambert.{field} must be {allowed}" in msg
+        assert "\n" not in msg
+    for name in ("../x", "b<i>x"):        # a model's name is a safe file name or refused
+        bad = dict(doc, datasets={"curet_07_velvet": {"models": {name: {}}}})
+        (tmp_path / "measured.json").write_text(json.dumps(bad))
+        with pytest.raises(ValueError, match="models: name .* refused"):
+            read_measured(tmp_path)

@@ -21,14 +21,18 @@ there), wi = (w_x, w_y, w_z) and the LTC's inverse maps it to
 ``mx_sheen_bsdf`` returns ``response = dirAlbedo * color * D`` as the radiance factor, which
 carries the cosine: f_r cos(theta_i) = R sheen D. Hence
 
-    f_sheen = sheen * R(cos_o, y) * D(wi) / cos(theta_i)
-    f_r     = f_sheen + (1 - R(cos_o, y)) * base / pi          (1/sr)
+    R+      = max(R(cos_o, y), 0)
+    f_sheen = sheen * R+ * D(wi) / cos(theta_i)
+    f_r     = f_sheen + (1 - R+) * base / pi                   (1/sr)
 
 the base scaled by ``throughput = 1 - dirAlbedo * weight`` (weight 1), colourless: a black
-sheen still darkens the base, as a black fuzz absorbs. The sheen lobe's own albedo is R exactly
-(D integrates to 1), so white sheen over a white base reflects R + (1 - R) = 1 wherever
-0 <= R <= 1. MaterialX clamps roughness to [0.01, 1] ("the range of original impl."), the
-validated range here.
+sheen still darkens the base, as a black fuzz absorbs. R+ is a reading: MaterialX's fit of R
+dips to -2.1e-5 at roughness 0.04 to 0.13 (MaterialX clamps the Imageworks albedo in the same
+file, not this one), which would make f_r negative (to -2.8e-3 1/sr over a black base); the
+clamp changes the albedo by at most 2.1e-5 and keeps f_r >= 0. The sheen lobe's own albedo
+is R+ exactly (D integrates to 1), so white sheen over a white base reflects R+ + (1 - R+) = 1.
+MaterialX clamps roughness to [0.01, 1] ("the range of original impl."), the validated range
+here.
 
 Not reciprocal: the lobe's shape and R follow wo alone (``reciprocal = False``).
 
@@ -39,6 +43,7 @@ mx_zeltner_sheen_importance_sample does); pdf = p cos(theta_i) / pi + (1 - p) D(
 Examples
 --------
 >>> import numpy as np
+>>> from brdf.baselines.sheen import hemisphere_rule
 >>> m = Zeltner(base=0.0, sheen=1.0, roughness=0.5)
 >>> wo = np.array([0.6, 0.0, 0.8])
 >>> wi, w = hemisphere_rule(0.8, 64, 64)             # the sheen lobe's albedo is R(0.8, 0.5)
@@ -53,12 +58,11 @@ import math
 
 import numpy as np
 
-from brdf.baselines.sheen import SheenModel, hemisphere_rule
+from brdf.baselines.sheen import SheenModel
 from brdf.frames import flat_pairs
 from brdf.schema import ParamInfo
 
-__all__ = ["Zeltner", "ROUGHNESS_ZELTNER", "dir_albedo", "ltc_ainv", "ltc_binv", "ltc_d",
-           "hemisphere_rule"]
+__all__ = ["Zeltner", "ROUGHNESS_ZELTNER", "dir_albedo", "ltc_ainv", "ltc_binv", "ltc_d"]
 
 #: MaterialX's M_FLOAT_EPS: the least NdotV.
 EPS = 1e-8
@@ -129,11 +133,11 @@ class Zeltner(SheenModel):
     def lobe(cls, geom, roughness):
         g = geom
         d = ltc_d(g["wx"], g["wy"], g["cos_i"], g["cos_o"], roughness)
-        return dir_albedo(g["cos_o"], roughness) * d / g["cos_i"]
+        return np.maximum(dir_albedo(g["cos_o"], roughness), 0.0) * d / g["cos_i"]
 
     @classmethod
     def layer(cls, geom, roughness, sheen):
-        return 1.0 - dir_albedo(geom["cos_o"], roughness)
+        return 1.0 - np.maximum(dir_albedo(geom["cos_o"], roughness), 0.0)
 
     # -- sampling: the cosine hemisphere or the LTC lobe ----------------------------------
     def sample_directions(self, wo, u):

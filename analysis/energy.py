@@ -25,7 +25,7 @@ import numpy as np
 from analysis.albedo import albedo_hemispherical, run_tasks
 from analysis.furnace import (FURNACE_SCAN, MODES, SCAN_PHI, SCAN_THETA, directions_grid,
                               max_info, white_furnace)
-from analysis.variants import VARIANTS, check_names, fabric_of, label_of
+from analysis.variants import VARIANTS, Named, applies, check_names, fabric_of, label_of
 from gonio.progress import progress_bar
 
 __all__ = [
@@ -106,6 +106,8 @@ def _curves(presets, variants, modes, th, ph, tol, min_level, workers, tick) -> 
     dirs = directions_grid(th, ph).reshape(-1, 3)
     keys, tasks = [], []
     for p, v, m in itertools.product(presets, variants, modes):
+        if not applies(p, v):
+            continue
         keys.append((p, v, m))
         tasks.append((fabric_of(p, v), dirs,
                       {"swap": MODES[m], "tol": tol, "min_level": min_level}))
@@ -129,9 +131,11 @@ def _hemispherical(presets, tol, min_level, workers, tick) -> list[dict]:
 
 def _total(presets, variants, modes, n_dirs, hemispherical, furnace, scan, scan_dirs) -> int:
     """Directions computed in all, for the progress bar."""
-    n_scan = (len(presets) * (1 + sum(len(v) for v in scan.values())) * len(modes)
+    fabrics = [p for p in presets if not isinstance(p, Named)]
+    n_scan = (len(fabrics) * (1 + sum(len(v) for v in scan.values())) * len(modes)
               * scan_dirs) if furnace else 0
-    return (len(presets) * len(variants) * len(modes) * n_dirs + n_scan
+    n_curves = sum(applies(p, v) for p in presets for v in variants)
+    return (n_curves * len(modes) * n_dirs + n_scan
             + (len(presets) * _HEMI_TICKS if hemispherical else 0))
 
 
@@ -206,9 +210,11 @@ def energy_report(presets=None, variants=None, *, theta_deg=DEFAULT_THETA, phi_d
     try:
         curves = _curves(presets, variants, modes, th, ph, tol, min_level, workers, tick)
         hemi = _hemispherical(presets, tol, min_level, workers, tick) if hemispherical else []
-        scan_rows = (white_furnace(presets, scan=scan, theta_deg=scan_theta_deg,
+        fabrics = [p for p in presets if not isinstance(p, Named)]
+        scan_rows = (white_furnace(fabrics, scan=scan, theta_deg=scan_theta_deg,
                                    phi_deg=scan_phi_deg, modes=modes, workers=workers,
-                                   min_level=min_level, progress=tick) if furnace else [])
+                                   min_level=min_level, progress=tick)
+                     if furnace and fabrics else [])
     finally:
         if bar is not None:
             bar.close()

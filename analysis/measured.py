@@ -46,7 +46,9 @@ import numpy as np
 from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
 from analysis.folderlock import output_lock
+from analysis.families import MICROCYLINDER
 from analysis.measuredjson import load_measured_json
+from analysis.measuredmodels import fit_folder, models_entry, parse_models
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write, meta_text, plain
@@ -210,7 +212,8 @@ def measured_spec(name, fab=None):
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
                  max_steps: int = 20000, time_limit: float | None = None,
                  rgl_step: float = 15.0, plots=None, progress: bool = True,
-                 echo=None, workers: int | None = None, scheduler: str | None = None) -> dict:
+                 echo=None, workers: int | None = None, scheduler: str | None = None,
+                 models=None) -> dict:
     """Fit measured datasets as a batch (:func:`analysis.batch.run_batch`); write
     ``out_dir/NAME/``, the batch summaries and ``out_dir/measured.json``.
 
@@ -218,6 +221,12 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     ----------
     names : sequence of str, optional
         Keys of :data:`analysis.measured.MEASURED` (default all).
+    models : str or sequence of str, optional
+        The models fitted to each dataset (:func:`analysis.measuredmodels.parse_models`:
+        ``"all"`` or names; default the microcylinder alone). A baseline model's fit goes
+        into ``out_dir/NAME-MODEL/``; with models other than the microcylinder alone, each
+        dataset's entry gets ``models``, the models ranked by PSIS-LOO
+        (:func:`analysis.measuredmodels.models_entry`).
     out_dir : path
         Output folder; existing fits there are resumed, converged ones not redone.
     data_dir : path, optional
@@ -257,40 +266,69 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     bad = [n for n in names if n not in MEASURED]
     if bad:
         raise ValueError(f"unknown measured dataset {bad[0]!r}; valid: {', '.join(MEASURED)}")
+    compare = models is not None and tuple(parse_models(models)) != (MICROCYLINDER,)
+    models = parse_models(models)
     root = (Path(data_dir) if data_dir is not None else default_data_dir()).resolve()
     tables = {n: load_measured(n, root, rgl_step=rgl_step) for n in names}
     out = Path(out_dir)
     spath = out / SUMMARY_FILE
     _read_summary(spath)                # a damaged summary is refused before any fit
-    jobs = [_job(n, root, rgl_step, plots, {"seed": seed, "max_steps": max_steps,
-                                            "time_limit": time_limit}) for n in names]
+    fit = {"seed": seed, "max_steps": max_steps, "time_limit": time_limit}
+    jobs = [_job(n, root, rgl_step, plots, fit, m) for n in names for m in models]
     with output_lock(out, "fit-measured"):       # the batch's lock, measured.json included
         summary = run_batch(jobs, out, workers=workers, scheduler=scheduler,
                             progress=progress, echo=echo, locked=True)
         # read just before writing: another fit-measured run may have added its datasets
         doc = _read_summary(spath)
         for n in names:
-            doc["datasets"][n] = _entry(n, tables[n], summary.rows[n], out)
+            doc["datasets"][n] = _dataset_entry(n, tables[n], summary.rows, out, models,
+                                                compare, doc["datasets"].get(n, {}))
         with atomic_write(spath, "w") as fh:
             # strict JSON: a non-finite number is written null (the schema refuses NaN)
             fh.write(json.dumps(plain(doc, nonfinite="null"), indent=2) + "\n")
     return doc
 
 
-def _job(n: str, root: Path, rgl_step: float, plots, fit: dict) -> BatchJob:
-    """The batch job of dataset ``n``: read on the worker by :func:`load_measured`."""
+def _job(n: str, root: Path, rgl_step: float, plots, fit: dict,
+         model: str = MICROCYLINDER) -> BatchJob:
+    """The batch job of dataset ``n`` and ``model``: read on the worker by
+    :func:`load_measured`; a baseline model with its default free set for the table."""
     d = MEASURED[n]
+    loader = functools.partial(load_measured, n, str(root), rgl_step)
+    if model != MICROCYLINDER:
+        return BatchJob(fit_folder(n, model), str(root / d.path), d.sample, d.preset, fit=fit,
+                        loader=loader, plots=plots, model=model,
+                        config_extra={"dataset": n, "rgl_step": rgl_step})
     return BatchJob(n, str(root / d.path), d.sample, d.preset, d.free, d.ties, fit=fit,
-                    loader=functools.partial(load_measured, n, str(root), rgl_step),
-                    plots=plots,
+                    loader=loader, plots=plots,
                     config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
+
+
+def _dataset_entry(n: str, table, rows: dict, out: Path, models, compare: bool,
+                   old: dict) -> dict:
+    """Dataset ``n``'s new entry: the microcylinder's fields (from this run, else ``old``'s),
+    and its ``models`` ranked where several models are or were fitted."""
+    if MICROCYLINDER in models:
+        entry = _entry(n, table, rows[n], out)
+    else:               # the microcylinder's fields stay as an earlier run wrote them
+        entry = {**_base_entry(n, table), **old}
+    if compare or "models" in old:
+        entry.pop("compare_error", None)
+        entry.update(models_entry(out, n, models, rows, old.get("models")))
+    return entry
+
+
+def _base_entry(n: str, table) -> dict:
+    """What ``measured.json`` says of dataset ``n`` whatever was fitted."""
+    d = MEASURED[n]
+    return {"title": d.title, "preset": d.preset,
+            "source": meta_text(table.meta.get("source", "")), "pairs": len(table)}
 
 
 def _entry(n: str, table, row: dict, out: Path) -> dict:
     """The ``measured.json`` entry of dataset ``n`` from its batch row and results."""
     d = MEASURED[n]
-    entry = {"title": d.title, "preset": d.preset,
-             "source": meta_text(table.meta.get("source", "")), "pairs": len(table),
+    entry = {**_base_entry(n, table),
              "free": list(d.free), "ties": list(d.ties), "converged": False,
              "reason": row.get("error") or row.get("reason", ""),
              "steps": row.get("steps", 0), "wall_s": row.get("wall_s"),

@@ -14,7 +14,15 @@ null), ``converged`` (true/false), ``wall_s`` (a finite number >= 0 or null), ``
 ``ties`` (lists of strings), ``quality`` (an object whose ``rms_residual``,
 ``rms_normalized`` and ``albedo_delta_e2000`` are finite numbers >= 0 or null),
 ``albedo_delta_e2000`` (the same) and ``results`` (the relative path of the dataset's
-``results.json``, default ``NAME/results.json``).
+``results.json``, default ``NAME/results.json``), and where several models were fitted
+(``fit-measured --models``, :mod:`analysis.measuredmodels`) ``models``: an object keyed by
+model names (safe file names), each with ``results`` (a relative path, checked like the
+dataset's), ``converged`` (true/false), ``adequate`` (true, false or null), ``rank``,
+``steps``, ``values_used`` (integers >= 0 or null), ``elpd``, ``d_elpd`` (finite numbers or
+null; elpd may be negative), ``se``, ``d_se``, ``rms_residual``, ``rms_normalized``,
+``wall_s`` (finite numbers >= 0 or null), ``error`` (a string) and ``identifiability`` (a
+list of strings); and ``compare_error`` (a string). A dataset fitted by baseline models only
+has no ``results`` of its own (:func:`has_microcylinder`).
 """
 
 from __future__ import annotations
@@ -26,7 +34,7 @@ from pathlib import Path, PurePosixPath
 from gonio.safenames import check_component, check_inside
 from gonio.statefields import FileFields
 
-__all__ = ["load_measured_json", "check_measured_doc", "results_path"]
+__all__ = ["load_measured_json", "check_measured_doc", "results_path", "has_microcylinder"]
 
 _STRINGS = ("title", "preset", "source", "reason", "error")
 _COUNTS = ("pairs", "values_used", "steps")
@@ -73,6 +81,48 @@ def _entry(path, name: str, e) -> None:
         _number(path, f"{where}.quality.{k}", q.get(k))
     if "results" in e and not isinstance(e["results"], str):
         raise _bad(path, f"{where}.results", "a relative path (a string)", e["results"])
+    if "compare_error" in e and not isinstance(e["compare_error"], str):
+        raise _bad(path, f"{where}.compare_error", "a string", e["compare_error"])
+    models = e.get("models", {})
+    if not isinstance(models, dict):
+        raise _bad(path, f"{where}.models", "an object", models)
+    for m, me in models.items():
+        check_component(m, source=path, entry=f"{where}.models")
+        _model(path, f"{where}.models.{m}", me)
+
+
+def _model(path, where: str, e) -> None:
+    """One model's entry of a dataset's ``models``."""
+    if not isinstance(e, dict):
+        raise _bad(path, where, "an object", e)
+    for k in ("results", "error"):
+        if k in e and not isinstance(e[k], str):
+            raise _bad(path, f"{where}.{k}", "a string", e[k])
+    if "converged" in e and not isinstance(e["converged"], bool):
+        raise _bad(path, f"{where}.converged", "true or false", e["converged"])
+    if e.get("adequate") is not None and not isinstance(e["adequate"], bool):
+        raise _bad(path, f"{where}.adequate", "true, false or null", e["adequate"])
+    for k in ("rank", "steps", "values_used"):
+        v = e.get(k)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 0):
+            raise _bad(path, f"{where}.{k}", "an integer >= 0 or null", v)
+    for k in ("se", "d_se", "rms_residual", "rms_normalized", "wall_s"):
+        _number(path, f"{where}.{k}", e.get(k))
+    for k in ("elpd", "d_elpd"):
+        v = e.get(k)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
+                              or not math.isfinite(v)):
+            raise _bad(path, f"{where}.{k}", "a finite number or null", v)
+    ids = e.get("identifiability", [])
+    if not (isinstance(ids, list) and all(isinstance(x, str) for x in ids)):
+        raise _bad(path, f"{where}.identifiability", "a list of strings", ids)
+
+
+def has_microcylinder(entry: dict) -> bool:
+    """Whether a dataset's entry holds a microcylinder fit of its own (``results``): not
+    when only baseline models were fitted to it."""
+    return "results" in entry or "microcylinder" in entry.get("models", {}) or \
+        "models" not in entry
 
 
 def check_measured_doc(doc, path) -> dict:

@@ -16,6 +16,7 @@ space, for tables without sigma).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from typing import Mapping
@@ -27,7 +28,7 @@ from brdf import schema
 __all__ = ["BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES",
            "defaults_from_fabric", "parse_free", "parse_ties", "base_of", "checked_defaults",
            "checked_bounds", "checked_priors", "checked_ties", "resolve_ties", "checked_toml",
-           "PRIORS", "TOML_KEYS"]
+           "PRIORS", "TOML_KEYS", "Catalogue", "CATALOGUE"]
 
 #: The priors a parameter may take.
 PRIORS = ("uniform", "log-uniform")
@@ -80,6 +81,21 @@ DEFAULT_FREE = ("eta1", "kd1", "kd2", "gamma_s1", "gamma_v1", "gamma_s2", "gamma
 DEFAULT_TIES = ("eta2=eta1", "area2=1-area1")
 
 
+@dataclasses.dataclass(frozen=True)
+class Catalogue:
+    """The names a fit of one model knows: every parameter name, and the group aliases
+    ``--free`` expands (``albedo1`` -> its three channels). The parsing and checking functions
+    of this module take one (``cat=``; default :data:`CATALOGUE`, the microcylinder's); an
+    :class:`analysis.families.ModelFamily` is one too."""
+
+    names: tuple
+    aliases: Mapping
+
+
+#: The microcylinder's names and aliases.
+CATALOGUE = Catalogue(PARAM_NAMES, ALIASES)
+
+
 def base_of(name: str) -> tuple[str, int | None]:
     """Split a full name into its base quantity and thread: ``albedo2_g`` -> ``("albedo_g", 2)``;
     a name of no thread (``scale``) -> ``(name, None)``.
@@ -104,11 +120,12 @@ def entry(name: str) -> Entry:
     return BASE_PARAMS.get(base) or EXTRA_PARAMS[name]
 
 
-def unknown(name: str, what: str = "parameter") -> ValueError:
+def unknown(name: str, what: str = "parameter", cat: Catalogue = CATALOGUE) -> ValueError:
     """The error for a name that is no parameter (it lists the valid ones)."""
-    return ValueError(f"unknown {what} {name!r}; valid names: {', '.join(PARAM_NAMES)} "
-                      f"(aliases: {', '.join(ALIASES)})")
-def parse_free(free) -> tuple[str, ...]:
+    tail = f" (aliases: {', '.join(cat.aliases)})" if cat.aliases else ""
+    return ValueError(f"unknown {what} {name!r}; valid names: {', '.join(cat.names)}{tail}")
+
+def parse_free(free, cat: Catalogue = CATALOGUE) -> tuple[str, ...]:
     """Parse ``"eta1,kd1,albedo1"`` (or a sequence) into full names, aliases expanded.
 
     Raises
@@ -127,14 +144,14 @@ def parse_free(free) -> tuple[str, ...]:
         s = s.strip()
         if not s:
             continue
-        for name in ALIASES.get(s, (s,)):
-            if name not in PARAM_NAMES:
-                raise unknown(name, "free parameter")
+        for name in cat.aliases.get(s, (s,)):
+            if name not in cat.names:
+                raise unknown(name, "free parameter", cat)
             if name not in out:
                 out.append(name)
     if not out:
         raise ValueError(f"free parameters: none given ({free!r}); valid names: "
-                         f"{', '.join(PARAM_NAMES)}")
+                         f"{', '.join(cat.names)}")
     return tuple(out)
 
 
@@ -157,7 +174,7 @@ def _items(value, what: str, allowed: str) -> list[str]:
     return out
 
 
-def parse_ties(ties) -> dict[str, tuple[str, str]]:
+def parse_ties(ties, cat: Catalogue = CATALOGUE) -> dict[str, tuple[str, str]]:
     """Parse ties ``"eta2=eta1"`` or ``"area2=1-area1"`` into {target: (source, kind)}.
 
     ``a=b`` makes a follow b (a is the target). :class:`ParamSpec` swaps the two when only the
@@ -179,8 +196,8 @@ def parse_ties(ties) -> dict[str, tuple[str, str]]:
             raise ValueError(f"tie {t!r}: expected 'a=b' or 'a=1-b' with parameter names")
         target, comp, source = m.group(1), m.group(2), m.group(3)
         for name in (target, source):
-            if name not in PARAM_NAMES:
-                raise unknown(name, "tied parameter")
+            if name not in cat.names:
+                raise unknown(name, "tied parameter", cat)
         if target == source:
             raise ValueError(f"tie {t!r}: a parameter cannot be tied to itself")
         tie = (source, "complement" if comp else "equal")
@@ -218,7 +235,7 @@ def defaults_from_fabric(fab) -> dict[str, float]:
     return out
 
 
-def _table(value, what: str) -> dict:
+def _table(value, what: str, cat: Catalogue = CATALOGUE) -> dict:
     """A mapping keyed by parameter names (unknown names refused), as a dict."""
     if value is None:
         return {}
@@ -226,8 +243,8 @@ def _table(value, what: str) -> dict:
         raise ValueError(f"{what}: expected a table of parameter names; got "
                          f"{type(value).__name__} {value!r:.60}")
     for name in value:
-        if name not in PARAM_NAMES:
-            raise unknown(name, f"parameter in {what}")
+        if name not in cat.names:
+            raise unknown(name, f"parameter in {what}", cat)
     return dict(value)
 
 
@@ -240,15 +257,16 @@ def _number(value, what: str) -> float:
     return v
 
 
-def checked_defaults(defaults) -> dict[str, float]:
+def checked_defaults(defaults, cat: Catalogue = CATALOGUE) -> dict[str, float]:
     """Start values: a mapping name -> finite number (a ValueError naming the first bad one)."""
-    return {n: _number(v, f"start value of {n}") for n, v in _table(defaults, "start").items()}
+    return {n: _number(v, f"start value of {n}")
+            for n, v in _table(defaults, "start", cat).items()}
 
 
-def checked_bounds(bounds) -> dict[str, tuple[float, float]]:
+def checked_bounds(bounds, cat: Catalogue = CATALOGUE) -> dict[str, tuple[float, float]]:
     """Bounds: a mapping name -> (lo, hi) of finite numbers."""
     out = {}
-    for name, b in _table(bounds, "bounds").items():
+    for name, b in _table(bounds, "bounds", cat).items():
         if isinstance(b, (str, bytes, Mapping)) or not hasattr(b, "__len__") or len(b) != 2:
             raise ValueError(f"bounds of {name} must be [lo, hi]; got {b!r:.60}")
         out[name] = (_number(b[0], f"lower bound of {name}"),
@@ -256,9 +274,9 @@ def checked_bounds(bounds) -> dict[str, tuple[float, float]]:
     return out
 
 
-def checked_priors(priors) -> dict[str, str]:
+def checked_priors(priors, cat: Catalogue = CATALOGUE) -> dict[str, str]:
     """Priors: a mapping name -> "uniform" | "log-uniform"."""
-    out = _table(priors, "prior")
+    out = _table(priors, "prior", cat)
     for name, v in out.items():
         if v not in PRIORS:
             raise ValueError(f"prior of {name} must be 'uniform' or 'log-uniform'; "
@@ -266,11 +284,11 @@ def checked_priors(priors) -> dict[str, str]:
     return out
 
 
-def checked_ties(ties) -> dict[str, tuple[str, str]]:
+def checked_ties(ties, cat: Catalogue = CATALOGUE) -> dict[str, tuple[str, str]]:
     """Ties as {target: (source, kind)}: strings parsed (:func:`parse_ties`), a mapping of
     that shape checked."""
     if not isinstance(ties, Mapping):
-        return parse_ties(ties)
+        return parse_ties(ties, cat)
     out = {}
     for target, value in ties.items():
         ok = (isinstance(value, (tuple, list)) and len(value) == 2
@@ -279,8 +297,8 @@ def checked_ties(ties) -> dict[str, tuple[str, str]]:
             raise ValueError(f"tie of {target!r}: expected (source, 'equal' | 'complement'); "
                              f"got {value!r:.60}")
         for name in (target, value[0]):
-            if name not in PARAM_NAMES:
-                raise unknown(name, "tied parameter")
+            if name not in cat.names:
+                raise unknown(name, "tied parameter", cat)
         if target == value[0]:
             raise ValueError(f"tie {target}={target}: a parameter cannot be tied to itself")
         out[target] = (value[0], value[1])
@@ -322,7 +340,7 @@ TOML_KEYS = {"free": "a list of names", "tie": "a list of 'a=b' strings",
              "'log-uniform'", "start": "a table name = value", "fabric": "a preset name"}
 
 
-def checked_toml(doc: Mapping) -> dict:
+def checked_toml(doc: Mapping, cat: Catalogue = CATALOGUE) -> dict:
     """The keys of a parsed TOML spec, each checked once (a ValueError naming the key):
     ``free`` and ``tie`` as lists of strings, ``bounds``/``prior``/``start`` as checked
     tables, ``fabric`` a string."""
@@ -330,11 +348,12 @@ def checked_toml(doc: Mapping) -> dict:
     if extra:
         raise ValueError(f"unknown keys {sorted(extra)}; allowed: {sorted(TOML_KEYS)}")
     out = {}
-    for key, check in (("free", lambda v: list(parse_free(v))),
+    for key, check in (("free", lambda v: list(parse_free(v, cat))),
                        ("tie", lambda v: [t for t in _items(v, "tie", "'a=b' strings")
                                           if t.strip()]),
-                       ("bounds", checked_bounds), ("prior", checked_priors),
-                       ("start", checked_defaults)):
+                       ("bounds", lambda v: checked_bounds(v, cat)),
+                       ("prior", lambda v: checked_priors(v, cat)),
+                       ("start", lambda v: checked_defaults(v, cat))):
         if key in doc:
             try:
                 out[key] = check(doc[key])

@@ -1,7 +1,9 @@
-"""Parameter specification for fitting the microcylinder model: bounds, priors, ties.
+"""Parameter specification for fitting a model: bounds, priors, ties.
 
-The names, their bounds, units and priors, and the parsing of ``--free``/``--tie`` strings are
-in :mod:`analysis.paramnames` (derived from :mod:`brdf.schema`); this module re-exports them.
+The names, their bounds, units and priors come from the model's family
+(:mod:`analysis.families`: the microcylinder's are in :mod:`analysis.paramnames`, derived from
+:mod:`brdf.schema`, each baseline's from its ``PARAMS``); the parsing of ``--free``/``--tie``
+strings is in :mod:`analysis.paramnames`; this module re-exports the microcylinder's names.
 
 Each parameter is free (sampled), fixed (at its default, normally the preset's value) or tied to
 another one (``eta2=eta1``: eta2 takes eta1's value; ``area2=1-area1``: the complement).
@@ -26,10 +28,11 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.special
 
+from analysis.families import ModelFamily, family
 from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_PARAM_NAMES,
                                  PARAM_NAMES, checked_bounds, checked_defaults,
                                  checked_priors, checked_ties, checked_toml,
-                                 defaults_from_fabric, entry, parse_free, parse_ties,
+                                 defaults_from_fabric, parse_free, parse_ties,
                                  resolve_ties, unknown)
 from brdf import schema
 from gonio.statefields import load_toml
@@ -136,6 +139,11 @@ class ParamSpec:
         Override bounds (natural units).
     priors : mapping name -> "uniform" | "log-uniform", optional
         Override priors.
+    family : ModelFamily or str, optional
+        The model (:func:`analysis.families.family`): its parameter names, bounds, priors
+        and forward-model arguments. Default the microcylinder.
+    notes : sequence of str, optional
+        Sentences on the choices made for identifiability (written to ``results.json``).
 
     Raises
     ------
@@ -153,19 +161,25 @@ class ParamSpec:
     >>> v = spec.values(spec.to_internal(np.array([[1.6, 4.0]])))
     >>> round(float(v["eta2"][0]), 12), round(float(v["gamma_s1"][0]), 12)
     (1.6, 4.0)
+    >>> ParamSpec("base", family="lambert").free
+    ('base_r', 'base_g', 'base_b')
     """
 
     def __init__(self, free, defaults: Mapping[str, float] | None = None, ties=None,
                  bounds: Mapping[str, Sequence[float]] | None = None,
-                 priors: Mapping[str, str] | None = None):
-        defaults = checked_defaults(defaults)
-        bounds, priors = checked_bounds(bounds), checked_priors(priors)
-        free = list(parse_free(free))
-        self.ties = resolve_ties(free, checked_ties(ties))
+                 priors: Mapping[str, str] | None = None,
+                 family: ModelFamily | str | None = None, notes: Sequence[str] = ()):
+        fam = _family(family)
+        self.family = fam
+        self.notes = tuple(notes)
+        defaults = checked_defaults(defaults, fam)
+        bounds, priors = checked_bounds(bounds, fam), checked_priors(priors, fam)
+        free = list(parse_free(free, fam))
+        self.ties = resolve_ties(free, checked_ties(ties, fam))
         free = [f for f in free if f not in self.ties]
         self.params: dict[str, Param] = {}
-        for name in PARAM_NAMES:
-            lo, hi, prior, unit, fallback = entry(name)
+        for name in fam.names:
+            lo, hi, prior, unit, fallback = fam.entry(name)
             lo, hi = bounds.get(name, (lo, hi))
             prior = priors.get(name, prior)
             self.params[name] = Param(name, float(lo), float(hi), prior, unit,
@@ -188,7 +202,8 @@ class ParamSpec:
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_toml(cls, path, defaults: Mapping[str, float] | None = None,
-                  free=None, ties=None) -> "ParamSpec":
+                  free=None, ties=None, family: ModelFamily | str | None = None
+                  ) -> "ParamSpec":
         """Read a spec from a TOML file.
 
         Keys: ``free`` (list), ``tie`` (list of ``"a=b"``), tables ``[bounds]``
@@ -204,19 +219,20 @@ class ParamSpec:
             once, before any work.
         """
         path = Path(path)
+        fam = _family(family)
         doc = load_toml(path, "fit spec")     # unreadable, invalid or nested: one line
         try:
-            doc = checked_toml(doc)
-            d = checked_defaults(defaults)
+            doc = checked_toml(doc, fam)
+            d = checked_defaults(defaults, fam)
             d.update(doc.get("start", {}))
             fr = doc.get("free", [])
             if free:
-                fr += [f for f in parse_free(free) if f not in fr]
+                fr += [f for f in parse_free(free, fam) if f not in fr]
             if isinstance(ties, str):
                 ties = ties.split(",")
             tie_list = doc.get("tie", []) + list(ties or [])
             return cls(fr, defaults=d, ties=tie_list, bounds=doc.get("bounds"),
-                       priors=doc.get("prior"))
+                       priors=doc.get("prior"), family=fam)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
 
@@ -243,7 +259,7 @@ class ParamSpec:
         new.params = dict(self.params)
         for k, v in values.items():
             if k not in new.params:
-                raise unknown(k)
+                raise unknown(k, cat=self.family)
             new.params[k] = dataclasses.replace(new.params[k], default=float(v))
         return new
 
@@ -292,26 +308,30 @@ class ParamSpec:
         ok = np.all((theta >= self.lower) & (theta <= self.upper) & np.isfinite(theta), axis=-1)
         with np.errstate(invalid="ignore"):
             jac = -(np.logaddexp(0.0, theta) + np.logaddexp(0.0, -theta)).sum(axis=-1)
-        if self.ties or any(n.startswith("area") for n in self.free):
+        areas = "area1" in self.params and any(n.startswith("area") for n in self.free)
+        if self.ties or areas:
             v = self.values(theta)
-            ok &= v["area1"] + v["area2"] <= schema.AREA_SUM_MAX + 1e-12
+            if "area1" in self.params:
+                ok &= v["area1"] + v["area2"] <= schema.AREA_SUM_MAX + 1e-12
             for target in self.ties:
                 p = self.params[target]
                 ok &= (v[target] >= p.lo) & (v[target] <= p.hi)
         return np.where(ok, jac, -np.inf)
 
     def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """Keyword arguments of ``prepare(...).eval``: each (B..., 2), albedo (B..., 2, 3)."""
-        kw = {}
-        for q in schema.SCALAR_PARAMS:
-            kw[q] = np.stack([values[f"{q}1"], values[f"{q}2"]], axis=-1)
-        for q in (p.name for p in schema.THREAD_PARAMS if p.kind == "rgb"):
-            kw[q] = np.stack([np.stack([values[f"{q}{j}_{c}"] for c in schema.RGB_CHANNELS],
-                                       axis=-1) for j in (1, 2)], axis=-2)
-        return kw
+        """Keyword arguments of the model's ``prepare(...).eval``
+        (:meth:`analysis.families.ModelFamily.model_kwargs`): for the microcylinder each
+        (B..., 2), albedo (B..., 2, 3); for a baseline each scalar (B...), RGB (B..., 3)."""
+        return self.family.model_kwargs(values)
+
+    @property
+    def model(self) -> str:
+        """The name of the model fitted (``microcylinder`` or a baseline's)."""
+        return self.family.name
 
     def describe(self) -> dict:
-        """A JSON-ready description (for checkpoints and reports)."""
+        """A JSON-ready description (for checkpoints and reports); the model is the
+        configuration's ``model`` (:meth:`analysis.fit.FitOptions.config`)."""
         return {
             "free": list(self.free),
             "ties": {k: list(v) for k, v in self.ties.items()},
@@ -320,4 +340,10 @@ class ParamSpec:
         }
 
     def __repr__(self) -> str:
-        return f"ParamSpec(free={list(self.free)}, ties={self.ties})"
+        model = "" if self.family.is_microcylinder else f", model={self.model!r}"
+        return f"ParamSpec(free={list(self.free)}, ties={self.ties}{model})"
+
+
+def _family(value) -> ModelFamily:
+    """A family from a family or a model's name (None: the microcylinder)."""
+    return value if isinstance(value, ModelFamily) else family(value)

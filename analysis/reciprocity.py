@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from analysis.colour import luminance
-from analysis.variants import VARIANTS, check_names, fabric_of, label_of
+from analysis.variants import VARIANTS, applies, check_names, fabric_of, label_of
 from brdf import validate
 from brdf.frames import to_angles
 from brdf.protocols import BRDF
@@ -344,7 +344,7 @@ def reciprocity_report(presets=None, variants=None, *, n: int = 20000, seed=0,
     presets, variants = check_names(presets, variants)
     pairs = random_pairs(n, seed)
     rows = [_report_row(label_of(p), v, "model", fabric_of(p, v), pairs, geometry,
-                        channel, n_worst) for p in presets for v in variants]
+                        channel, n_worst) for p in presets for v in variants if applies(p, v)]
     measured = [_measured(felt) for felt in felts]
     rows += [_report_row(name, None, "measured", b, pairs, geometry, channel, n_worst)
              for name, b in measured]

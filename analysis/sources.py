@@ -14,8 +14,10 @@ A source is one of
 
 :func:`resolve` returns a :class:`Source`: its kind, a label for tables and legends, the
 BRDF (a :class:`brdf.Fabric` for every kind but ``table``) and the path it came from.
-:data:`Source.model` names the model a fit is of (``microcylinder`` today), so that fits of
-other models can be told apart when they come.
+:data:`Source.model` names the model a fit is of: ``microcylinder``, or a baseline model
+(``lambert``, ...; :mod:`brdf.baselines`) whose :attr:`Source.brdf` is that model at the
+fit's posterior medians (a :class:`brdf.baselines.BaselineModel`: ``eval``, ``sample``,
+``pdf``, not a fabric: fabric-only options refuse it).
 """
 
 from __future__ import annotations
@@ -49,15 +51,15 @@ class Source:
         What tables, legends and pages call it: the preset's name, else the file's or
         folder's name without suffix (``fit`` for ``runs/fit/``).
     brdf : object
-        The BRDF: a :class:`brdf.Fabric`, or for a table its evaluator (``eval(wi, wo)``,
-        f_r in 1/sr, shape (..., 3)).
+        The BRDF: a :class:`brdf.Fabric`, a baseline model (a fit of one), or for a table
+        its evaluator (``eval(wi, wo)``, f_r in 1/sr, shape (..., 3)).
     path : pathlib.Path or None
         The file or folder it was read from (None for a preset).
     preset : str or None
         The preset the fabric derives from (a fit's start, a file's ``fabric`` key).
     model : str
-        The model of the BRDF: ``microcylinder`` for every kind but ``table``
-        (``measured``).
+        The model of the BRDF: ``microcylinder``, a baseline's name for a fit of one, or
+        ``measured`` for a table.
     """
 
     kind: str
@@ -76,9 +78,14 @@ class Source:
     def fabric(self) -> brdf.Fabric:
         """The :class:`brdf.Fabric`; a ValueError for a measured table."""
         if not self.is_fabric:
-            raise ValueError(f"{self.label}: a measured table, not a fabric (the model's "
-                             f"options and parameters do not apply)")
+            raise ValueError(f"{self.label}: {self.what}, not a fabric (the microcylinder "
+                             f"fabric's options and parameters do not apply)")
         return self.brdf
+
+    @property
+    def what(self) -> str:
+        """What the source is when not a fabric, in words (for refusals)."""
+        return "a measured table" if self.kind == "table" else f"a fit of model {self.model}"
 
     def with_options(self, **options) -> "Source":
         """The same source with the fabric's variant options changed (``masking``,
@@ -87,7 +94,7 @@ class Source:
         if not options:
             return self
         if not self.is_fabric:
-            raise ValueError(f"{self.label}: a measured table takes no model option "
+            raise ValueError(f"{self.label}: {self.what} takes no model option "
                              f"({', '.join(sorted(options))})")
         return dataclasses.replace(self, brdf=self.brdf.replace(**options))
 
@@ -118,7 +125,7 @@ def _fit(text: str, path: Path, what: str, preset: str | None) -> Source:
         med = median_fabric(folder, preset=preset)
     except ValueError as exc:
         raise ValueError(f"{what} {text!r}: not a fit folder: {exc}") from None
-    return Source("fit", _label(folder), med.fabric, folder, med.preset)
+    return Source("fit", _label(folder), med.fabric, folder, med.preset, med.model_name)
 
 
 def resolve(text, *, what: str = "FABRIC", tables: bool = False,

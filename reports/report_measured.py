@@ -5,7 +5,10 @@ on convergence, the posterior table (median, 68% and 95% intervals, tau, R-hat, 
 the model explains the data (residual rms in the likelihood's space and in units of the noise,
 CIEDE2000 between measured and predicted albedo colours, the PSIS-LOO elpd and the LOO-PIT
 uniformity test) and the fit's figures: posterior-predictive lobes over the data points, the
-residual map, the LOO-PIT histogram, the corner and the trace plots.
+residual map, the LOO-PIT histogram, the corner and the trace plots. Where several models
+were fitted (``fit-measured --models``), a table per dataset ranks them (:func:`models_table`:
+elpd, the difference to the best with its standard error, residual rms, adequacy) under one
+sentence of verdict drawn from those numbers (:func:`models_verdict`).
 """
 
 from __future__ import annotations
@@ -13,12 +16,18 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import math
+
 from analysis.fit.results import read_results
-from analysis.measuredjson import load_measured_json, results_path
+from analysis.measuredjson import has_microcylinder, load_measured_json, results_path
 from gonio.safenames import check_component, check_inside
 from reports.safehtml import Markup, html, join, table, url
 
-__all__ = ["read_measured", "measured_page", "PLOTS"]
+__all__ = ["read_measured", "measured_page", "PLOTS", "models_table", "models_verdict",
+           "SEPARATION_SE"]
+
+#: A difference of elpd within this many standard errors does not separate two models.
+SEPARATION_SE = 2.0
 
 #: The figures of a fit, in page order, with captions.
 PLOTS = {
@@ -63,6 +72,9 @@ def read_measured(folder) -> dict:
     out = {}
     for name, entry in doc["datasets"].items():
         e = dict(entry)
+        if not has_microcylinder(e):        # baseline models only: their numbers alone
+            out[name] = dict(e, results=None, folder=None, plot_files={}, data_files=[])
+            continue
         rpath = results_path(folder, name, e, source)
         e["results"] = read_results(rpath)
         e["folder"] = rpath.parent
@@ -117,6 +129,8 @@ def overview_table(measured: dict) -> Markup:
     elpd."""
     rows = []
     for name, e in measured.items():
+        if e.get("results") is None:
+            continue
         q = e.get("quality", {})
         doc = e.get("results") or {}
         kinds = sorted({str(w.get("kind")) for w in doc.get("warnings") or []
@@ -182,6 +196,11 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         overview_table(measured)]
     summary = {}
     for name, e in measured.items():
+        if e.get("results") is None:
+            body.append(html('<section id="{}" class="measured"><h2>{}: {}</h2>{}</section>',
+                             name, name, e.get("title", ""), _models_part(e)))
+            summary[name] = {"models": e.get("models", {})}
+            continue
         doc = e["results"]
         res = doc.get("parameters", {})
         params = list(res)
@@ -203,7 +222,8 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
             shutil.copyfile(src, check_inside(dest / src.name, root))
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
-        body.append(_section(folder, name, e, verdict, rows, figs, _trust(doc)))
+        body.append(_section(folder, name, e, verdict, rows, figs,
+                             _trust(doc) + _models_part(e)))
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
                          "adequate": doc.get("adequate"), "warnings": doc.get("warnings", []),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
@@ -212,7 +232,79 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
                                             ("median", "lo68", "hi68", "lo95", "hi95", "tau",
                                              "rhat", "ess")} for k in params},
                          "figures": len(figs)}
+        if "models" in e:
+            summary[name]["models"] = e["models"]
     return join(body), summary
+
+
+def _ranked(models: dict) -> list[tuple[str, dict]]:
+    """The models by rank (unranked ones last, by name)."""
+    return sorted(((m, e) for m, e in models.items() if isinstance(e, dict)),
+                  key=lambda me: (me[1].get("rank") is None, me[1].get("rank") or 0, me[0]))
+
+
+def models_verdict(models: dict, compare_error: str | None = None) -> str:
+    """One sentence from the ranking of a dataset's models (plain text).
+
+    Examples
+    --------
+    >>> models_verdict({"charlie": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
+    ...                 "lambert": {"rank": 2, "d_elpd": 12.0, "d_se": 3.0}})
+    'charlie is preferred over lambert by 12.0 ± 3.0 (4.0 se).'
+    >>> models_verdict({"a": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
+    ...                 "b": {"rank": 2, "d_elpd": 1.0, "d_se": 2.0}})
+    'The data cannot separate a and b (difference 1.0 ± 2.0, within 2 se).'
+    """
+    ranked = [(m, e) for m, e in _ranked(models) if e.get("rank") is not None]
+    if compare_error:
+        return f"The models were not ranked: {compare_error}"
+    if len(ranked) < 2:
+        return "Fewer than two models have a PSIS-LOO: nothing to rank."
+    (best, _), (second, e2) = ranked[0], ranked[1]
+    d, se = float(e2.get("d_elpd") or 0.0), float(e2.get("d_se") or 0.0)
+    z = d / se if se > 0 else (math.inf if d > 0 else 0.0)
+    if z <= SEPARATION_SE:
+        return (f"The data cannot separate {best} and {second} (difference {d:.1f} ± "
+                f"{se:.1f}, within {SEPARATION_SE:g} se).")
+    rest = ""
+    if len(ranked) > 2:
+        zs = [float(e.get("d_elpd") or 0) / float(e["d_se"]) if e.get("d_se") else math.inf
+              for _, e in ranked[2:]]
+        rest = f", and over the {len(ranked) - 2} others by at least {min(zs):.1f} se"
+    return (f"{best} is preferred over {second} by {d:.1f} ± {se:.1f} ({z:.1f} se)"
+            f"{rest}.")
+
+
+def models_table(models: dict) -> Markup:
+    """The models of one dataset, best first: elpd ± se, the difference to the best ± its
+    se (and in se), residual rms (likelihood space, normalized), adequate, converged."""
+    rows = []
+    for m, e in _ranked(models):
+        d, se = e.get("d_elpd"), e.get("d_se")
+        diff = "-" if d is None else (f"{_f(d, '.1f')} ± {_f(se, '.1f')}"
+                                      + (f" ({float(d) / float(se):.1f} se)" if se else ""))
+        if e.get("rank") == 1:
+            diff = "best"
+        rows.append([_f(e.get("rank"), ".0f"), m, _elpd(e), diff,
+                     _f(e.get("rms_residual"), ".4f"), _f(e.get("rms_normalized"), ".2f"),
+                     {True: "yes", False: "NO"}.get(e.get("adequate"), "-"),
+                     "yes" if e.get("converged") else "NO", e.get("error") or ""])
+    return table(["rank", "model", "elpd (PSIS-LOO)", "best − this", "residual rms",
+                  "normalized rms", "adequate", "converged", "error"], rows)
+
+
+def _models_part(e: dict) -> Markup:
+    """A dataset's models: the verdict, the table and each model's identifiability notes."""
+    models = e.get("models")
+    if not isinstance(models, dict) or not models:
+        return Markup("")
+    notes = join(html("<li>{}: {}</li>", m, n) for m, me in _ranked(models)
+                 for n in me.get("identifiability") or [])
+    return (html("<h3>Models</h3><p><b>{}</b></p>",
+                 models_verdict(models, e.get("compare_error")))
+            + models_table(models)
+            + (html("<p>Identifiability choices:</p><ul>{}</ul>", notes) if notes else
+               Markup("")))
 
 
 def _section(folder: str, name: str, e: dict, verdict: str, rows, figs, trust) -> Markup:

@@ -48,7 +48,8 @@ def test_compare_ranks_the_generating_fabric_first_by_more_than_4_se(fits, tmp_p
     assert r.returncode == 0, r.stderr
     rows = json.loads(r.stdout)
     assert [row["fit"] for row in rows] == [str(fits["right"]), str(fits["wrong"])]
-    assert all(set(row) == {"fit", "elpd", "se", "d_elpd", "d_se"} for row in rows)
+    assert all(set(row) == {"fit", "model", "elpd", "se", "d_elpd", "d_se"} for row in rows)
+    assert all(row["model"] == "microcylinder" for row in rows)
     best, wrong = rows
     assert best["d_elpd"] == 0 and best["d_se"] == 0
     assert wrong["d_elpd"] == pytest.approx(best["elpd"] - wrong["elpd"])
@@ -63,9 +64,10 @@ def test_compare_ranks_the_generating_fabric_first_by_more_than_4_se(fits, tmp_p
                     env={"XDG_CACHE_HOME": str(tmp_path / "cache")})
     assert text.returncode == 0 and "ArviZ" not in text.stderr and "Warning" not in text.stderr
     lines = text.stdout.splitlines()
-    assert lines[0].split()[:3] == ["rank", "fit", "elpd"]
-    assert lines[1].split()[:2] == ["1", str(fits["right"])]
-    assert f"{fits['wrong']}: behind {fits['right']} by" in text.stdout
+    assert lines[0].split()[:4] == ["rank", "fit", "model", "elpd"]
+    assert lines[1].split()[:3] == ["1", str(fits["right"]), "microcylinder"]
+    assert (f"{fits['wrong']} (microcylinder): behind {fits['right']} (microcylinder) by"
+            in text.stdout)
 
 
 def test_compare_refuses_fits_of_different_tables_in_one_line(fits):

@@ -29,6 +29,7 @@ from typing import Callable
 import brdf
 import gonio
 from gonio.io import READ_SUFFIXES
+from analysis.families import MICROCYLINDER, family
 from analysis.fit.workflow import fit_spec
 from gonio.curet import N_SAMPLES
 from gonio.safenames import digest, safe_component
@@ -69,6 +70,11 @@ class BatchJob:
     config_extra : dict, optional
         Recorded in (and matched against) the fit's stored configuration; default the
         preset, its options and the sample, as ``microcyl fit`` records them.
+    model : str
+        The model fitted (:func:`analysis.families.model_names`; default microcylinder). A
+        baseline model starts from its typical values (``preset`` unused) and, with
+        ``free`` None, takes its default free set for the table
+        (:meth:`analysis.families.ModelFamily.default_free`).
     """
 
     name: str
@@ -84,21 +90,28 @@ class BatchJob:
     loader: Callable | None = None
     plots: Callable | None = None
     config_extra: dict | None = None
+    model: str = MICROCYLINDER
 
-    def fabric(self) -> brdf.Fabric:
-        """The start fabric (preset and options)."""
-        return brdf.fabric(self.preset, **self.fabric_options)
+    def fabric(self):
+        """The start model: the preset's fabric with its options (a baseline model at its
+        typical values)."""
+        if self.model == MICROCYLINDER:
+            return brdf.fabric(self.preset, **self.fabric_options)
+        return family(self.model).start(options=self.fabric_options)
 
-    def param_spec(self, fab=None):
-        """The :class:`~analysis.params.ParamSpec` of this fit (checks every name)."""
+    def param_spec(self, fab=None, table=None):
+        """The :class:`~analysis.params.ParamSpec` of this fit (checks every name); ``table``
+        decides a baseline's default free set."""
         return fit_spec(fab if fab is not None else self.fabric(), self.free, self.ties,
-                        self.spec)
+                        self.spec, table=table)
 
     def key(self) -> str:
         """A digest of everything that decides the fit: the job's fields and the size and
         modification time of its files. A converged row with the same key is not redone."""
         doc = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
                if f.name not in ("plots",)}
+        if doc["model"] == MICROCYLINDER:
+            del doc["model"]                # the keys of batches run before models stand
         doc["loader"] = repr(self.loader)
         for what, p in (("table", self.path), ("spec_file", self.spec)):
             if p is not None and Path(p).exists():

@@ -7,7 +7,8 @@ from pathlib import Path
 
 from analysis.batch.jobs import BatchJob, read_job_table
 from analysis.fit.driver import estimate_fit_time
-from analysis.fit.posterior import FabricModel
+from analysis.families import MICROCYLINDER
+from analysis.fit.posterior import forward_model
 from analysis.fit.workflow import fit_fabric
 
 __all__ = ["run_job", "estimate_job", "result_row", "error_row"]
@@ -42,11 +43,13 @@ def run_job(job: BatchJob, out_dir) -> dict:
     try:
         table = read_job_table(job)
         fab = job.fabric()
-        spec = job.param_spec(fab)
+        spec = job.param_spec(fab, table)
         fit_kw = dict(job.fit)
         fit_kw.setdefault("threads", 1)
         extra = job.config_extra
-        if extra is None:
+        if extra is None and job.model != MICROCYLINDER:
+            extra = {"sample": job.sample}
+        elif extra is None:
             extra = {"fabric": job.preset, "options": fab.options, "sample": job.sample}
         result = fit_fabric(table, fab, spec, folder, plots=job.plots, progress=False,
                             config_extra=extra, **fit_kw)
@@ -63,14 +66,14 @@ def estimate_job(job: BatchJob) -> tuple[float, str]:
     fab = job.fabric()
     fit_kw = dict(job.fit)
     fit_kw.setdefault("threads", 1)
-    return estimate_fit_time(table, job.param_spec(fab), FabricModel(fab, table.wi, table.wo),
-                             **fit_kw)
+    return estimate_fit_time(table, job.param_spec(fab, table),
+                             forward_model(fab, table.wi, table.wo), **fit_kw)
 
 
 def _base(job: BatchJob) -> dict:
     return {"name": job.name, "status": "", "error": "", "steps": 0, "wall_s": 0.0,
             "path": job.path, "sample": job.sample, "preset": job.preset, "reason": "",
-            "folder": job.name}
+            "folder": job.name, "model": job.model}
 
 
 def result_row(job: BatchJob, result, wall_s: float) -> dict:

@@ -70,7 +70,7 @@ from analysis.fit.loo import LOO_FILE, Loo, load_loo, psis_loo
 from analysis.fit.medians import FitModel, MedianFabric, median_fabric
 from analysis.fit.moves import EnsembleMoves
 from analysis.fit.optimize import point_estimate
-from analysis.fit.posterior import FabricModel, LogPosterior
+from analysis.fit.posterior import BaselineForward, FabricModel, LogPosterior, forward_model
 from analysis.fit.proposal import LaplaceMove
 from analysis.fit.quality import albedo_colours, albedo_delta_e, fit_quality
 from analysis.fit.results import SCHEMA_VERSION, FitResult, write_results
@@ -81,7 +81,7 @@ from analysis.fit.workflow import fit_fabric, fit_spec
 
 __all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInterrupted",
            "write_results",
-           "FabricModel", "LogPosterior", "point_estimate", "LockStep", "Chain",
+           "FabricModel", "BaselineForward", "forward_model", "LogPosterior", "point_estimate", "LockStep", "Chain",
            "EnsembleRunner", "EnsembleMoves", "LaplaceMove", "Criteria", "Diagnosis",
            "FitFolder", "fit_quality", "albedo_colours", "albedo_delta_e", "CONFIG_FILE",
            "CHECKPOINT_FILE", "SCHEMA_VERSION", "MedianFabric", "median_fabric", "FitModel",

@@ -73,6 +73,12 @@ class FitFolder:
             raise self._corrupt(exc) from None
         stored_cfg = stored["config"]
         config = plain(config)
+        stored_cfg.setdefault("model", "microcylinder")     # written before models: the one
+        config.setdefault("model", "microcylinder")
+        if config["model"] != stored_cfg["model"]:
+            raise ValueError(f"{self.path} holds a fit of model {stored_cfg['model']}, not "
+                             f"{config['model']}; use another output folder (or --model "
+                             f"{stored_cfg['model']} to resume it)")
         if config != stored_cfg:
             diff = sorted(k for k in set(config) | set(stored_cfg)
                           if config.get(k) != stored_cfg.get(k))
@@ -144,7 +150,8 @@ def read_config(path) -> dict:
     """A ``fit_config.json``, every field the readers use checked: ``config.spec`` (``free``
     a list of names, ``params`` each with finite ``lo``, ``hi``, ``default`` and string
     ``prior``/``unit``, ``ties`` target -> [source, "equal" or "complement"] among the
-    params), ``config.extra`` (``fabric``/``preset`` a string, ``options`` an object).
+    params), ``config.model`` (a string; absent: ``microcylinder``), ``config.extra``
+    (``fabric``/``preset`` a string, ``options`` an object).
 
     Raises
     ------
@@ -156,6 +163,7 @@ def read_config(path) -> dict:
     if not isinstance(doc, dict):
         raise ValueError(f"{path}: not a fit configuration (not a JSON object)")
     cfg = f.mapping(doc, "config")
+    f.string(cfg, "model", "config", default="microcylinder")   # absent before models
     spec = f.mapping(cfg, "spec", "config")
     params = f.mapping(spec, "params", "config.spec")
     for name in params:

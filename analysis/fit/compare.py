@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.families import model_names
 from analysis.fit.checkpoint import CONFIG_FILE
 from analysis.fit.loo import HIGH_K, LOO_FILE, import_arviz, load_loo
 from analysis.fit.results import read_results
@@ -28,7 +29,7 @@ from analysis.fit.results import read_results
 __all__ = ["compare_fits", "read_fit", "difference_in_se", "FIT_KEYS"]
 
 #: The keys of each fit in :func:`compare_fits`'s answer (``microcyl compare --json``).
-FIT_KEYS = ("fit", "elpd", "se", "d_elpd", "d_se")
+FIT_KEYS = ("fit", "model", "elpd", "se", "d_elpd", "d_se")
 
 
 def read_fit(folder) -> dict:
@@ -37,8 +38,9 @@ def read_fit(folder) -> dict:
     Returns
     -------
     dict
-        ``folder`` (Path), ``loo`` (:class:`~analysis.fit.loo.Loo`), ``table`` (digest),
-        ``converged`` (bool or None).
+        ``folder`` (Path), ``model`` (the model fitted, ``results.json``'s; a name no
+        model has is shown as its ``ascii()``), ``loo`` (:class:`~analysis.fit.loo.Loo`),
+        ``table`` (digest), ``converged`` (bool or None).
 
     Raises
     ------
@@ -70,7 +72,9 @@ def read_fit(folder) -> dict:
         raise ValueError(f"{folder / LOO_FILE}: records no table digest; run the same "
                          f"`microcyl fit` again to recompute it")
     converged = results.get("converged")
-    return {"folder": folder, "loo": loo, "table": table,
+    model = results["model"]
+    return {"folder": folder, "model": model if model in model_names() else ascii(model),
+            "loo": loo, "table": table,
             "converged": None if converged is None else bool(converged)}
 
 
@@ -115,7 +119,7 @@ def compare_fits(folders, names=None) -> list[dict]:
     Returns
     -------
     list of dict
-        Best first: ``fit``, ``elpd``, ``se``, ``d_elpd`` (the best's elpd minus this one's,
+        Best first: ``fit``, ``model`` (the model fitted), ``elpd``, ``se``, ``d_elpd`` (the best's elpd minus this one's,
         >= 0), ``d_se`` (its standard error), and ``p_loo``, ``weight`` (arviz's stacking
         weight), ``n_high_k``, ``pareto_k_max``, ``converged``, ``values``, ``table``.
 
@@ -146,7 +150,8 @@ def compare_fits(folders, names=None) -> list[dict]:
         fit = by_name[name]
         loo = fit["loo"]
         d_se = float(row["dse"])
-        out.append({"fit": name, "elpd": float(row["elpd_loo"]), "se": float(row["se"]),
+        out.append({"fit": name, "model": fit["model"], "elpd": float(row["elpd_loo"]),
+                    "se": float(row["se"]),
                     "d_elpd": float(row["elpd_diff"]), "d_se": d_se,
                     "p_loo": float(row["p_loo"]), "weight": float(row["weight"]),
                     "n_high_k": loo.n_high_k, "pareto_k_max": float(np.max(loo.pareto_k)),

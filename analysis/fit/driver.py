@@ -126,7 +126,7 @@ class FitOptions:
 
     def config(self, spec: ParamSpec, table, lik: Likelihood, extra=None) -> dict:
         """What a checkpoint must match to be resumed (everything that changes the chains)."""
-        return {"version": CONFIG_VERSION, "spec": spec.describe(),
+        return {"version": CONFIG_VERSION, "model": spec.model, "spec": spec.describe(),
                 "likelihood": self.likelihood, "nu": self.nu, "ensembles": self.ensembles,
                 "walkers": self.walkers, "seed": self.seed, "table": table_digest(table),
                 "n_used": lik.n_used, "laplace_move": self.laplace_move, "adapt": self.adapt,
@@ -147,7 +147,8 @@ def with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
     return ParamSpec(list(spec.free) + extra,
                      defaults={n: p.default for n, p in spec.params.items()}, ties=spec.ties,
                      bounds={n: (p.lo, p.hi) for n, p in spec.params.items()},
-                     priors={n: p.prior for n, p in spec.params.items()})
+                     priors={n: p.prior for n, p in spec.params.items()},
+                     family=spec.family, notes=spec.notes)
 
 
 def _check_points(lik: Likelihood, ndim: int):

@@ -36,8 +36,9 @@ import math
 import numpy as np
 
 import gonio
+from analysis.families import family_of
 from analysis.fit.driver import with_nuisance
-from analysis.fit.posterior import FabricModel, LogPosterior
+from analysis.fit.posterior import LogPosterior, forward_model
 from analysis.fit.workflow import fit_spec
 from analysis.likelihood import Likelihood, is_grey
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec
@@ -271,9 +272,13 @@ def _noise_at_start(spec: ParamSpec, lik: Likelihood, logpost: LogPosterior) -> 
 
 def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
     """The candidates of :func:`suggest_free`: ``free`` / ``ties`` / ``toml`` as
-    :func:`analysis.fit.fit_spec` takes them when given; otherwise the default free set
-    (:data:`analysis.params.DEFAULT_FREE` and its ties) plus both threads' albedos for an
-    RGB table (a grey table cannot tell the channels apart)."""
+    :func:`analysis.fit.fit_spec` takes them when given; otherwise for the microcylinder the
+    default free set (:data:`analysis.params.DEFAULT_FREE` and its ties) plus both threads'
+    albedos for an RGB table (a grey table cannot tell the channels apart), for a baseline
+    model its default free set for the table (every parameter, with
+    :meth:`analysis.families.ModelFamily.default_free`'s identifiability choices)."""
+    if not family_of(fabric).is_microcylinder:
+        return fit_spec(fabric, free, ties, toml, table=table)
     if free is None and toml is None:
         free = list(DEFAULT_FREE)
         ties = list(DEFAULT_TIES) if ties is None else ties
@@ -314,5 +319,5 @@ def suggest_for_file(path, fabric, free=None, ties=None, toml=None, *, read_opti
     if free is not None or toml is not None:
         fit_spec(fabric, free, ties, toml)      # a bad free set, tie or spec: before reading
     table = gonio.read(path, **dict(read_options or {}))
-    return suggest_free(table, fabric, FabricModel(fabric, table.wi, table.wo), free, ties,
+    return suggest_free(table, fabric, forward_model(fabric, table.wi, table.wo), free, ties,
                         toml, likelihood=likelihood, nu=nu)

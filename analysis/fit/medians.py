@@ -1,5 +1,9 @@
 """The fabric of a fit's posterior medians: what ``microcyl export`` writes for a renderer.
 
+A fit of a baseline model (``microcyl fit --model lambert``) gives that model at its medians
+(a :class:`brdf.baselines.BaselineModel`, :attr:`MedianFabric.fabric`) in the same way;
+:attr:`MedianFabric.model_name` says which model it is.
+
 A fit folder holds ``results.json`` (each free parameter's median) and ``fit_config.json``
 (the preset, the options, the spec: fixed values and ties). :func:`median_fabric` puts them
 together: free parameters at their medians, tied ones from their sources, fixed ones at the
@@ -17,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 import brdf
+from analysis.families import family
 from analysis.fit.checkpoint import CONFIG_FILE, read_config
 from analysis.fit.results import read_results
 from brdf import schema
@@ -31,13 +36,14 @@ class FitModel:
 
     Attributes
     ----------
-    fabric : brdf.Fabric
-        The median fabric (tangent offsets already scaled by ``tangent_scale``).
+    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+        The median fabric (tangent offsets already scaled by ``tangent_scale``), or the
+        median baseline model.
     scale : float
         The fit's overall factor on f_r (its ``scale`` parameter; 1 for absolute data).
     """
 
-    fabric: brdf.Fabric
+    fabric: object
     scale: float = 1.0
 
     def eval(self, wi, wo) -> np.ndarray:
@@ -52,9 +58,11 @@ class MedianFabric:
 
     Attributes
     ----------
-    fabric : brdf.Fabric
-        Named after the preset the fit started from, with the fit's options.
-    preset : str
+    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+        Named after the preset the fit started from, with the fit's options (a fit of a
+        baseline model: that model at the medians).
+    preset : str or None
+        None for a baseline model.
     values : dict
         Every parameter's value (natural units: degrees for gammas): medians of the free
         ones, the rest fixed or tied.
@@ -62,13 +70,21 @@ class MedianFabric:
         The fit's free parameters.
     converged : bool or None
         The fit's verdict (``results.json``).
+    model_name : str
+        The model fitted (``microcylinder`` or a baseline's name).
     """
 
-    fabric: brdf.Fabric
-    preset: str
+    fabric: object
+    preset: str | None
     values: dict
     free: tuple
     converged: bool | None
+    model_name: str = "microcylinder"
+
+    @property
+    def is_fabric(self) -> bool:
+        """Whether this is a microcylinder fabric (not a baseline model)."""
+        return self.model_name == "microcylinder"
 
     @property
     def scale(self) -> float:
@@ -92,6 +108,7 @@ def _config(folder: Path) -> dict:
     extra = cfg.get("extra", {})   # `microcyl fit` and fit-batch: fabric; fit-measured: preset
     preset = extra.get("fabric")
     return {"preset": extra.get("preset") if preset is None else preset,
+            "model": cfg.get("model", "microcylinder"),
             "options": dict(extra.get("options") or {}),
             "params": spec["params"], "ties": spec.get("ties", {}),
             "free": tuple(spec["free"])}
@@ -133,19 +150,19 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
     cfg = _config(folder)
     if preset is not None:
         cfg["preset"] = preset
+    try:
+        fam = family(cfg["model"])
+    except ValueError as exc:
+        raise ValueError(f"{folder / CONFIG_FILE}: config.model: {exc}") from None
+    if results["model"] != fam.name:
+        raise ValueError(f"{folder}: results.json is a fit of model {ascii(results['model'])}"
+                         f", {CONFIG_FILE} of {fam.name}")
+    if not fam.is_microcylinder:
+        return _median_baseline(folder, fam, cfg, results)
     if cfg["preset"] not in brdf.PRESETS:
         raise ValueError(f"{folder / CONFIG_FILE}: cannot tell which preset was fitted "
                          f"({cfg['preset']!r}); name it")
-    medians = results.get("parameters", {})
-    values = {name: float(p["default"]) for name, p in cfg["params"].items()}
-    missing = [n for n in cfg["free"] if n not in medians]
-    if missing:
-        raise ValueError(f"{folder / 'results.json'}: no median for free parameter(s) "
-                         f"{', '.join(missing)}")
-    values.update({n: float(medians[n]["median"]) for n in cfg["free"]})
-    _check_magnitudes(folder, values, cfg["free"])
-    for target, (source, kind) in cfg["ties"].items():
-        values[target] = values[source] if kind == "equal" else 1.0 - values[source]
+    values = _values(folder, cfg, results)
     threads = []
     for j, t in enumerate(brdf.preset_threads(cfg["preset"]), start=1):
         change = {q: values[f"{q}{j}"] for q in schema.SCALAR_PARAMS if f"{q}{j}" in values}
@@ -165,3 +182,34 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{folder / CONFIG_FILE}: config.extra.options: {exc}") from None
     return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))
+
+
+def _values(folder: Path, cfg: dict, results: dict) -> dict:
+    """Every parameter's value: medians of the free ones, fixed ones at their defaults,
+    tied ones from their sources."""
+    medians = results.get("parameters", {})
+    values = {name: float(p["default"]) for name, p in cfg["params"].items()}
+    missing = [n for n in cfg["free"] if n not in medians]
+    if missing:
+        raise ValueError(f"{folder / 'results.json'}: no median for free parameter(s) "
+                         f"{', '.join(missing)}")
+    values.update({n: float(medians[n]["median"]) for n in cfg["free"]})
+    _check_magnitudes(folder, values, cfg["free"])
+    for target, (source, kind) in cfg["ties"].items():
+        values[target] = values[source] if kind == "equal" else 1.0 - values[source]
+    return values
+
+
+def _median_baseline(folder: Path, fam, cfg: dict, results: dict) -> MedianFabric:
+    """A baseline model's fit at its medians."""
+    missing = [n for n in fam.model_names if n not in cfg["params"]]
+    if missing:
+        raise ValueError(f"{folder / CONFIG_FILE}: config.spec.params: no value of "
+                         f"{', '.join(missing)} (parameters of model {fam.name})")
+    values = _values(folder, cfg, results)
+    try:
+        model = fam.build(values)
+    except ValueError as exc:
+        raise ValueError(f"{folder}: the fit's values make no valid {fam.name} model "
+                         f"({exc})") from None
+    return MedianFabric(model, None, values, cfg["free"], results.get("converged"), fam.name)

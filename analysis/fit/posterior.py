@@ -14,9 +14,10 @@ import numpy as np
 
 from analysis.likelihood import Likelihood
 from analysis.params import ParamSpec
+from brdf.baselines import BaselineModel
 from brdf.shading import shade_dtype
 
-__all__ = ["FabricModel", "LogPosterior"]
+__all__ = ["FabricModel", "BaselineForward", "forward_model", "LogPosterior"]
 
 
 class FabricModel:
@@ -65,6 +66,31 @@ class FabricModel:
         return out.reshape(batch + out.shape[1:])
 
 
+class BaselineForward:
+    """Forward model of a baseline model (:class:`brdf.baselines.BaselineModel`) at fixed
+    pairs: ``model.prepare(wi, wo)``, called with its batched keyword arguments (scalars
+    (B...), RGB ones (B..., 3); :meth:`analysis.families.BaselineFamily.model_kwargs`) ->
+    f_r (B..., n, 3) in 1/sr, float64 (baselines shade in float64 only, so it offers no
+    ``with_dtype``)."""
+
+    def __init__(self, model: BaselineModel, wi, wo):
+        self.model = model
+        self.wi = np.asarray(wi, dtype=np.float64)
+        self.wo = np.asarray(wo, dtype=np.float64)
+        self.prep = model.prepare(self.wi, self.wo)
+
+    def __call__(self, **kw) -> np.ndarray:
+        return self.prep.eval(**kw)
+
+
+def forward_model(obj, wi, wo):
+    """The forward model of a model object at pairs (wi, wo): a :class:`FabricModel` of a
+    :class:`brdf.Fabric`, a :class:`BaselineForward` of a baseline model."""
+    if isinstance(obj, BaselineModel):
+        return BaselineForward(obj, wi, wo)
+    return FabricModel(obj, wi, wo)
+
+
 class _Count:
     """A count shared by threads (and by a posterior and its :meth:`~LogPosterior.with_model`
     copies)."""
@@ -96,8 +122,9 @@ class LogPosterior:
         names = set(spec.free) | set(spec.ties)
         self.use_scale = "scale" in names or spec.params["scale"].default != 1.0
         self.use_noise = "log_noise" in names
-        self.use_tangent = bool({"tangent_scale1", "tangent_scale2"} & names) or any(
-            spec.params[f"tangent_scale{j}"].default != 1.0 for j in (1, 2))
+        tangent = [f"tangent_scale{j}" for j in (1, 2) if f"tangent_scale{j}" in spec.params]
+        self.use_tangent = bool(set(tangent) & names) or any(
+            spec.params[n].default != 1.0 for n in tangent)
 
     @property
     def n_evals(self) -> int:

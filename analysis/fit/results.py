@@ -2,7 +2,8 @@
 
 ``results.json`` (schema ``microcyl-fit``, version :data:`SCHEMA_VERSION`)::
 
-    {"schema": "microcyl-fit", "schema_version": 2,
+    {"schema": "microcyl-fit", "schema_version": 2, "model": "microcylinder",
+     "identifiability": ["grey table: base_g and base_b tied to base_r ...", ...],
      "converged": true, "reason": "converged at step 350: ...",
      "adequate": false, "adequate_reason": "residuals differ between ...",
      "warnings": [{"kind": "at_bound", "parameters": ["eta1"], "message": "..."}, ...],
@@ -20,7 +21,10 @@
 ``loo`` is the PSIS-LOO of the fit (:mod:`analysis.fit.loo`; its pointwise values in
 ``loo.npz``), ``quality["loo_pit"]`` the uniformity test of its LOO-PIT.
 
-``converged`` is the sampler's verdict; ``adequate`` (true, false or null) whether the model
+``model`` names the model fitted (:func:`analysis.families.model_names`; a file written
+before models were named reads as ``microcylinder``), ``identifiability`` the choices its
+default free set made for this table (:meth:`analysis.families.ModelFamily.default_free`;
+empty when none). ``converged`` is the sampler's verdict; ``adequate`` (true, false or null) whether the model
 describes the data (:mod:`analysis.fit.adequacy`); ``warnings`` what the answer cannot be
 trusted for (:mod:`analysis.fit.trust`). Intervals are central (68%: 15.9-84.1 percentiles),
 in each parameter's natural unit.
@@ -178,6 +182,8 @@ class FitResult:
             quality["adequacy"] = self.adequacy
         doc = {
             "schema": "microcyl-fit", "schema_version": SCHEMA_VERSION,
+            "model": "microcylinder" if self.spec is None else self.spec.model,
+            "identifiability": [] if self.spec is None else list(self.spec.notes),
             "converged": bool(self.converged), "reason": self.reason,
             "adequate": self.adequacy.get("adequate"),
             "adequate_reason": self.adequacy.get("reason", "not checked"),
@@ -288,6 +294,8 @@ def check_results(doc: dict, path) -> dict:
     f = FileFields(path)
     f.boolean(doc, "converged", none=True)
     f.string(doc, "reason", default="")
+    doc.setdefault("model", "microcylinder")        # written before models were named
+    f.string(doc, "model")
     params = f.mapping(doc, "parameters")
     for name in params:
         where = f"parameters.{name}"

@@ -149,9 +149,12 @@ def correlated(result) -> list[dict]:
     return out
 
 
-def _typical(name: str):
+def _typical(name: str, spec=None):
     """brdf.schema's plausible range of a fit parameter (its typical range where it gives
-    none); None for the fit's own parameters (scale, noise, tangent scales)."""
+    none); None for the fit's own parameters (scale, noise, tangent scales). For a baseline
+    model's fit (``spec.family``) its ParamInfo's plausible range, or None."""
+    if spec is not None and not spec.family.is_microcylinder:
+        return spec.family.plausible(name)
     base, _ = base_of(name)
     info = schema.THREAD.get(base) or schema.THREAD.get(base.rsplit("_", 1)[0])
     return None if info is None else (info.plausible or info.typical)
@@ -161,7 +164,7 @@ def implausible(result) -> list[dict]:
     """``implausible`` warnings: medians outside brdf.schema's plausible (or typical) range."""
     out = []
     for name in result.names:
-        typical = _typical(name)
+        typical = _typical(name, result.spec)
         if typical is None:
             continue
         s = result.summary[name]

@@ -12,31 +12,40 @@ from analysis.budget import check_fit_rows
 from analysis.fit.checkpoint import table_digest
 from analysis.fit.driver import FitOptions, fit
 from analysis.fit.loo import psis_loo
-from analysis.fit.posterior import FabricModel
+from analysis.families import family_of
+from analysis.fit.posterior import forward_model
 from analysis.fit.quality import fit_quality
 from analysis.fit.results import FitResult, write_results
 from analysis.folderlock import output_lock
-from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec, defaults_from_fabric
+from analysis.likelihood import is_grey, is_relative
+from analysis.params import ParamSpec
 
 __all__ = ["fit_fabric", "fit_spec", "check_fit_size"]
 
 
-def fit_spec(fabric, free=None, ties=None, toml=None) -> ParamSpec:
+def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
     """The parameter spec of a fit as ``microcyl fit`` builds it from its options.
 
     Parameters
     ----------
-    fabric : brdf.Fabric
-        Gives the defaults (fixed values and the start).
+    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+        The model fitted (its family, :func:`analysis.families.family_of`); gives the
+        defaults (fixed values and the start).
     free : str or sequence of str, optional
         Free parameters (comma-separated or a sequence); a name ending in ``.toml`` is a spec
-        file. Default :data:`analysis.params.DEFAULT_FREE`.
+        file. Default the family's default free set
+        (:meth:`analysis.families.ModelFamily.default_free`: the microcylinder's
+        :data:`analysis.params.DEFAULT_FREE`; every parameter of a baseline, with the
+        identifiability choices for a grey or relative ``table``).
     ties : sequence of str, optional
         ``"a=b"`` / ``"a=1-b"`` ties (each item may hold several, comma-separated; ``"none"``
-        is dropped). Default :data:`analysis.params.DEFAULT_TIES` when neither ``free`` nor
-        ``toml`` is given, none otherwise.
+        is dropped). Default the family's default ties when neither ``free`` nor ``toml`` is
+        given, none otherwise.
     toml : path, optional
         A TOML spec (:meth:`ParamSpec.from_toml`); ``free`` and ``ties`` are added to it.
+    table : gonio.Table, optional
+        The table to be fitted: whether it is grey or relative decides a baseline's default
+        free set (without it: neither).
 
     Returns
     -------
@@ -47,19 +56,27 @@ def fit_spec(fabric, free=None, ties=None, toml=None) -> ParamSpec:
     >>> import brdf
     >>> fit_spec(brdf.fabric("silk_crepe_de_chine"), "kd1,gamma_s1").free
     ('kd1', 'gamma_s1')
+    >>> from brdf.baselines import Lambert
+    >>> fit_spec(Lambert()).free
+    ('base_r', 'base_g', 'base_b')
     """
-    defaults = defaults_from_fabric(fabric)
+    fam = family_of(fabric)
+    defaults = fam.defaults(fabric)
     if ties is not None:
         ties = [t for item in ties for t in str(item).split(",")
                 if t.strip() and t.strip().lower() != "none"]
     if isinstance(free, str) and free.lower().endswith(".toml"):
         toml, free = free, None
-    if ties is None and free is None and toml is None:
-        ties = list(DEFAULT_TIES)
+    notes = ()
+    if free is None and toml is None:
+        grey = table is not None and is_grey(table.values)
+        relative = table is not None and is_relative(getattr(table, "meta", {}))
+        free, default_ties, notes = fam.default_free(grey=grey, relative=relative)
+        if ties is None:
+            ties = list(default_ties)
     if toml is not None:
-        return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties)
-    return ParamSpec(free if free is not None else DEFAULT_FREE, defaults=defaults,
-                     ties=ties or ())
+        return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties, family=fam)
+    return ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes)
 
 
 def check_fit_size(path, spec: ParamSpec, walkers: int | None = None, **read_options) -> None:
@@ -98,15 +115,17 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     Parameters
     ----------
     table : gonio.Table
-    fabric : brdf.Fabric
-        The fabric whose parameters ``spec`` fixes and whose geometry is evaluated.
+    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+        The model whose parameters ``spec`` fixes and whose geometry is evaluated (of the
+        spec's family).
     spec : analysis.params.ParamSpec
     out_dir : path
         Output folder.
     plots : callable, optional
         ``plots(result, table, model_factory, out_dir) -> {name: path}`` (for example
         ``reports.plots.fit_diagnostics.write_fit_plots``); ``model_factory(wi, wo)`` is a
-        :class:`~analysis.fit.posterior.FabricModel` of the fabric at other pairs.
+        forward model (:func:`~analysis.fit.posterior.forward_model`) of the model at
+        other pairs.
     **fit_kw
         Passed to :func:`analysis.fit.fit`.
 
@@ -116,8 +135,11 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         With ``quality``, ``loo``, ``warnings`` and ``plots`` filled in.
     """
     out = Path(out_dir)
+    if family_of(fabric) is not spec.family:
+        raise ValueError(f"the spec is of model {spec.model}, the start of model "
+                         f"{family_of(fabric).name}")
     with output_lock(out, "fit"):
-        result = fit(table, spec, FabricModel(fabric, table.wi, table.wo), out_dir=out,
+        result = fit(table, spec, forward_model(fabric, table.wi, table.wo), out_dir=out,
                      **fit_kw)
         result.quality = fit_quality(result, table)
         t0 = time.perf_counter()
@@ -127,7 +149,7 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         result.warnings = [*result.warnings, *result.loo.warnings()]
         result.loo.save(out)
         if plots is not None:
-            files = plots(result, table, lambda wi, wo: FabricModel(fabric, wi, wo), out)
+            files = plots(result, table, lambda wi, wo: forward_model(fabric, wi, wo), out)
             result.plots = {k: Path(v).name for k, v in files.items()}
         write_results(result, out)
     return result

@@ -48,6 +48,9 @@ def run(args) -> int:
     """Check the output, resolve the fabric, write its plugin dictionary, print a summary."""
     out = cliutil.check_output_suffix(args.output, SUFFIXES)
     src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
+    if not src.is_fabric:
+        raise ValueError(f"export writes the microcylinder plugin's fabric; {src.label} is "
+                         f"{src.what} (exporting baseline models is not supported yet)")
     write_fabric_file(out, src.brdf, src.preset)
     log.info("wrote %s", out)
     if src.kind == "fit":

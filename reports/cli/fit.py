@@ -1,8 +1,11 @@
 """The ``microcyl fit`` verb: Bayesian parameter estimation from a BRDF table.
 
 ``microcyl fit TABLE --fabric PRESET [--free eta1,kd1,...] [--tie eta2=eta1] -o DIR``
+``microcyl fit TABLE --model lambert|... [--free base,...] -o DIR``
 
-The preset gives the fixed values and the starting point. Writes ``DIR/results.json`` and
+The preset gives the fixed values and the starting point (``--model microcylinder``, the
+default); a baseline model (:mod:`brdf.baselines`) starts from its parameters' typical values
+and takes no preset. Writes ``DIR/results.json`` and
 ``DIR/results.csv`` (medians, 68%/95% intervals, tau, R-hat, ESS, verdict), the plots, and the
 checkpoint ``DIR/checkpoint.h5``; the same command run again resumes from it. The work is
 :func:`analysis.fit.fit_fabric`; this module parses the arguments and prints.
@@ -14,9 +17,10 @@ import sys
 from pathlib import Path
 
 import brdf
+from analysis.families import MICROCYLINDER, family, model_names
 from analysis.fit import fit_fabric, fit_spec
-from analysis.fit.workflow import check_fit_size
 from analysis.fit.fisher import suggest_for_file
+from analysis.fit.workflow import check_fit_size
 from analysis.fit.loo import HIGH_K
 from reports.cli import lazy
 from reports.cli import options as cliutil
@@ -34,13 +38,19 @@ def register(sub):
     """Add ``fit`` to the ``microcyl`` sub-parsers."""
     p = sub.add_parser(
         "fit", help="estimate model parameters from a BRDF table (emcee)",
-        description="Fit the microcylinder model to a BRDF table: point estimate, then several "
+        description="Fit the microcylinder model (or a baseline model, --model) to a BRDF "
+                    "table: point estimate, then several "
                     "independent emcee ensembles until every parameter has N > 50 tau, tau is "
                     "stable and R-hat < 1.01, or a step limit. Resumes from DIR's checkpoints.")
     p.add_argument("table", metavar="TABLE", help="table file (.exr, .csv, .binary, .alta, "
                                                   ".bsdf, CUReT abrdf.dat with --sample)")
-    p.add_argument("--fabric", required=True, metavar="PRESET",
-                   help=f"preset giving fixed values and the start: {', '.join(brdf.PRESETS)}")
+    p.add_argument("--model", default=MICROCYLINDER, choices=model_names(),
+                   help="the model fitted (default microcylinder); a baseline model "
+                        "starts from its parameters' typical values and takes no --fabric")
+    p.add_argument("--fabric", default=None, metavar="PRESET",
+                   help=f"preset giving fixed values and the start (required for the "
+                        f"microcylinder, refused for another model): "
+                        f"{', '.join(brdf.PRESETS)}")
     cliutil.add_fit_options(p)
     p.add_argument("--sample", type=int, default=None, metavar="N",
                    help="CUReT sample number (for abrdf.dat)")
@@ -58,31 +68,61 @@ def register(sub):
     p.set_defaults(func=run)
 
 
-def _spec_from_args(args, fab):
-    return fit_spec(fab, args.free, cliutil.split_ties(args.tie), args.spec)
+def _spec_from_args(args, fab, table=None):
+    return fit_spec(fab, args.free, cliutil.split_ties(args.tie), args.spec, table=table)
+
+
+def start_model(args):
+    """The model a fit starts from: the preset ``--fabric`` with the variant flags for the
+    microcylinder, a baseline model at its typical values otherwise; one line for
+    ``--fabric`` (or a variant flag) with a baseline, or no ``--fabric`` for the
+    microcylinder."""
+    fam = family(args.model)
+    if fam.is_microcylinder:
+        if args.fabric is None:
+            raise ValueError("--fabric PRESET is required for --model microcylinder (the "
+                             f"preset gives the fixed values and the start): "
+                             f"{', '.join(brdf.PRESETS)}")
+        return cliutil.fabric_from_args(brdf.check_preset(args.fabric), args)
+    if args.fabric is not None:
+        raise ValueError(f"--fabric applies to --model microcylinder only; --model "
+                         f"{fam.name} starts from its own typical values (drop --fabric)")
+    given = cliutil.fabric_options(args)
+    if given:
+        raise ValueError(f"--model {fam.name} takes no fabric variant option "
+                         f"({', '.join(sorted(given))}): they belong to the microcylinder")
+    return fam.start()
+
+
+def _config_extra(args, fab) -> dict:
+    """What the fit records of its start (and matches on resume)."""
+    if args.model != MICROCYLINDER:
+        return {"sample": args.sample}
+    return {"fabric": args.fabric, "options": fab.options, "sample": args.sample}
 
 
 def run(args) -> int:
     """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
-    brdf.check_preset(args.fabric)
+    fab = start_model(args)
     fit_kw = cliutil.fit_kwargs(args)
     if args.suggest:
-        return _suggest(args, fit_kw)
+        return _suggest(args, fit_kw, fab)
     if args.output is None:
         raise ValueError("-o/--output DIR is required (unless --suggest)")
-    fab = cliutil.fabric_from_args(args.fabric, args)
     spec = _spec_from_args(args, fab)
     check_fit_size(args.table, spec, args.walkers,
                    **cliutil.reader_options(args.table, sample=args.sample))
     out = cliutil.check_writable_dir(Path(args.output))
     table = read_table(args.table, args.sample)
+    spec = _spec_from_args(args, fab, table)     # a baseline's default free set: the table's
     plots = None
     if not args.no_plots:
         plots = lazy.plots().fit_diagnostics.write_fit_plots
     result = fit_fabric(
         table, fab, spec, out, plots=plots, progress=cliutil.progress(args), **fit_kw,
         notify=lambda line: print(line, file=sys.stderr, flush=True),
-        config_extra={"fabric": args.fabric, "options": fab.options, "sample": args.sample})
+        config_extra=_config_extra(args, fab))
+    print(f"model: {spec.model}" + "".join(f"; {n}" for n in spec.notes))
     print(format_summary(result))
     print(format_warnings(result))
     q = result.quality
@@ -98,10 +138,9 @@ def run(args) -> int:
     return 0
 
 
-def _suggest(args, fit_kw) -> int:
+def _suggest(args, fit_kw, fab) -> int:
     """``--suggest``: :func:`analysis.fit.fisher.suggest_for_file`, printed; no sampling,
     nothing written."""
-    fab = cliutil.fabric_from_args(args.fabric, args)
     given = cliutil.reader_options(args.table, sample=args.sample)
     report, kept = suggest_for_file(args.table, fab, args.free, cliutil.split_ties(args.tie),
                                     args.spec, read_options=given,

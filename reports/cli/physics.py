@@ -10,6 +10,7 @@ import brdf
 from analysis import sources
 from analysis.energy import VARIANTS, EnergyReport
 from analysis.plausibility import energy_document, reciprocity_document, sanity_results
+from analysis.variants import Named
 from reports.cli import options as cliutil
 from reports.prose import energy_statements, energy_summary, reciprocity_statements
 
@@ -25,11 +26,21 @@ def _sources(args, tables: bool = False) -> list:
     return [cliutil.source_from_args(text, args, tables=tables)]
 
 
+def _named(s):
+    """A source for :mod:`analysis.energy` and :mod:`analysis.reciprocity`: a preset by its
+    name, another fabric named by its label, a fit of a baseline model as a
+    :class:`analysis.variants.Named` BRDF (the default variant only)."""
+    if s.kind == "preset":
+        return s.label
+    if s.is_fabric:
+        return s.brdf.replace(name=s.label)
+    return Named(s.label, s.brdf, s.model)
+
+
 def _presets(args) -> tuple:
     """The fabrics of the FABRIC argument for :mod:`analysis.energy` and
-    :mod:`analysis.reciprocity`: a preset by its name, another fabric named by its label."""
-    return tuple(s.label if s.kind == "preset" else s.brdf.replace(name=s.label)
-                 for s in _sources(args))
+    :mod:`analysis.reciprocity` (:func:`_named`)."""
+    return tuple(_named(s) for s in _sources(args))
 
 
 def _variants(text: str | None):
@@ -225,9 +236,8 @@ def format_reciprocity(rep: dict) -> str:
 def run_reciprocity(args) -> int:
     """``microcyl reciprocity``."""
     chosen = _sources(args, tables=True)
-    presets = tuple(s.label if s.kind == "preset" else s.brdf.replace(name=s.label)
-                    for s in chosen if s.is_fabric)
-    tables = [(s.label, s.brdf) for s in chosen if not s.is_fabric]
+    presets = tuple(_named(s) for s in chosen if s.kind != "table")
+    tables = [(s.label, s.brdf) for s in chosen if s.kind == "table"]
     variants = _variants(args.variants)
     if args.n < 1:
         raise ValueError(f"-n must be >= 1; got {args.n}")

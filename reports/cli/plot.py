@@ -197,10 +197,10 @@ def fitted_model(fit, preset=None):
     """The model of a fit at its posterior medians, to draw against its table, and its label:
     the median fabric (tangent offsets scaled by the fit's ``tangent_scale``) times the fit's
     overall ``scale`` (:attr:`analysis.fit.MedianFabric.model`); the label names the preset
-    and a scale other than 1."""
+    (a baseline model's fit: the model) and a scale other than 1."""
     m = _medians(fit, preset)
     scale = "" if m.scale == 1.0 else f", × {m.scale:.3g}"
-    return m.model, f"fit ({m.preset}{scale})"
+    return m.model, f"fit ({m.preset if m.is_fabric else m.model_name}{scale})"
 
 
 def _models(args) -> dict:
@@ -214,6 +214,10 @@ def _models(args) -> dict:
 def run_plot(args):
     _check(args)
     models = _models(args)
+    others = [label for label, b in models.items() if not isinstance(b, brdf.Fabric)]
+    if args.view == "masking" and others:
+        raise ValueError(f"masking: {', '.join(others)} is no microcylinder fabric (a fit of "
+                         f"a baseline model): the view switches the microcylinder's masking")
     plot_views, save_figure = lazy.plots().views, lazy.plots().common.save_figure
 
     opts = dict(channel=args.channel, theta_i=args.theta_i, planes=args.plane,

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import brdf
+from brdf.baselines import BaselineModel
 from analysis.folderlock import output_lock
 from gonio.atomic import file_mode
 from gonio.progress import progress_bar
@@ -125,8 +126,14 @@ def _run_info(reports, quality: str, command: str | None, generated: str) -> dic
 
 def _fabric_header(rep: FabricReport, colour, run: dict) -> Markup:
     e = rep.data(EnergyData)
-    lede = html("{} of the microcylinder cloth model (Sadeghi et al. 2013); energy: {}.",
-                "A preset fabric" if rep.name in brdf.PRESETS else "A fabric", 
+    if isinstance(rep.fabric, brdf.Fabric):
+        what = ("A preset fabric" if rep.name in brdf.PRESETS else "A fabric") \
+            + " of the microcylinder cloth model (Sadeghi et al. 2013)"
+    elif isinstance(rep.fabric, BaselineModel):
+        what = f"A fit of the baseline model {rep.fabric.name} (not the microcylinder)"
+    else:
+        what = "A BRDF that is no microcylinder fabric"
+    lede = html("{}; energy: {}.", what,
                 e.verdict() if e is not None else "not computed (no energy section)")
     return run_header(rep.name, lede, run, swatch(colour))
 

@@ -37,7 +37,7 @@ def can_unmask(fab) -> bool:
         return False
     try:
         replace(masking=False)
-    except TypeError:
+    except (TypeError, ValueError):      # no such option (a baseline model: ValueError)
         return False
     return True
 

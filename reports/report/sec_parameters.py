@@ -6,6 +6,7 @@ import dataclasses
 from typing import Any
 
 from brdf import schema
+from brdf.baselines import BaselineModel
 from reports.report.markup import fmt, html, plain_json, table
 from reports.report.page import Page
 from reports.report.settings import Section
@@ -24,11 +25,15 @@ def parameters_of(fab) -> dict:
     """Plain data of a BRDF's threads (the :data:`THREAD_FIELDS`) and options.
 
     A BRDF without threads or options (a measured table, a user's analytic model) gives an
-    empty list and dict.
+    empty list and dict; a baseline model (:mod:`brdf.baselines`) adds ``model`` (its name)
+    and ``values`` (its parameters).
     """
     threads = [{f: plain_json(getattr(t, f, None)) for f in THREAD_FIELDS}
                for t in getattr(fab, "threads", ()) or ()]
-    return {"threads": threads, "options": plain_json(dict(getattr(fab, "options", {}) or {}))}
+    out = {"threads": threads, "options": plain_json(dict(getattr(fab, "options", {}) or {}))}
+    if isinstance(fab, BaselineModel):
+        out.update(model=fab.name, values=plain_json(fab.params()))
+    return out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,6 +55,15 @@ def section_parameters(p: Page) -> Section:
     """Thread table, options and f_r at :data:`reports.standard.STANDARD_GEOMETRIES`."""
     params = parameters_of(p.fabric)
     link = p.json("parameters.json", params)
+    if "model" in params:
+        values = standard_values(p.fabric)
+        rows = [[q.name, ", ".join(fmt(x) for x in v) if isinstance(v, (list, tuple))
+                 else fmt(v), q.unit, q.description]
+                for q, v in zip(type(p.fabric).PARAMS, params["values"].values())]
+        return Section(html("<p>The baseline model <b>{}</b> (not the microcylinder).</p>{}"
+                            "<p>Data: {}</p>", params["model"],
+                            table(["parameter", "value", "unit", "meaning"], rows), link),
+                       ParametersData(params, values))
     if not params["threads"]:
         return Section(html("<p>This BRDF exposes no threads.</p><p>Data: {}</p>", link),
                        ParametersData(params, None))

@@ -166,3 +166,19 @@ def test_a_hostile_models_entry_is_escaped_or_refused(tmp_path):
         (tmp_path / "measured.json").write_text(json.dumps(bad))
         with pytest.raises(ValueError, match="models: name .* refused"):
             read_measured(tmp_path)
+
+
+def test_fit_batch_fits_a_baseline_model(fits, tmp_path):
+    """`fit-batch --model lambert` (options after the inputs, in any order) fits every table by
+    the model and records it; --fabric with a baseline and a microcylinder batch without
+    --fabric are one-line refusals."""
+    r = microcyl("fit-batch", fits / "lam.csv", "-o", tmp_path / "b", *SHORT, "--model",
+                 "lambert", "--workers", "1", "--no-plots")
+    assert r.returncode == 0, r.stderr
+    doc = json.loads((tmp_path / "b" / "lam" / "results.json").read_text())
+    assert doc["model"] == "lambert" and set(doc["parameters"]) == {"base_r", "base_g", "base_b"}
+    for args, message in ((["--model", "lambert", "--fabric", "velvet"], "--fabric applies"),
+                          ([], "--fabric PRESET is required")):
+        r = microcyl("fit-batch", fits / "lam.csv", "-o", tmp_path / "c", *args)
+        assert r.returncode != 0 and message in r.stderr, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1, r.stderr

@@ -252,17 +252,18 @@ def _override(job: BatchJob, folder: Path, stem: str) -> BatchJob:
     return dataclasses.replace(job, spec=str(toml), free=None, ties=(), preset=preset)
 
 
-def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, samples=None,
-                     fit=None, fabric_options=None, read_options=None,
-                     plots=None) -> list[BatchJob]:
+def jobs_from_inputs(inputs, *, preset: str | None, free=None, ties=None, spec=None,
+                     samples=None, fit=None, fabric_options=None, read_options=None,
+                     plots=None, model: str = MICROCYLINDER) -> list[BatchJob]:
     """The jobs of a batch, every input and every spec checked before any fit starts.
 
     Parameters
     ----------
     inputs : sequence of str
         Table files, globs or folders.
-    preset : str
-        Preset of every table (a ``NAME.toml`` beside a table may name another).
+    preset : str or None
+        Preset of every table (a ``NAME.toml`` beside a table may name another); None for
+        a baseline ``model`` (which takes none).
     free, ties, spec
         As ``microcyl fit``'s ``--free``, ``--tie``, ``--spec``.
     samples : str or sequence of int, optional
@@ -270,6 +271,8 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
     fit, fabric_options, read_options : dict, optional
         Fit options, Fabric options, reader options (see :class:`BatchJob`).
     plots : callable, optional
+    model : str
+        The model fitted to every table (:func:`analysis.families.model_names`).
 
     Returns
     -------
@@ -283,9 +286,11 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
         A missing input, a file gonio cannot read, CUReT without samples, an unknown preset,
         or a spec with unknown parameters (naming the table).
     """
-    brdf.check_preset(preset)
+    family(model)                                         # an unknown model: one line
+    if model == MICROCYLINDER:
+        brdf.check_preset(preset)
     sample_list = parse_samples(samples)
-    base = dict(preset=preset, free=None if free is None else tuple(free),
+    base = dict(model=model, preset=preset or BatchJob.preset, free=None if free is None else tuple(free),
                 ties=None if ties is None else tuple(ties), spec=spec, fit=dict(fit or {}),
                 fabric_options=dict(fabric_options or {}),
                 read_options=dict(read_options or {}), plots=plots)
@@ -316,7 +321,8 @@ def jobs_from_inputs(inputs, *, preset: str, free=None, ties=None, spec=None, sa
 def _check(job: BatchJob) -> None:
     """The preset, its options and the spec of a job, or a ValueError naming the table."""
     try:
-        brdf.check_preset(job.preset)
+        if job.model == MICROCYLINDER:
+            brdf.check_preset(job.preset)
         job.param_spec()
     except ValueError as exc:
         raise ValueError(f"table {job.name} ({job.path}): {exc}") from None

@@ -63,9 +63,8 @@ class FitOptions:
     shading: str = "float32"
 
     def check(self) -> "FitOptions":
-        """The options that need no free set checked, each by its command-line name (the one
-        rule of ``microcyl fit``, ``fit-batch`` and :meth:`resolve`); ``self`` when all hold,
-        else a ValueError naming the first bad option, its value and what is allowed.
+        """The options that need no free set checked by their command-line names (the one rule
+        of ``fit``, ``fit-batch`` and :meth:`resolve`): ``self``, or a ValueError naming one.
 
         Examples
         --------

@@ -1,7 +1,7 @@
 """The ``microcyl fit-batch`` verb: fit many tables on Dask.
 
 ``microcyl fit-batch INPUT... --fabric PRESET [fit options] [--workers N | --scheduler ADDR]
--o DIR``
+-o DIR``, or ``--model lambert|charlie|ashikhmin|zeltner`` instead of ``--fabric``
 
 Each table is fitted into ``DIR/<name>/`` (resumable); ``DIR/summary.csv`` and
 ``DIR/summary.json`` hold a row per table, and ``DIR/index.html`` links every fit's plots.
@@ -15,8 +15,10 @@ from pathlib import Path
 
 import brdf
 from analysis.batch import jobs_from_inputs, run_batch
+from analysis.families import MICROCYLINDER, model_names
 from reports.cli import lazy
 from reports.cli import options as cliutil
+from reports.cli.fit import start_model
 from reports.report_batch import write_batch_page
 
 __all__ = ["register", "run"]
@@ -34,8 +36,12 @@ def register(sub):
                     "unfinished fits and skips converged ones. A file NAME.toml beside a table "
                     "replaces --spec/--free/--tie (and, with a fabric key, --fabric) for it.")
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="table files, globs or folders")
-    p.add_argument("--fabric", required=True, metavar="PRESET",
-                   help=f"preset giving fixed values and the start: {', '.join(brdf.PRESETS)}")
+    p.add_argument("--model", default=MICROCYLINDER, choices=model_names(),
+                   help="the model fitted to every table (default microcylinder); a baseline "
+                        "model starts from its parameters' typical values and takes no --fabric")
+    p.add_argument("--fabric", default=None, metavar="PRESET",
+                   help=f"preset giving fixed values and the start (required for the "
+                        f"microcylinder, refused for another model): {', '.join(brdf.PRESETS)}")
     cliutil.add_fit_options(p)
     p.add_argument("--sample", default=None, metavar="all|N,N,...",
                    help="CUReT samples of an abrdf.dat input")
@@ -53,17 +59,16 @@ def run(args) -> int:
     """Check everything, run the batch, print the counts; exit 1 when a table failed."""
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be >= 1; got {args.workers}")
-    brdf.check_preset(args.fabric)
+    fab = start_model(args)
     plots = None
     if not args.no_plots:
         plots = lazy.plots().fit_diagnostics.write_fit_plots
-    fab = cliutil.fabric_from_args(args.fabric, args)
     out = cliutil.check_writable_dir(Path(args.output))
     free = args.free.split(",") if args.free and not args.free.endswith(".toml") else args.free
     jobs = jobs_from_inputs(
         args.inputs, preset=args.fabric, free=free, ties=cliutil.split_ties(args.tie),
         spec=args.spec, samples=args.sample, fit=cliutil.fit_kwargs(args),
-        fabric_options=fab.options,
+        fabric_options=getattr(fab, "options", {}), model=args.model,
         read_options={} if args.rgl_step is None else {"step": args.rgl_step},
         plots=plots)
     log.info(f"fit-batch: {len(jobs)} tables into {out}")

@@ -6,7 +6,8 @@ cloth with ``fabric.eval(wi_local, wo_local)`` and everything else as Lambertian
 samples that hit lit cloth reach the BRDF, in batches of one image tile at a time, and tiles
 are spread over the processor cores.  :func:`write_exr` and :func:`write_png` (from
 :mod:`reports.render.imageio`) save the result.  ``render(..., mask=True)`` also returns the cloth's
-coverage (the fraction of each pixel's samples whose first hit is cloth), and
+coverage (the fraction of each pixel's samples whose first hit is metered cloth: the
+cylinder's side, not its caps), and
 :func:`cloth_coverage` traces it alone, for :func:`reports.render.exposure.auto_exposure`.
 
 Shading (direct light only: one key-light sample per camera sample, plus the sky when the
@@ -56,7 +57,7 @@ BRDF_BATCH = 131072
 # --------------------------------------------------------------------------- shading
 def _hits(scene, o, d):
     """The rays' first hits: indices of the rays that hit, points, normals turned toward
-    the viewer, warps, directions to the viewer and primitive indices."""
+    the viewer, warps, directions to the viewer, primitive indices and parts."""
     prims = scene.primitives
     t, pid, part = intersect(prims, o, d, 1e-6 * scene.scale)
     hit = np.nonzero(np.isfinite(t))[0]
@@ -71,7 +72,7 @@ def _hits(scene, o, d):
             n[sel], warp[sel] = prim.frame(p[sel], part[hit][sel])
     flip = np.einsum("ij,ij->i", n, wo) < 0          # two-sided: face the viewer
     n[flip] *= -1
-    return hit, p, n, warp, wo, pid_h
+    return hit, p, n, warp, wo, pid_h, part[hit]
 
 
 def _local(n, warp):
@@ -109,15 +110,16 @@ def _shade(scene, fabric, o, d, rng, sky=None, table=None):
     """Radiance (m, 3) of the rays ``(o, d)``: the key light, plus the sky when the scene has
     an environment light (:mod:`reports.render.envlight`), on the rays of nonzero weight in ``sky =
     (weights (m,), uniform numbers (m, 4))`` (None: every ray, weight 1); and whether each
-    ray's first hit is cloth (m,), as a fourth column. ``table``: the fabric's
+    ray's first hit is metered cloth (m,) (:func:`reports.render.pixelsamples.metered`:
+    the cylinder's side, not its caps), as a fourth column. ``table``: the fabric's
     :class:`reports.render.brdftable.BRDFTable` for the sky (None: cosine directions alone)."""
     out = np.zeros((len(o), 4))
-    hit, p, n, warp, wo, pid_h = _hits(scene, o, d)
+    hit, p, n, warp, wo, pid_h, part_h = _hits(scene, o, d)
     if hit.size == 0:
         return out
     prims = scene.primitives
     cloth = np.array([pr.material == "cloth" for pr in prims])[pid_h]
-    out[hit, 3] = cloth
+    out[hit, 3] = pixelsamples.metered(prims, pid_h, part_h)
     albedo = np.array([0.0 if pr.material == "cloth" else pr.albedo for pr in prims])[pid_h]
     rad = _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng)
     if scene.environment is not None:
@@ -139,8 +141,9 @@ def _shade(scene, fabric, o, d, rng, sky=None, table=None):
     return out
 
 
-def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
-    """The fraction of each pixel's samples (stratified jitter) whose first hit is cloth.
+def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536, metered=True):
+    """The fraction of each pixel's samples (stratified jitter) whose first hit is metered
+    cloth (:func:`reports.render.pixelsamples.metered`: the cylinder's side, not its caps).
 
     The mask of :func:`reports.render.exposure.auto_exposure` for an image rendered elsewhere
     (Mitsuba's): camera rays and the first hit alone, no shading.
@@ -154,6 +157,9 @@ def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
         Seed of the jitter.
     chunk : int
         Rays traced at once.
+    metered : bool
+        Count the metered cloth alone (the exposure's mask); False: any cloth (the
+        cylinder's caps too).
 
     Returns
     -------
@@ -166,7 +172,8 @@ def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
     ((3, 4), 1.0)
     """
     check_size(width, height, spp)
-    return pixelsamples.coverage(scene_of(scene, None, None), width, height, spp, seed, chunk)
+    return pixelsamples.coverage(scene_of(scene, None, None), width, height, spp, seed, chunk,
+                                 metered)
 
 
 def _tiles(width, height, tile):
@@ -245,21 +252,21 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
         Samples of the sky per pixel on cloth, 1 to ``spp`` (default ``spp``): on that many
         of a pixel's samples, spread over its area and weighted ``spp / sky_spp``, each with
         one cosine direction and one from a table of the fabric's ``f_r cos``
-        (:mod:`reports.render.brdftable`, built once per render; numbers stratified over
-        the pixel).  Diffuse
-        surfaces sample the sky on every sample (one cosine direction, stratified over the
-        pixel).  Fewer sky samples make a render of cloth faster: its two shadow rays and
-        two ``fabric.eval`` calls cost most of a sample.
+        (:mod:`reports.render.brdftable`, built once per render), numbers stratified over the
+        pixel.  Diffuse surfaces sample the sky on every sample (one cosine direction).
+        Fewer sky samples make a render of cloth faster: its two shadow rays and two
+        ``fabric.eval`` calls cost most of a sample.
     mask : bool
-        Also return the cloth's coverage (for :func:`reports.render.exposure.auto_exposure`).
+        Also return the coverage of the metered cloth (for
+        :func:`reports.render.exposure.auto_exposure`;
+        :func:`reports.render.pixelsamples.metered`).
 
     Returns
     -------
     (height, width, 3) float32 ndarray
         Linear RGB radiance (W / (m^2 sr) for intensities in W/sr).
     (height, width) float32 ndarray
-        With ``mask=True``, a second value: the fraction of each pixel's samples whose first
-        hit is cloth.
+        With ``mask=True``: the fraction of each pixel's samples that hit metered cloth.
 
     Raises
     ------

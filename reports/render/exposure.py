@@ -35,7 +35,7 @@ __all__ = ["Exposure", "auto_exposure", "parse_exposure", "exr_attributes", "PER
 PERCENTILE = 99.0
 #: Where that percentile lands, linear (sRGB-encoded about 0.95).
 TARGET = 0.9
-#: Largest |stops| accepted: 2**64 already saturates any f_r.
+#: Largest abs(stops) accepted: 2**64 already saturates any f_r.
 MAX_STOPS = 64.0
 
 

@@ -1,6 +1,7 @@
 """Tests of reports.plots.fit_diagnostics: the adequacy figure (residuals against angle, the optional PIT
-histogram, the verdict and warnings as text) and the corner plot a reviewer reads (titles
-apart, whole tick values, a PNG small enough for a page)."""
+histogram, the verdict and warnings as text), the corner plot a reviewer reads (titles
+apart, whole tick values, a PNG small enough for a page) and the lobe plot's note of a band
+thinner than its line (from real fits, one thin and one wide)."""
 
 from types import SimpleNamespace
 
@@ -99,5 +100,47 @@ def test_a_band_thinner_than_its_line_is_noted_and_a_wide_one_is_not():
             ax.plot(th, med)
             assert _note_thin_band(ax, band, np.full(th.shape, width)) is thin
             assert ("thinner than the line" in band.get_label()) is thin
+        finally:
+            plt.close(fig)
+
+
+def _band_width_pt(ax):
+    """The widest radial extent of the polar axes' filled band as drawn, in points: from the
+    band's polygon (theta, r) and the axes' own transform (independent of the note's rule)."""
+    band = ax.collections[0]
+    verts = band.get_paths()[0].vertices
+    theta = np.round(verts[:, 0], 9)
+    widths = [np.ptp(verts[theta == t, 1]) for t in np.unique(theta)]
+    fig = ax.figure
+    fig.canvas.draw()
+    origin, top = ax.transData.transform([[0.0, 0.0], [0.0, ax.get_rmax()]])
+    pt_per_unit = np.hypot(*(top - origin)) * 72.0 / fig.dpi / ax.get_rmax()
+    return max(widths) * pt_per_unit
+
+
+def test_the_lobe_plot_notes_a_band_thinner_than_its_line_from_a_real_fit():
+    """Two real fits of a simulated silk: 300 pairs at 0.2 % noise with gamma_s1 free (a
+    posterior so narrow that its 90% band, drawn, is under a point wide, under the 1-point
+    median line) and 40 pairs at 30 % noise with four parameters free (a band several points
+    wide). The lobe plot's legend says "thinner than the line" for the first alone."""
+    from reports.plots.fit_diagnostics import lobe_plot
+    cases = (("gamma_s1", 300, 0.002, 60, True),
+             ("kd1,gamma_v1,gamma_s1,gamma_v2", 40, 0.3, 150, False))
+    for free, n, rel, steps, thin in cases:
+        table, fab = fabric_table("silk_crepe_de_chine", n=n, rel=rel, seed=3)
+        spec = ParamSpec(free, defaults=defaults_from_fabric(fab))
+        r = fit(table, spec, FabricModel(fab, table.wi, table.wo), max_steps=steps,
+                progress=False, threads=1)
+        fig, ax = lobe_plot(r, table, lambda wi, wo: FabricModel(fab, wi, wo),
+                            theta_i_deg=[30])
+        try:
+            labels = [t.get_text() for t in ax[0].get_legend().get_texts()]
+            width = _band_width_pt(ax[0])
+            if thin:
+                assert width < 1.0, width
+                assert labels[0].startswith("90% band (thinner than the line: at most")
+            else:
+                assert width > 3.0, width
+                assert labels[0] == "90% band"
         finally:
             plt.close(fig)

@@ -57,8 +57,9 @@ def register(sub):
     p.add_argument("-o", "--output", default="report", metavar="DIR",
                    help="output folder (default ./report); replaced whole by the next run")
     p.add_argument("--quality", choices=("default", "high", "fast"), default="default",
-                   help="figure and render resolution: default (renders 640 x 360), high "
-                        "(1280 x 720, finer figures, slower) or fast (previews)")
+                   help="figure and render resolution: default (renders 448 x 252 at 16 "
+                        "spp, Mitsuba's 640 x 360), high (1280 x 720, finer figures, "
+                        "slower) or fast (previews)")
     p.add_argument("--render-engine", choices=("auto", "builtin", "mitsuba"), default="auto",
                    help="renders by Mitsuba 3 (path tracing; auto: where it runs in "
                         "llvm_ad_rgb) or the built-in renderer (direct light) (auto)")

@@ -6,14 +6,15 @@ cloth with ``fabric.eval(wi_local, wo_local)`` and everything else as Lambertian
 samples that hit lit cloth reach the BRDF, in batches of one image tile at a time, and tiles
 are spread over the processor cores.  :func:`write_exr` and :func:`write_png` (from
 :mod:`reports.render.imageio`) save the result.  ``render(..., mask=True)`` also returns the cloth's
-coverage (the fraction of each pixel's samples whose first hit is cloth), and
+coverage (the fraction of each pixel's samples whose first hit is metered cloth: the
+cylinder's side, not its caps), and
 :func:`cloth_coverage` traces it alone, for :func:`reports.render.exposure.auto_exposure`.
 
 Shading (direct light only: one key-light sample per camera sample, plus the sky when the
 scene has an environment light, :mod:`reports.render.envlight`, no bounces):
 
-    L_o = f_r(wi, wo) * E * cos(theta_i) * V  [+ the sky's, by MIS of Fabric.sample and
-                                                cosine directions]
+    L_o = f_r(wi, wo) * E * cos(theta_i) * V  [+ the sky's, by MIS of a table of the
+                                                fabric's f_r cos and cosine directions]
 
 the sky on every sample of a diffuse surface and on ``sky_spp`` samples a pixel of cloth
 (weighted ``spp / sky_spp``), its uniform numbers stratified over the pixel's samples;
@@ -39,6 +40,7 @@ from gonio.progress import progress_bar
 from reports.render import pixelsamples
 from reports.render.checks import (MAX_HEIGHT, MAX_SPP, MAX_WIDTH, check_size,  # noqa: F401
                                    check_workers, probe, resolve_fabric, scene_of)
+from reports.render.brdftable import BRDFTable
 from reports.render.envlight import environment_radiance
 from reports.render.imageio import write_exr, write_png
 from reports.render.scenes import SCENES
@@ -55,7 +57,7 @@ BRDF_BATCH = 131072
 # --------------------------------------------------------------------------- shading
 def _hits(scene, o, d):
     """The rays' first hits: indices of the rays that hit, points, normals turned toward
-    the viewer, warps, directions to the viewer and primitive indices."""
+    the viewer, warps, directions to the viewer, primitive indices and parts."""
     prims = scene.primitives
     t, pid, part = intersect(prims, o, d, 1e-6 * scene.scale)
     hit = np.nonzero(np.isfinite(t))[0]
@@ -70,7 +72,7 @@ def _hits(scene, o, d):
             n[sel], warp[sel] = prim.frame(p[sel], part[hit][sel])
     flip = np.einsum("ij,ij->i", n, wo) < 0          # two-sided: face the viewer
     n[flip] *= -1
-    return hit, p, n, warp, wo, pid_h
+    return hit, p, n, warp, wo, pid_h, part[hit]
 
 
 def _local(n, warp):
@@ -104,18 +106,20 @@ def _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng):
     return out
 
 
-def _shade(scene, fabric, o, d, rng, sky=None):
+def _shade(scene, fabric, o, d, rng, sky=None, table=None):
     """Radiance (m, 3) of the rays ``(o, d)``: the key light, plus the sky when the scene has
     an environment light (:mod:`reports.render.envlight`), on the rays of nonzero weight in ``sky =
     (weights (m,), uniform numbers (m, 4))`` (None: every ray, weight 1); and whether each
-    ray's first hit is cloth (m,), as a fourth column."""
+    ray's first hit is metered cloth (m,) (:func:`reports.render.pixelsamples.metered`:
+    the cylinder's side, not its caps), as a fourth column. ``table``: the fabric's
+    :class:`reports.render.brdftable.BRDFTable` for the sky (None: cosine directions alone)."""
     out = np.zeros((len(o), 4))
-    hit, p, n, warp, wo, pid_h = _hits(scene, o, d)
+    hit, p, n, warp, wo, pid_h, part_h = _hits(scene, o, d)
     if hit.size == 0:
         return out
     prims = scene.primitives
     cloth = np.array([pr.material == "cloth" for pr in prims])[pid_h]
-    out[hit, 3] = cloth
+    out[hit, 3] = pixelsamples.metered(prims, pid_h, part_h)
     albedo = np.array([0.0 if pr.material == "cloth" else pr.albedo for pr in prims])[pid_h]
     rad = _key_light(scene, fabric, p, n, warp, wo, cloth, albedo, rng)
     if scene.environment is not None:
@@ -131,13 +135,15 @@ def _shade(scene, fabric, o, d, rng, sky=None):
         rad[k] += w * environment_radiance(
             scene.environment, prims, fabric, p[k], n[k], frame,
             np.einsum("mij,mj->mi", frame, wo[k]), cloth[k], albedo[k], rng,
-            off=1e-4 * scene.scale, eps=1e-6 * scene.scale, batch=BRDF_BATCH, u=u)
+            off=1e-4 * scene.scale, eps=1e-6 * scene.scale, batch=BRDF_BATCH, u=u,
+            table=table)
     out[hit, :3] = rad
     return out
 
 
-def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
-    """The fraction of each pixel's samples (stratified jitter) whose first hit is cloth.
+def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536, metered=True):
+    """The fraction of each pixel's samples (stratified jitter) whose first hit is metered
+    cloth (:func:`reports.render.pixelsamples.metered`: the cylinder's side, not its caps).
 
     The mask of :func:`reports.render.exposure.auto_exposure` for an image rendered elsewhere
     (Mitsuba's): camera rays and the first hit alone, no shading.
@@ -151,6 +157,9 @@ def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
         Seed of the jitter.
     chunk : int
         Rays traced at once.
+    metered : bool
+        Count the metered cloth alone (the exposure's mask); False: any cloth (the
+        cylinder's caps too).
 
     Returns
     -------
@@ -163,7 +172,8 @@ def cloth_coverage(scene, width, height, spp=4, seed=0, chunk=65536):
     ((3, 4), 1.0)
     """
     check_size(width, height, spp)
-    return pixelsamples.coverage(scene_of(scene, None, None), width, height, spp, seed, chunk)
+    return pixelsamples.coverage(scene_of(scene, None, None), width, height, spp, seed, chunk,
+                                 metered)
 
 
 def _tiles(width, height, tile):
@@ -202,7 +212,7 @@ def _render_tile(tile, ctx=None):
     o, d = scene.camera.rays(sx, sy, width, height)
     sky = pixelsamples.sky_plan(rng, npix, spp, ctx["sky_spp"])
     rad = _shade(scene, ctx["fabric"], np.ascontiguousarray(o), np.ascontiguousarray(d), rng,
-                 sky)
+                 sky, ctx["table"])
     img = rad.reshape(npix, spp, 4).mean(axis=1)
     return tile, img.reshape(y1 - y0, x1 - x0, 4).astype(np.float32)
 
@@ -241,20 +251,22 @@ def render(scene, fabric, width=MAX_WIDTH, height=MAX_HEIGHT, spp=16, light=None
     sky_spp : int, optional
         Samples of the sky per pixel on cloth, 1 to ``spp`` (default ``spp``): on that many
         of a pixel's samples, spread over its area and weighted ``spp / sky_spp``, each with
-        one cosine and one fabric direction (numbers stratified over the pixel).  Diffuse
-        surfaces sample the sky on every sample (one cosine direction, stratified over the
-        pixel).  Fewer sky samples make a render of cloth faster: its two shadow rays and the
-        fabric's sampler cost most of a sample.
+        one cosine direction and one from a table of the fabric's ``f_r cos``
+        (:mod:`reports.render.brdftable`, built once per render), numbers stratified over the
+        pixel.  Diffuse surfaces sample the sky on every sample (one cosine direction).
+        Fewer sky samples make a render of cloth faster: its two shadow rays and two
+        ``fabric.eval`` calls cost most of a sample.
     mask : bool
-        Also return the cloth's coverage (for :func:`reports.render.exposure.auto_exposure`).
+        Also return the coverage of the metered cloth (for
+        :func:`reports.render.exposure.auto_exposure`;
+        :func:`reports.render.pixelsamples.metered`).
 
     Returns
     -------
     (height, width, 3) float32 ndarray
         Linear RGB radiance (W / (m^2 sr) for intensities in W/sr).
     (height, width) float32 ndarray
-        With ``mask=True``, a second value: the fraction of each pixel's samples whose first
-        hit is cloth.
+        With ``mask=True``: the fraction of each pixel's samples that hit metered cloth.
 
     Raises
     ------
@@ -300,8 +312,10 @@ def _checked_context(scene, fabric, width, height, spp, light, camera, seed, til
     if isinstance(sky_spp, bool) or not isinstance(sky_spp, (int, np.integer)) \
             or not 1 <= sky_spp <= spp:
         raise ValueError(f"sky_spp={sky_spp!r} must be an integer from 1 to spp={spp}")
+    # the sky's sampler, tabulated once here (the workers share it by fork)
+    table = BRDFTable(fabric, batch=BRDF_BATCH) if scene.environment is not None else None
     ctx = {"scene": scene, "fabric": fabric, "width": int(width), "height": int(height),
-           "spp": int(spp), "seed": int(seed), "sky_spp": int(sky_spp)}
+           "spp": int(spp), "seed": int(seed), "sky_spp": int(sky_spp), "table": table}
     return ctx, workers
 
 

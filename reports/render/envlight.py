@@ -5,17 +5,27 @@ zenith, world +y up). Its direct light at a surface point is estimated with one 
 strategy:
 
 - diffuse surfaces: a cosine-weighted direction, ``L_o = albedo L(wi) V``;
-- cloth: multiple importance sampling (balance heuristic) of two directions, one drawn by
-  :meth:`brdf.Fabric.sample` (density ``p_f``) and one cosine-weighted (``p_c = cos / pi``):
+- cloth: multiple importance sampling (balance heuristic) of two directions, one drawn from
+  the render's table of the fabric's :math:`f_r \cos\theta_i`
+  (:class:`reports.render.brdftable.BRDFTable`, density ``p_t``) and one cosine-weighted
+  (``p_c = cos / pi``):
 
   .. math::
-      L_o = \frac{f_r(w_f) \cos\theta_f L(w_f) V_f}{p_f(w_f) + p_c(w_f)}
-          + \frac{f_r(w_c) \cos\theta_c L(w_c) V_c}{p_f(w_c) + p_c(w_c)},
+      L_o = \frac{f_r(w_t) \cos\theta_t L(w_t) V_t}{p_t(w_t) + p_c(w_t)}
+          + \frac{f_r(w_c) \cos\theta_c L(w_c) V_c}{p_t(w_c) + p_c(w_c)},
 
   an unbiased estimate of :math:`\int f_r L \cos\theta V\, d\omega` whose variance stays low
-  both for the narrow specular lobes (the fabric's sampler finds them) and for the diffuse
-  part (the cosine directions). A BRDF without ``sample``/``pdf`` uses the cosine directions
-  alone.
+  both where the fabric's reflection gathers (the table follows it, velvet's grazing rim
+  included) and for the diffuse part and lobes narrower than a table bin (the cosine
+  directions). The table needs ``eval`` alone; without one (``table=None``) the cosine
+  directions are used alone.
+
+The fabric's own sampler (:meth:`brdf.Fabric.sample`) is not used here: for velvet it puts
+two thirds of its draws below the surface and some 30 times too few at grazing incidence,
+where velvet's f_r cos gathers, so that a few sky samples carried most of the light and
+showed as white speckles on the cylinder's shaded side; the table's estimate has 8 to 60
+times less variance there and on every preset, and costs two ``eval`` calls instead of an
+``eval``, a ``pdf`` and a ``sample`` (tests/test_reports_envlight.py).
 """
 
 from __future__ import annotations
@@ -24,7 +34,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from brdf.protocols import SampledBRDF
 from reports.render.tracing import occluded
 
 __all__ = ["EnvironmentLight", "environment_radiance"]
@@ -65,7 +74,7 @@ def _eval(fabric, wi, wo, batch):
 
 
 def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, rng, *,
-                         off, eps, batch=131072, u=None) -> np.ndarray:
+                         off, eps, batch=131072, u=None, table=None) -> np.ndarray:
     """Radiance (m, 3) reflected toward the viewer from the sky at points ``p``.
 
     Parameters
@@ -73,7 +82,7 @@ def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, r
     env : EnvironmentLight
     prims : sequence of primitives (for the shadow rays)
     fabric : BRDF
-        The cloth's BRDF (local frame); MIS when it has ``sample`` and ``pdf``.
+        The cloth's BRDF (local frame).
     p, n : ndarray (m, 3)
         Points and their normals (toward the viewer).
     frame : ndarray (m, 3, 3)
@@ -87,7 +96,10 @@ def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, r
         Lift of shadow-ray origins and the smallest hit distance, scene units.
     u : ndarray (m, 4), optional
         Uniform numbers in [0, 1) of the two draws (the cosine direction: ``u[:, :2]``; the
-        fabric's: ``u[:, 2:]``), e.g. stratified over a pixel's samples; default from ``rng``.
+        table's: ``u[:, 2:]``), e.g. stratified over a pixel's samples; default from ``rng``.
+    table : BRDFTable, optional
+        ``fabric``'s table (:class:`reports.render.brdftable.BRDFTable`): MIS of its
+        directions and cosine ones on cloth; None: cosine directions alone.
     """
     out = np.zeros((len(p), 3))
     to_world = np.swapaxes(frame, 1, 2)
@@ -102,17 +114,18 @@ def environment_radiance(env, prims, fabric, p, n, frame, wo_l, cloth, albedo, r
     if c.size == 0:
         return out
     f_c = _eval(fabric, w_c[c], wo_l[c], batch)
-    cos_c, pc_c = w_c[c, 2], w_c[c, 2] / np.pi
-    if not isinstance(fabric, SampledBRDF):            # an eval-only BRDF: cosine alone
+    cos_c = w_c[c, 2]
+    if table is None:                                  # cosine directions alone
         out[c] = f_c * np.pi * sky_c[c]
         return out
-    pf_c = np.asarray(fabric.pdf(wo_l[c], w_c[c]))
-    out[c] = f_c * (cos_c / (pf_c + pc_c))[:, None] * sky_c[c]
-    w_f, weight, pf_f = fabric.sample(wo_l[c], np.ascontiguousarray(u[c, 2:]))
-    up = (w_f[:, 2] > 0) & (pf_f > 0) & np.all(np.isfinite(weight), axis=1)
+    pt_c = table.pdf(wo_l[c], w_c[c])
+    out[c] = f_c * (cos_c / (pt_c + cos_c / np.pi))[:, None] * sky_c[c]
+    w_t, pt_t = table.sample(wo_l[c], np.ascontiguousarray(u[c, 2:]))
+    up = w_t[:, 2] > 0
     k = c[up]
-    wf_world = np.einsum("mij,mj->mi", to_world[k], w_f[up])
-    sky_f = _visible_sky(env, prims, p[k], n[k], wf_world, off, eps)
-    mis = pf_f[up] / (pf_f[up] + w_f[up, 2] / np.pi)
-    out[k] += weight[up] * mis[:, None] * sky_f
+    w_t, pt_t = w_t[up], pt_t[up]
+    f_t = _eval(fabric, w_t, wo_l[k], batch)
+    wt_world = np.einsum("mij,mj->mi", to_world[k], w_t)
+    sky_t = _visible_sky(env, prims, p[k], n[k], wt_world, off, eps)
+    out[k] += f_t * (w_t[:, 2] / (pt_t + w_t[:, 2] / np.pi))[:, None] * sky_t
     return out

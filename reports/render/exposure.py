@@ -4,11 +4,15 @@ A render is linear radiance; its PNG shows it multiplied by ``2 ** stops`` and c
 [0, 1] before the sRGB encoding (:func:`reports.render.imageio.encode_srgb`). The automatic exposure
 (:func:`auto_exposure`, the default of ``microcyl render`` and of the report) looks at the
 cloth alone, so that a dark fabric is not exposed for the bright floor beside it: of the
-pixels whose primary hit is cloth (a coverage mask from the renderer: the fraction of a
-pixel's samples that first hit cloth, at least one half), the :data:`PERCENTILE` th
+pixels whose primary hit is metered cloth (a coverage mask from the renderer: the fraction of
+a pixel's samples that first hit it, at least one half), the :data:`PERCENTILE` th
 percentile of their brightest channel, ``max(R, G, B)``, is mapped to :data:`TARGET`; only
-1 % of the cloth's pixels then clip in any channel. Without cloth in view, the non-zero
-pixels of the whole image stand in.
+1 % of those pixels then clip in any channel. Metered cloth is all of it but the cylinder's
+caps (:func:`reports.render.pixelsamples.metered`): the cameras see the top cap nearly
+edge-on, where velvet glows with its grazing sheen, and metered on it the cylinder's side
+and its rim came out a stop too dark (velvet: +3.0 against +3.95 stops); metered on the
+side, the rim shows bright, as a photographer exposes for the subject and lets an edge-on
+highlight clip. Without cloth in view, the non-zero pixels of the whole image stand in.
 
 ``--exposure`` (:func:`parse_exposure`) overrides it: ``auto``, a number of stops (``1.5``,
 ``-2``: the PNG is ``2 ** stops`` times the linear values), or a scale with an ``x`` suffix
@@ -31,7 +35,7 @@ __all__ = ["Exposure", "auto_exposure", "parse_exposure", "exr_attributes", "PER
 PERCENTILE = 99.0
 #: Where that percentile lands, linear (sRGB-encoded about 0.95).
 TARGET = 0.9
-#: Largest |stops| accepted: 2**64 already saturates any f_r.
+#: Largest abs(stops) accepted: 2**64 already saturates any f_r.
 MAX_STOPS = 64.0
 
 

@@ -1,5 +1,9 @@
 """Where a pixel's samples go: the camera jitter, the sky's uniform numbers, and the cloth's
-coverage of the pixels (camera rays and first hits alone), for :mod:`reports.render.engine`."""
+coverage of the pixels (camera rays and first hits alone), for :mod:`reports.render.engine`.
+
+The coverage counts the *metered* cloth (:func:`metered`): the hits on cloth that set the
+automatic exposure, on every part of a primitive except where it names its
+``metered_parts`` (the cylinder: its side, not its caps)."""
 
 from __future__ import annotations
 
@@ -7,7 +11,7 @@ import numpy as np
 
 from reports.render.tracing import intersect
 
-__all__ = ["sample_offsets", "lhs", "sky_plan", "coverage"]
+__all__ = ["sample_offsets", "lhs", "sky_plan", "metered", "coverage"]
 
 
 def sample_offsets(rng, npix, spp):
@@ -40,9 +44,33 @@ def sky_plan(rng, npix, spp, sky_spp):
     return weight.ravel(), lhs(rng, npix, spp, 2).reshape(-1, 2), u_cloth.reshape(-1, 4)
 
 
-def coverage(scene, width, height, spp, seed, chunk):
-    """The fraction of each pixel's ``spp`` samples whose first hit is cloth, (height, width)
-    float32: :func:`reports.render.engine.cloth_coverage` (which checks its arguments)."""
+def metered(prims, pid, part) -> np.ndarray:
+    """Whether each hit (primitive ``pid``, part ``part``; ``pid < 0``: none) is metered
+    cloth: cloth, on a part in its primitive's ``metered_parts`` (every part where it has
+    none).
+
+    Examples
+    --------
+    >>> from reports.render.scenes import make_scene
+    >>> prims = make_scene("cylinder").primitives      # cylinder (side, top, bottom), floor
+    >>> metered(prims, np.array([0, 0, 1, -1]), np.array([0, 1, 0, 0])).tolist()
+    [True, False, False, False]
+    """
+    pid, part = np.asarray(pid), np.asarray(part)
+    out = np.zeros(pid.shape, bool)
+    for k, prim in enumerate(prims):
+        if prim.material != "cloth":
+            continue
+        sel = pid == k
+        parts = getattr(prim, "metered_parts", None)
+        out |= sel if parts is None else sel & np.isin(part, parts)
+    return out
+
+
+def coverage(scene, width, height, spp, seed, chunk, metered_only=True):
+    """The fraction of each pixel's ``spp`` samples whose first hit is metered cloth
+    (:func:`metered`; any cloth with ``metered_only=False``), (height, width) float32:
+    :func:`reports.render.engine.cloth_coverage` (which checks its arguments)."""
     rng = np.random.default_rng(seed)
     cloth = np.array([pr.material == "cloth" for pr in scene.primitives])
     ys, xs = np.mgrid[0:height, 0:width]
@@ -52,7 +80,9 @@ def coverage(scene, width, height, spp, seed, chunk):
     hits = np.zeros(sx.size)
     for s in range(0, sx.size, chunk):
         o, d = scene.camera.rays(sx[s:s + chunk], sy[s:s + chunk], width, height)
-        t, pid, _ = intersect(scene.primitives, np.ascontiguousarray(o),
-                              np.ascontiguousarray(d), 1e-6 * scene.scale)
-        hits[s:s + chunk] = np.isfinite(t) & cloth[np.maximum(pid, 0)]
+        t, pid, part = intersect(scene.primitives, np.ascontiguousarray(o),
+                                 np.ascontiguousarray(d), 1e-6 * scene.scale)
+        pid = np.where(np.isfinite(t), pid, -1)
+        hits[s:s + chunk] = metered(scene.primitives, pid, part) if metered_only else \
+            cloth[np.maximum(pid, 0)] & (pid >= 0)
     return hits.reshape(height, width, spp).mean(axis=2).astype(np.float32)

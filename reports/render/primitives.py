@@ -155,6 +155,9 @@ class Cylinder:
     material, albedo : see :class:`Rectangle`.
     cap_warp : (3,) array_like
         The caps' warp before its projection onto their plane (not along +y).
+    metered_parts : tuple of int
+        The parts whose pixels set the automatic exposure (:mod:`reports.render.exposure`):
+        the side; the top cap, seen nearly edge-on, glows with a fabric's grazing sheen.
     """
 
     center: tuple = (0.0, 0.0, 0.0)
@@ -163,6 +166,7 @@ class Cylinder:
     material: str = "cloth"
     albedo: float = 0.5
     cap_warp: tuple = (1.0, 0.0, 0.0)
+    metered_parts: tuple = (0,)
 
     def cap_direction(self):
         """The caps' warp: ``cap_warp`` with its y component removed, unit (3,).

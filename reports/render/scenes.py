@@ -27,8 +27,9 @@ Named scenes (:data:`SCENES`, built by :func:`make_scene`):
     pie-shaped wedges.
 
 The curtain and the cylinder are also lit by a dim sky
-(:class:`reports.render.envlight.EnvironmentLight`, sampled with the fabric's importance sampling
-and MIS), so their shadows are not black; the sphere and the patch have the key light alone.
+(:class:`reports.render.envlight.EnvironmentLight`, sampled by MIS of a table of the fabric's
+f_r cos and cosine directions), so their shadows are not black; the sphere and the patch have
+the key light alone.
 
 ``sphere``
     The lit sphere of Disney's BRDF Explorer: a unit sphere on black, lit by one point

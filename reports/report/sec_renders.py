@@ -9,9 +9,10 @@ for, at the built-in size); ``render_engine`` (``auto``, ``builtin``, ``mitsuba`
 quality dictionary overrides the choice. The built-in renderer samples the sky on
 :data:`SKY_SPP` of each pixel's samples on cloth (every sample on the backdrop). Each scene is
 exposed automatically for its cloth (:func:`reports.render.exposure.auto_exposure`: the 99th
-percentile of the cloth's pixels shown at 0.9, the mask traced once per scene and size by
-:func:`reports.render.engine.cloth_coverage`); the cylinder without masking takes the exposure of the
-cylinder with masking, so that the two compare.
+percentile of the metered cloth's pixels shown at 0.9, the cylinder's side and not its cap,
+the mask traced once per scene and size by :func:`reports.render.engine.cloth_coverage`); the
+cylinder without masking takes the exposure of the cylinder with masking, so that the two
+compare.
 """
 
 from __future__ import annotations
@@ -46,6 +47,8 @@ RENDERS = (("curtain", "curtain", True, "curtain"),
 #: The report's render engines and how each caption names them.
 ENGINES = {"builtin": "built-in renderer (direct light, MIS sky)",
            "mitsuba": "Mitsuba 3 llvm_ad_rgb (path tracing, 8 bounces)"}
+#: What a scene's exposure meters, where not all its cloth (reports.render.pixelsamples.metered).
+METERED = {"cylinder": "cylinder's side (not its cap, seen edge-on)"}
 #: Sky samples a pixel on cloth in the built-in renderer's renders (at most spp).
 SKY_SPP = 4
 
@@ -150,10 +153,12 @@ def section_renders(p: Page) -> Section:
         expo = per_scene[scene]
         write_file(p.path(f"render_{stem}.png"), _png(img, expo.stops))
         sky = f" (sky: {min(spp, SKY_SPP)} on cloth)" if engine == "builtin" else ""
+        metered = METERED.get(scene, "cloth")
         out.append(figure_html(
             p.rel(f"render_{stem}.png"),
             f"{caption}, {ENGINES[engine]}, {width} × {height}, {spp} spp{sky}, exposure "
-            f"{expo.stops:+.1f} stops ({_exposure_words(expo)}; sRGB via colour-science)"))
+            f"{expo.stops:+.1f} stops ({_exposure_words(expo, metered)}; sRGB via "
+            f"colour-science)"))
         stats[stem] = {"scene": scene, "masking": masking, "engine": engine,
                        "width": width, "height": height, "spp": spp,
                        "sky_spp": min(spp, SKY_SPP) if engine == "builtin" else None,
@@ -163,8 +168,8 @@ def section_renders(p: Page) -> Section:
     return Section(join(out), RendersData(first.reference if first else 1.0, stats))
 
 
-def _exposure_words(expo) -> str:
-    """How the exposure was chosen, as the caption says it."""
+def _exposure_words(expo, metered="cloth") -> str:
+    """How the exposure was chosen, as the caption says it; ``metered``: what it metered."""
     if expo.cloth:
-        return f"automatic: the cloth's 99th percentile shown at {TARGET:g}"
+        return f"automatic: the 99th percentile of the {metered} shown at {TARGET:g}"
     return f"automatic: the image's 99th percentile shown at {TARGET:g}, no cloth in view"

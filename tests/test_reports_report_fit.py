@@ -25,3 +25,8 @@ def test_fit_section_lists_adequacy_and_warnings_escaped(tmp_path):
     html2 = section_fit(Page(tmp_path, "f", None, {}, fit_results=path))
     html2 = html2.html
     assert "No warnings." in html2 and "Adequate (the model describes the data): True" in html2
+    assert "<p>Model: microcylinder</p>" in html2          # a results.json from before models
+    doc.update(model="zeltner", parameters={"roughness": doc["parameters"]["eta1"]})
+    path.write_text(json.dumps(doc))
+    assert "<p>Model: zeltner</p>" in section_fit(Page(tmp_path, "f", None, {},
+                                                       fit_results=path)).html

@@ -44,7 +44,8 @@ def section_fit(p: Page) -> Section:
     except ValueError as exc:
         raise Unavailable(str(exc)) from None
     rows = [[k] + [fmt(v.get(f)) for f in _COLUMNS] for k, v in data["parameters"].items()]
-    return Section(table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat",
+    return Section(html("<p>Model: {}</p>", str(data.get("model", "microcylinder")))
+                   + table(["parameter", "median", "lo68", "hi68", "lo95", "hi95", "τ", "R-hat",
                           "ESS"], rows)
                    + html("<p>Converged: {}</p>", fmt(data.get("converged")))
                    + _trust(data), FitData(data))

@@ -86,9 +86,12 @@ def charlie_lambda(cos, alpha):
 
 
 def charlie_v(cos_i, cos_o, alpha):
-    """The Charlie visibility G / (4 cos_i cos_o) (dimensionless); broadcasts."""
-    return 1.0 / ((1.0 + charlie_lambda(cos_o, alpha) + charlie_lambda(cos_i, alpha))
-                  * (4.0 * cos_i * cos_o))
+    """The Charlie visibility G / (4 cos_i cos_o) clamped to [0, 1] as the glTF Sample
+    Viewer's V_Sheen clamps it (dimensionless); broadcasts over directions above the horizon
+    (cos_i, cos_o > 0)."""
+    v = 1.0 / ((1.0 + charlie_lambda(cos_o, alpha) + charlie_lambda(cos_i, alpha))
+               * (4.0 * cos_i * cos_o))
+    return np.clip(v, 0.0, 1.0)
 
 
 def sheen_albedo(cos, roughness):

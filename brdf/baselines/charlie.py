@@ -8,24 +8,29 @@ over a Lambertian base with the extension's albedo scaling.
               P1 = (25.3245, 3.32435, 0.16801, -1.27393, -4.85967)
     Lambda(c) = exp(l(c))                     if c < 0.5
               = exp(2 l(0.5) - l(1 - c))      otherwise
-    V       = 1 / ((1 + Lambda(cos_o) + Lambda(cos_i)) 4 cos_i cos_o)
+    V       = clamp(1 / ((1 + Lambda(cos_o) + Lambda(cos_i)) 4 cos_i cos_o), 0, 1)
     f_sheen = sheen * D * V
     S       = min(1 - max3(sheen) E(cos_o), 1 - max3(sheen) E(cos_i))
     f_r     = f_sheen + S * base / pi                       (1/sr)
 
 Source: KHR_materials_sheen (KhronosGroup/glTF, extensions/2.0/Khronos/KHR_materials_sheen/
 README.md at 77b44be7, "Implementation Notes": "Sheen distribution", "Sheen visibility" with the
-constants above, "Albedo-scaling technique"); Estevez and Kulla, "Production Friendly
-Microfacet Sheen BRDF", SIGGRAPH 2017 course notes. E(cos) is the sheen lobe's directional
+constants above, "Albedo-scaling technique"); the clamp of V is Khronos's reference
+renderer's (KhronosGroup/glTF-Sample-Viewer, source/Renderer/shaders/brdf.glsl at 00536c7d,
+V_Sheen); Estevez and Kulla, "Production Friendly Microfacet Sheen BRDF", SIGGRAPH 2017
+course notes. E(cos) is the sheen lobe's directional
 albedo with colour 1, integral D V cos_i dwi; the spec reads it from a table (Enterprise PBR's
 section 6.2.3); here it is computed by quadrature on a grid
 (:mod:`brdf.baselines.charlietable`, checked in as charlie_albedo.json;
 ``bench/charlie_albedo_table.py`` regenerates it) and interpolated.
 
-Readings (docs/guide/baselines.rst): E exceeds 1 at grazing (the fitted Lambda is finite at 0,
-so D V cos_i grows like 1 / cos_o), where the spec's S would go negative; E is taken as
-min(E, 1) in S, as a table stored in an image (values in [0, 1]) gives it, so S >= 0. Below the
-table's first node (cos < 1/4096) E takes that node's value.
+Readings (docs/guide/baselines.rst): V is clamped to [0, 1] as the Sample Viewer clamps it (the
+spec's V has no clamp; its fitted Lambda is finite at cos 0, so unclamped V, and f_r, grow like
+1 / cos: up to 4e7 1/sr at theta = 90 deg); with it f_sheen <= sheen * D <= sheen (2 + 1/alpha)
+/ (2 pi). E still exceeds 1 at grazing (up to 1.87 in the table, 1.99 at theta_o = 90 deg),
+where the spec's S would go negative; E is taken as min(E, 1) in S, as a table stored in an
+image (values in [0, 1]) gives it, so S >= 0. Below the table's first node (cos < 1/4096) E
+takes that node's value.
 
 Reciprocal: D depends on h; V and S are symmetric in cos_i and cos_o.
 
@@ -37,6 +42,10 @@ Examples
 >>> bool(np.allclose(m.eval(wi, wo), 0.5 / np.pi))
 True
 >>> 0.0 < float(sheen_albedo(1.0, 1.0)) < 0.2              # the lobe's albedo at normal view
+True
+>>> grazing = np.array([1.0, 0.0, np.cos(np.pi / 2)])     # theta = 90 deg: cos 6e-17 > 0
+>>> f = float(Charlie(base=0.0, sheen=1.0, roughness=1.0).eval(grazing, wo)[0])
+>>> 0.0 < f <= 3.0 / (2.0 * np.pi)                         # V <= 1: f <= D's maximum
 True
 """
 
@@ -86,9 +95,12 @@ def charlie_lambda(cos, alpha):
 
 
 def charlie_v(cos_i, cos_o, alpha):
-    """The Charlie visibility G / (4 cos_i cos_o) (dimensionless); broadcasts."""
-    return 1.0 / ((1.0 + charlie_lambda(cos_o, alpha) + charlie_lambda(cos_i, alpha))
-                  * (4.0 * cos_i * cos_o))
+    """The Charlie visibility G / (4 cos_i cos_o) clamped to [0, 1] as the glTF Sample
+    Viewer's V_Sheen clamps it (dimensionless); broadcasts over directions above the horizon
+    (cos_i, cos_o > 0)."""
+    v = 1.0 / ((1.0 + charlie_lambda(cos_o, alpha) + charlie_lambda(cos_i, alpha))
+               * (4.0 * cos_i * cos_o))
+    return np.clip(v, 0.0, 1.0)
 
 
 def sheen_albedo(cos, roughness):

@@ -243,8 +243,21 @@ def _ranked(models: dict) -> list[tuple[str, dict]]:
                   key=lambda me: (me[1].get("rank") is None, me[1].get("rank") or 0, me[0]))
 
 
+def _z(e: dict) -> float:
+    """A model's difference to the best in standard errors (inf for an exact difference)."""
+    d, se = float(e.get("d_elpd") or 0.0), float(e.get("d_se") or 0.0)
+    return d / se if se > 0 else (math.inf if d > 0 else 0.0)
+
+
+def _names(items) -> str:
+    names = [m for m, _ in items]
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
 def models_verdict(models: dict, compare_error: str | None = None) -> str:
-    """One sentence from the ranking of a dataset's models (plain text).
+    """One sentence from the ranking of a dataset's models (plain text): which models the
+    data cannot separate from the best (difference within :data:`SEPARATION_SE` se), which
+    it is preferred over and by how much, and which fits did not converge.
 
     Examples
     --------
@@ -254,25 +267,41 @@ def models_verdict(models: dict, compare_error: str | None = None) -> str:
     >>> models_verdict({"a": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
     ...                 "b": {"rank": 2, "d_elpd": 1.0, "d_se": 2.0}})
     'The data cannot separate a and b (difference 1.0 ± 2.0, within 2 se).'
+    >>> models_verdict({"a": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
+    ...                 "b": {"rank": 2, "d_elpd": 50.0, "d_se": 18.0},
+    ...                 "c": {"rank": 3, "d_elpd": 50.0, "d_se": 69.0, "converged": False},
+    ...                 "d": {"rank": 4, "d_elpd": 68.0, "d_se": 6.0}})
+    'The data cannot separate a and c (difference 50.0 ± 69.0, within 2 se); a is preferred over b and d by at least 2.8 se (c did not converge: its elpd may still change).'
     """
     ranked = [(m, e) for m, e in _ranked(models) if e.get("rank") is not None]
     if compare_error:
         return f"The models were not ranked: {compare_error}"
     if len(ranked) < 2:
         return "Fewer than two models have a PSIS-LOO: nothing to rank."
-    (best, _), (second, e2) = ranked[0], ranked[1]
-    d, se = float(e2.get("d_elpd") or 0.0), float(e2.get("d_se") or 0.0)
-    z = d / se if se > 0 else (math.inf if d > 0 else 0.0)
-    if z <= SEPARATION_SE:
-        return (f"The data cannot separate {best} and {second} (difference {d:.1f} ± "
-                f"{se:.1f}, within {SEPARATION_SE:g} se).")
-    rest = ""
-    if len(ranked) > 2:
-        zs = [float(e.get("d_elpd") or 0) / float(e["d_se"]) if e.get("d_se") else math.inf
-              for _, e in ranked[2:]]
-        rest = f", and over the {len(ranked) - 2} others by at least {min(zs):.1f} se"
-    return (f"{best} is preferred over {second} by {d:.1f} ± {se:.1f} ({z:.1f} se)"
-            f"{rest}.")
+    best = ranked[0][0]
+    close = [(m, e) for m, e in ranked[1:] if _z(e) <= SEPARATION_SE]
+    far = [(m, e) for m, e in ranked[1:] if _z(e) > SEPARATION_SE]
+    if close:
+        diffs = "; ".join(f"{float(e.get('d_elpd') or 0):.1f} ± {float(e.get('d_se') or 0):.1f}"
+                          for _, e in close)
+        text = (f"The data cannot separate {best} and {_names(close)} "
+                f"(difference{'s' if len(close) > 1 else ''} {diffs}, within "
+                f"{SEPARATION_SE:g} se)")
+        if far:
+            text += (f"; {best} is preferred over {_names(far)} by at least "
+                     f"{min(_z(e) for _, e in far):.1f} se")
+    else:
+        (second, e2), rest = far[0], far[1:]
+        text = (f"{best} is preferred over {second} by {float(e2['d_elpd']):.1f} ± "
+                f"{float(e2.get('d_se') or 0):.1f} ({_z(e2):.1f} se)")
+        if rest:
+            text += (f", and over {_names(rest)} by at least "
+                     f"{min(_z(e) for _, e in rest):.1f} se")
+    stuck = [(m, e) for m, e in ranked if e.get("converged") is False]
+    if stuck:
+        text += (f" ({_names(stuck)} did not converge: {'its' if len(stuck) == 1 else 'their'}"
+                 f" elpd may still change)")
+    return text + "."
 
 
 def models_table(models: dict) -> Markup:

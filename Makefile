@@ -13,8 +13,11 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
+# the suite on every core (pytest-xdist, tests handed to whichever worker is free);
+# `make test WORKERS=0` runs it in one process
+WORKERS ?= auto
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(WORKERS)
 
 # the report includes the measured-data fits when `make fits` has made them
 report: $(STAMP)

@@ -13,9 +13,10 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
-# the suite on every core (pytest-xdist, tests handed to whichever worker is free);
+# the suite on every CPU this process may use (pytest-xdist, tests handed to whichever worker
+# is free; nproc, not -n auto, which counts the physical cores of the whole host);
 # `make test WORKERS=0` runs it in one process
-WORKERS ?= auto
+WORKERS ?= $(shell nproc 2>/dev/null || echo 2)
 test: $(STAMP)
 	$(PY) -m pytest -n $(WORKERS)
 

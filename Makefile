@@ -13,8 +13,12 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
+# the suite on every CPU this process may use (pytest-xdist, tests handed to whichever worker
+# is free; nproc, not -n auto, which counts the physical cores of the whole host);
+# `make test WORKERS=0` runs it in one process
+WORKERS ?= $(shell nproc 2>/dev/null || echo 2)
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(WORKERS)
 
 # the report includes the measured-data fits when `make fits` has made them
 report: $(STAMP)

@@ -4,6 +4,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import settings
+
+#: Property tests take their time on a loaded machine (`make test` runs one worker per core,
+#: beside the fits' and renders' own processes): no per-example deadline by default.
+settings.register_profile("microcyl", deadline=None)
+settings.load_profile("microcyl")
 
 #: ../shared/data, the measured BRDF data kept beside this repository (never copied in).
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

@@ -272,3 +272,46 @@ def test_bad_shading_is_refused():
     spec = ParamSpec("kd1", defaults=defaults_from_fabric(fab))
     with pytest.raises(ValueError, match="shading must be one of float32, float64; got 'half'"):
         fit(table, spec, FabricModel(fab, table.wi, table.wo), shading="half", **FAST)
+
+
+def test_ctrl_c_while_the_ensemble_threads_start_leaves_no_thread_waiting(monkeypatch):
+    """A Ctrl-C that lands in EnsembleRunner.run_to while it submits the ensembles' jobs (a
+    thread's start waits, and Ctrl-C raises there): the jobs already started must not wait
+    for the others forever (before, `microcyl fit` printed its one line and then hung at
+    exit, joining such a thread; seen under load in tests/test_cli_fit_e2e.py)."""
+    import concurrent.futures as cf
+    from analysis.fit.ensemble import EnsembleRunner
+
+    class Chain:                  # what run_to needs of a chain: steps, run, log_prob_fn
+        steps = 0
+
+        def run(self, target):
+            while self.steps < target:
+                self.log_prob_fn(np.zeros((2, 1)))
+                self.steps += 1
+
+    runner = EnsembleRunner([Chain() for _ in range(3)], lambda x: x[:, 0])
+    real, calls = cf.ThreadPoolExecutor.submit, []
+
+    def submit(self, *a, **kw):
+        calls.append(1)
+        fut = real(self, *a, **kw)        # queued and started, as when start() is interrupted
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return fut
+
+    monkeypatch.setattr(cf.ThreadPoolExecutor, "submit", submit)
+    raised = []
+
+    def go():
+        try:
+            runner.run_to(5)
+        except KeyboardInterrupt:
+            raised.append(True)
+
+    t = threading.Thread(target=go, daemon=True)
+    t.start()
+    t.join(30)
+    assert not t.is_alive(), "run_to hung: a started job waits for the ensembles never started"
+    assert raised == [True]
+    runner.close()

@@ -157,9 +157,13 @@ class EnsembleRunner:
         """
         jobs = [c for c in self.chains if c.steps < target]
         self.lock.reset(len(jobs))
+        futs: list[cf.Future] = []
         with cf.ThreadPoolExecutor(max(1, len(jobs))) as ex:
-            futs = [ex.submit(self._job, c, target) for c in jobs]
             try:
+                # submitted inside the try: a Ctrl-C while a job's thread starts must abort
+                # the jobs already started (they would wait for the others forever)
+                for c in jobs:
+                    futs.append(ex.submit(self._job, c, target))
                 while cf.wait(futs, timeout=poll)[1]:
                     if tick is not None:
                         tick(self.steps)

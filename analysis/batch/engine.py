@@ -167,7 +167,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
               echo: Callable[[str], None] | None = print,
               notify: Callable[[str], None] | None = None,
-              locked: bool = False) -> BatchSummary:
+              locked: bool = False,
+              page: Callable[[Path], object] | None = None) -> BatchSummary:
     """Fit every job on Dask into ``out_dir/<name>``, keeping the summaries up to date.
 
     Jobs that converged before with the same inputs (:meth:`BatchSummary.done`) are not
@@ -192,6 +193,9 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
     locked : bool
         The caller holds ``out_dir``'s lock already (:func:`analysis.fit_measured`, which
         writes measured.json under the same lock); else the batch takes it.
+    page : callable, optional
+        ``page(out_dir)`` writes the batch's page once the summaries are written (for
+        example ``reports.report_batch.write_batch_page``), under the same lock.
 
     Returns
     -------
@@ -229,6 +233,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
                 with _quiet_dask(), _client(workers, scheduler) as client:
                     _gather(client, todo, out, summary, names, bar, say)
             summary.write(names)
+        if page is not None:
+            page(out)
     return summary
 
 

@@ -73,8 +73,9 @@ def run(args) -> int:
         plots=plots)
     log.info(f"fit-batch: {len(jobs)} tables into {out}")
     summary = run_batch(jobs, out, workers=args.workers, scheduler=args.scheduler,
-                        progress=cliutil.progress(args), notify=log.info)
-    page = write_batch_page(out)
+                        progress=cliutil.progress(args), notify=log.info,
+                        page=write_batch_page)
+    page = out / "index.html"
     c = summary.counts()
     print(f"{c.get('converged', 0)} converged, {c.get('not_converged', 0)} not converged, "
           f"{c.get('error', 0)} errors; summary: {out / 'summary.csv'}; page: {page}")

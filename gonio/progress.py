@@ -6,7 +6,7 @@ import sys
 
 import tqdm.auto
 
-__all__ = ["progress_bar", "interactive", "progress_line"]
+__all__ = ["progress_bar", "interactive", "progress_line", "LineStream", "PIPE_INTERVAL"]
 
 
 def interactive(stream=None) -> bool:
@@ -38,9 +38,42 @@ def progress_line(text: str, stream=None) -> None:
     print(text, file=stream, flush=True)
 
 
+#: Seconds between two lines of a bar on a pipe or a file (:class:`LineStream`).
+PIPE_INTERVAL = 10.0
+
+
+class LineStream:
+    """What a bar writes to a pipe or a file: each redraw one line, the redraws that only
+    clear the line dropped (tqdm redraws in place with carriage returns, which a log shows
+    as one ever longer line).
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> s = LineStream(out)
+    >>> s.write("\\rdemo:  50%|#####     | 1/2"); s.write("\\r" + " " * 30 + "\\r")
+    >>> out.getvalue()
+    'demo:  50%|#####     | 1/2\\n'
+    """
+
+    def __init__(self, stream):
+        self.stream = stream
+
+    def write(self, text: str) -> None:
+        line = text.replace("\r", "").rstrip()
+        if line:
+            self.stream.write(line + "\n")
+
+    def flush(self) -> None:
+        self.stream.flush()
+
+
 def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = True,
                  initial: int = 0):
-    """A tqdm bar (``tqdm.auto``: a widget in notebooks) on stderr that vanishes when closed.
+    """A tqdm bar (``tqdm.auto``: a widget in notebooks) on stderr that vanishes when closed;
+    on a pipe or a file (not :func:`interactive`) one line at the start, one every
+    :data:`PIPE_INTERVAL` seconds and one at the end (:class:`LineStream`).
 
     Parameters
     ----------
@@ -60,5 +93,9 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
     ...     bar.update(3)
     """
     # looked up on each call (not bound at import), so a patched tqdm.auto.tqdm is used
+    if enabled and not interactive():
+        return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=True,
+                              file=LineStream(sys.stderr), mininterval=PIPE_INTERVAL,
+                              ncols=80)
     return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=False,
                           file=sys.stderr, disable=not enabled)

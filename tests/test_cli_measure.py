@@ -151,6 +151,9 @@ def test_progress_shows_on_a_pipe_unless_turned_off(tmp_path):
         assert len(gonio.read(out)) == 625                 # full:30: 625 pairs
         runs[bool(flag)] = r.stderr
     assert "measure:" in runs[False] and "625" in runs[False] and "pair" in runs[False]
+    # on a pipe the bar is whole lines (no carriage returns), the last one at 100%
+    bar = [line for line in runs[False].splitlines() if line.startswith("measure:")]
+    assert "\r" not in runs[False] and bar[-1].startswith("measure: 100%")
     assert "measure:" not in runs[True] and "%|" not in runs[True]
 
 

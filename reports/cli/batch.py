@@ -13,12 +13,9 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import brdf
 from analysis.batch import jobs_from_inputs, run_batch
-from analysis.families import MICROCYLINDER, model_names
 from reports.cli import lazy
 from reports.cli import options as cliutil
-from reports.cli.fit import start_model
 from reports.report_batch import write_batch_page
 
 __all__ = ["register", "run"]
@@ -36,12 +33,7 @@ def register(sub):
                     "unfinished fits and skips converged ones. A file NAME.toml beside a table "
                     "replaces --spec/--free/--tie (and, with a fabric key, --fabric) for it.")
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="table files, globs or folders")
-    p.add_argument("--model", default=MICROCYLINDER, choices=model_names(),
-                   help="the model fitted to every table (default microcylinder); a baseline "
-                        "model starts from its parameters' typical values and takes no --fabric")
-    p.add_argument("--fabric", default=None, metavar="PRESET",
-                   help=f"preset giving fixed values and the start (required for the "
-                        f"microcylinder, refused for another model): {', '.join(brdf.PRESETS)}")
+    cliutil.add_model_arguments(p)
     cliutil.add_fit_options(p)
     p.add_argument("--sample", default=None, metavar="all|N,N,...",
                    help="CUReT samples of an abrdf.dat input")
@@ -59,7 +51,7 @@ def run(args) -> int:
     """Check everything, run the batch, print the counts; exit 1 when a table failed."""
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be >= 1; got {args.workers}")
-    fab = start_model(args)
+    fab = cliutil.start_model(args)
     plots = None
     if not args.no_plots:
         plots = lazy.plots().fit_diagnostics.write_fit_plots

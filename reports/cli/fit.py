@@ -16,8 +16,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import brdf
-from analysis.families import MICROCYLINDER, family, model_names
+from analysis.families import MICROCYLINDER
 from analysis.fit import fit_fabric, fit_spec
 from analysis.fit.fisher import suggest_for_file
 from analysis.fit.workflow import check_fit_size
@@ -44,13 +43,7 @@ def register(sub):
                     "stable and R-hat < 1.01, or a step limit. Resumes from DIR's checkpoints.")
     p.add_argument("table", metavar="TABLE", help="table file (.exr, .csv, .binary, .alta, "
                                                   ".bsdf, CUReT abrdf.dat with --sample)")
-    p.add_argument("--model", default=MICROCYLINDER, choices=model_names(),
-                   help="the model fitted (default microcylinder); a baseline model "
-                        "starts from its parameters' typical values and takes no --fabric")
-    p.add_argument("--fabric", default=None, metavar="PRESET",
-                   help=f"preset giving fixed values and the start (required for the "
-                        f"microcylinder, refused for another model): "
-                        f"{', '.join(brdf.PRESETS)}")
+    cliutil.add_model_arguments(p)
     cliutil.add_fit_options(p)
     p.add_argument("--sample", type=int, default=None, metavar="N",
                    help="CUReT sample number (for abrdf.dat)")
@@ -72,28 +65,6 @@ def _spec_from_args(args, fab, table=None):
     return fit_spec(fab, args.free, cliutil.split_ties(args.tie), args.spec, table=table)
 
 
-def start_model(args):
-    """The model a fit starts from: the preset ``--fabric`` with the variant flags for the
-    microcylinder, a baseline model at its typical values otherwise; one line for
-    ``--fabric`` (or a variant flag) with a baseline, or no ``--fabric`` for the
-    microcylinder."""
-    fam = family(args.model)
-    if fam.is_microcylinder:
-        if args.fabric is None:
-            raise ValueError("--fabric PRESET is required for --model microcylinder (the "
-                             f"preset gives the fixed values and the start): "
-                             f"{', '.join(brdf.PRESETS)}")
-        return cliutil.fabric_from_args(brdf.check_preset(args.fabric), args)
-    if args.fabric is not None:
-        raise ValueError(f"--fabric applies to --model microcylinder only; --model "
-                         f"{fam.name} starts from its own typical values (drop --fabric)")
-    given = cliutil.fabric_options(args)
-    if given:
-        raise ValueError(f"--model {fam.name} takes no fabric variant option "
-                         f"({', '.join(sorted(given))}): they belong to the microcylinder")
-    return fam.start()
-
-
 def _config_extra(args, fab) -> dict:
     """What the fit records of its start (and matches on resume)."""
     if args.model != MICROCYLINDER:
@@ -103,7 +74,7 @@ def _config_extra(args, fab) -> dict:
 
 def run(args) -> int:
     """Parse-level checks, then :func:`analysis.fit.fit_fabric`; print the summary."""
-    fab = start_model(args)
+    fab = cliutil.start_model(args)
     fit_kw = cliutil.fit_kwargs(args)
     if args.suggest:
         return _suggest(args, fit_kw, fab)

@@ -13,6 +13,7 @@ import brdf
 import gonio
 import gonio.io
 from analysis import sources
+from analysis.families import MICROCYLINDER, family, model_names
 from analysis.fit.driver import MAX_ENSEMBLES, FitOptions  # MAX_ENSEMBLES: re-exported
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
@@ -23,7 +24,7 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
            "fabric_argument", "source_from_args", "add_quiet_options", "progress",
            "check_output_suffix", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
-           "add_cluster_options", "check_tangent_samples", "reader_options", "read_table",
+           "add_cluster_options", "add_model_arguments", "start_model", "check_tangent_samples", "reader_options", "read_table",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
@@ -286,3 +287,37 @@ def check_writable_dir(path: Path) -> Path:
     finally:
         remove_empty_folders(created)
     return path
+
+
+def add_model_arguments(p) -> None:
+    """``--model`` and ``--fabric`` of ``fit`` and ``fit-batch`` (checked by
+    :func:`start_model`)."""
+    p.add_argument("--model", default=MICROCYLINDER, choices=model_names(),
+                   help="the model fitted (default microcylinder); a baseline model "
+                        "starts from its parameters' typical values and takes no --fabric")
+    p.add_argument("--fabric", default=None, metavar="PRESET",
+                   help=f"preset giving fixed values and the start (required for the "
+                        f"microcylinder, refused for another model): "
+                        f"{', '.join(brdf.PRESETS)}")
+
+
+def start_model(args):
+    """The model a fit starts from: the preset ``--fabric`` with the variant flags for the
+    microcylinder, a baseline model at its typical values otherwise; one line for
+    ``--fabric`` (or a variant flag) with a baseline, or no ``--fabric`` for the
+    microcylinder."""
+    fam = family(args.model)
+    if fam.is_microcylinder:
+        if args.fabric is None:
+            raise ValueError("--fabric PRESET is required for --model microcylinder (the "
+                             f"preset gives the fixed values and the start): "
+                             f"{', '.join(brdf.PRESETS)}")
+        return fabric_from_args(brdf.check_preset(args.fabric), args)
+    if args.fabric is not None:
+        raise ValueError(f"--fabric applies to --model microcylinder only; --model "
+                         f"{fam.name} starts from its own typical values (drop --fabric)")
+    given = fabric_options(args)
+    if given:
+        raise ValueError(f"--model {fam.name} takes no fabric variant option "
+                         f"({', '.join(sorted(given))}): they belong to the microcylinder")
+    return fam.start()

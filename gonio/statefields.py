@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gonio.safeopen import MAX_STATE_BYTES, read_bytes, read_text
+
 __all__ = ["FileFields", "load_json", "loads_json", "load_toml", "one_line", "MAX_DEPTH",
            "MAX_MAGNITUDE"]
 
@@ -78,23 +80,19 @@ def _check_depth(path, doc):
     return doc
 
 
-def load_json(path, what: str = "JSON file"):
+def load_json(path, what: str = "JSON file", *, max_bytes: int = MAX_STATE_BYTES):
     """The JSON document in ``path``.
 
     Raises
     ------
     ValueError
-        One line naming the file: unreadable, not UTF-8, not JSON, or nested more than
-        :data:`MAX_DEPTH` levels (``what`` says what the file should have been).
+        One line naming the file: unreadable, a link or not a regular file, larger than
+        ``max_bytes`` (bytes; :data:`gonio.safeopen.MAX_STATE_BYTES` by default), not UTF-8,
+        not JSON, or nested more than :data:`MAX_DEPTH` levels (``what`` says what the file
+        should have been). The file is opened once through :func:`gonio.safeopen.open_regular`.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"{path}: cannot read {what} (not UTF-8 text: {exc.reason})") from None
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
-    return loads_json(text, path, what)
+    return loads_json(read_text(path, max_bytes=max_bytes, what=what), path, what)
 
 
 def loads_json(text: str, path, what: str = "JSON file"):
@@ -108,12 +106,12 @@ def loads_json(text: str, path, what: str = "JSON file"):
     return _check_depth(path, doc)
 
 
-def load_toml(path, what: str = "TOML file") -> dict:
-    """The TOML document in ``path``; errors as :func:`load_json`."""
+def load_toml(path, what: str = "TOML file", *, max_bytes: int = MAX_STATE_BYTES) -> dict:
+    """The TOML document in ``path``; errors and the size cap as :func:`load_json`."""
     path = Path(path)
+    data = read_bytes(path, max_bytes=max_bytes, what=what)
     try:
-        with open(path, "rb") as fh:
-            doc = tomllib.load(fh)
+        doc = tomllib.loads(data.decode("utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{path}: not valid TOML: {exc}") from None
     except UnicodeDecodeError as exc:

@@ -41,6 +41,7 @@ ValueError: ...a.h5: x must be an array of numbers of shape (2,); got shape (3,)
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -60,6 +61,9 @@ _KINDS = {"number": ({h5py.h5t.FLOAT: (2, 4, 8), h5py.h5t.INTEGER: (1, 2, 4, 8)}
                      "an array of numbers", "a number"),
           "int": ({h5py.h5t.INTEGER: (1, 2, 4, 8)}, "an array of integers", "an integer"),
           "text": ({h5py.h5t.STRING: None}, "text", "text")}
+_CLASSES = {getattr(h5py.h5t, k): k.lower() for k in (
+    "INTEGER", "FLOAT", "TIME", "STRING", "BITFIELD", "OPAQUE", "COMPOUND", "REFERENCE", "ENUM",
+    "VLEN", "ARRAY")}
 _STORED = {h5py.h5d.CONTIGUOUS: "contiguous", h5py.h5d.COMPACT: "compact",
            h5py.h5d.CHUNKED: "chunked", getattr(h5py.h5d, "VIRTUAL", -1): "virtual"}
 
@@ -174,8 +178,8 @@ class _Walk:
         allowed = ", ".join(layout.entries) or "none"
         n = len(group)
         if n > len(layout.entries):
-            raise self.f.error(where or "/", f"a group of at most {len(layout.entries)} "
-                               f"entries ({allowed})", got=f"{n} entries")
+            raise self.f.error(where or "/", f"a group of at most {_count(len(layout.entries))} "
+                               f"({allowed})", got=_count(n))
         doc, seen = {}, set()
         for name in group:
             here = f"{where}.{name}" if where else name
@@ -222,7 +226,7 @@ class _Walk:
         dcpl = dset.id.get_create_plist()
         if dcpl.get_external_count() > 0:
             raise self.f.error(here, "a dataset stored in this file",
-                               got=f"external raw storage in {dcpl.get_external(0)[0]!r}")
+                               got=f"external raw storage in {os.fsdecode(dcpl.get_external(0)[0])}")
         stored = dcpl.get_layout()
         if dset.is_virtual or stored not in (h5py.h5d.CONTIGUOUS, h5py.h5d.COMPACT):
             raise self.f.error(here, "a dataset stored contiguous or compact in this file, "
@@ -266,7 +270,8 @@ class _Walk:
         sizes = classes.get(cls, ())
         if cls not in classes or (sizes is not None and tid.get_size() not in sizes):
             raise self.f.error(here, words,
-                               got=f"HDF5 type class {cls}, {tid.get_size()} bytes")
+                               got=f"an HDF5 {_CLASSES.get(cls, 'unknown')} type of "
+                                   f"{tid.get_size()} bytes")
 
     def _attributes(self, group, layout: H5Group, where: str, count: int, doc: dict):
         """Check a group's attributes: at most the layout's, each a scalar of its kind."""
@@ -289,6 +294,10 @@ class _Walk:
                 raise self.f.error(here, "a single value", got=f"shape {aid.shape}")
             self._kind(aid.get_type(), layout.attrs[name], here, 2)
             self.attrs.append((group, doc, name))
+
+
+def _count(n: int) -> str:
+    return f"{n} entr{'y' if n == 1 else 'ies'}"
 
 
 def _node_kind(obj) -> str:

@@ -46,7 +46,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import h5py
-import numpy as np
 
 from gonio.memory import check_memory
 from gonio.safeopen import open_regular
@@ -194,6 +193,7 @@ class _Walk:
                     raise self.f.error(here, "a group", got=_node_kind(obj))
                 doc[name] = self.group(obj, spec, here)
             else:
+                self._visit(obj, here)
                 self.dataset(obj, spec, here)
                 self.datasets.append((obj, doc, name))
         missing = [k for k in layout.entries if k not in seen and k not in layout.optional]

@@ -128,6 +128,11 @@ def _hard_link_repeat(f):
     f["ensemble_1"] = f["ensemble_0"]              # one node under two names
 
 
+def _hard_link_dataset(f):
+    del f["ensemble_1/accepted"]
+    f["ensemble_1/accepted"] = f["ensemble_0/accepted"]
+
+
 def _extra_entry(f):
     f["ensemble_0/rng/notes"] = np.zeros(3)
 
@@ -166,6 +171,7 @@ def _array_attribute(f):
 @pytest.mark.parametrize("change, field, why", [
     (_soft_link, "ensemble_1.chain", "soft link"),
     (_hard_link_repeat, "ensemble_1", "hard link to a node reached before"),
+    (_hard_link_dataset, "ensemble_1.accepted", "hard link to a node reached before"),
     (_extra_entry, "ensemble_0.rng", "at most 1 entry (keys)"),
     (_wrong_walkers, "ensemble_0.accepted", "shape (6,); got shape (7,)"),
     (_enum_accepted, "ensemble_0.accepted", "enum"),

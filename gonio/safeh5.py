@@ -145,8 +145,8 @@ def read_h5(path, layout: H5Group, *, what: str, max_bytes: int | None = None,
                 for group, doc, name in walk.attrs:
                     doc[f"attr:{name}"] = group.attrs[name]
         except (OSError, KeyError, TypeError, RuntimeError) as exc:
-            raise ValueError(f"{path}: cannot read {what} as HDF5 "
-                             f"({one_line(str(exc))})") from None
+            raise ValueError(f"{path}: corrupt, or not {what} (HDF5 cannot read it: "
+                             f"{one_line(str(exc))})") from None
     return tree
 
 

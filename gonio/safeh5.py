@@ -225,8 +225,9 @@ class _Walk:
             raise self.f.error(here, "a dataset", got=_node_kind(dset))
         dcpl = dset.id.get_create_plist()
         if dcpl.get_external_count() > 0:
+            other = os.fsdecode(dcpl.get_external(0)[0])
             raise self.f.error(here, "a dataset stored in this file",
-                               got=f"external raw storage in {os.fsdecode(dcpl.get_external(0)[0])}")
+                               got=f"external raw storage in {other}")
         stored = dcpl.get_layout()
         if dset.is_virtual or stored not in (h5py.h5d.CONTIGUOUS, h5py.h5d.COMPACT):
             raise self.f.error(here, "a dataset stored contiguous or compact in this file, "

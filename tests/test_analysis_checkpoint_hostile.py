@@ -288,3 +288,21 @@ def test_read_h5_counts_nodes_and_attributes(tmp_path):
         f.create_group("g")
     with pytest.raises(ValueError, match=r"a\.h5: attrs must be at most 0 attributes"):
         read_h5(p, layout, what="a test file")
+
+
+def test_checkpoint_h5_has_one_reader():
+    """Only gonio/safeh5.py opens an HDF5 file for reading; analysis/fit/checkpoint.py
+    writes one (through atomic_write) and reads through it. Any other h5py.File in the
+    package sources would be a second reader of checkpoint.h5."""
+    opened = {}
+    for path in ROOT.glob("*/**/*.py"):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in ("tests", "bench", "docs", ".venv"):
+            continue
+        n = sum("h5py.File(" in line for line in path.read_text().splitlines()
+                if not line.lstrip().startswith((">>>", "...")))     # doctests write files
+        if n:
+            opened[str(rel)] = n
+    assert opened == {"gonio/safeh5.py": 1, "analysis/fit/checkpoint.py": 1}, opened
+    text = (ROOT / "analysis" / "fit" / "checkpoint.py").read_text()
+    assert 'h5py.File(fh, "w")' in text and "read_h5(" in text

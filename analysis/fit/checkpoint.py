@@ -116,12 +116,13 @@ class FitFolder:
     def read_checkpoint(self, config: dict | None = None) -> dict | None:
         """The checkpoint: ``{"progress": dict, "ensembles": [dict of arrays, ...]}``, or None.
 
-        The file is read as data by :func:`gonio.safeh5.read_h5`: opened once (no link, no
-        FIFO, no larger than the memory limit, :func:`gonio.memory.memory_limit`), its structure checked against what the fit
-        of ``config`` writes (:func:`checkpoint_layout`: its ensembles, walkers and free
-        parameters; no link but hard links to nodes of its own, no external or virtual
-        storage) and the values it declares against the memory limit, before any value is
-        read; then the values are checked (:func:`check_checkpoint`).
+        The file is read as data by :func:`gonio.safeh5.read_h5`, the one reader of
+        ``checkpoint.h5`` (the resume, ``plan FITDIR``): opened once (no link, no FIFO, no
+        larger than :func:`gonio.memory.memory_limit`), its structure checked against what
+        the fit of ``config`` writes (:func:`checkpoint_layout`: its ensembles, walkers and
+        free parameters; no link but hard links to nodes of its own, no external, virtual or
+        chunked storage) and the values it declares against the memory limit, before any
+        value is read; then the values are checked (:func:`check_checkpoint`).
 
         Parameters
         ----------

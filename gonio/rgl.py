@@ -12,17 +12,31 @@ import numpy as np
 from brdf.frames import flat_pairs
 from brdf.shading import DENOM_MIN
 from gonio.errors import FormatError
+from gonio.memory import check_memory
 
-__all__ = ["read_tensor_file", "read_tensor_field", "load_rgl", "RGLBRDF", "HEADER_LIMIT"]
+__all__ = ["read_tensor_file", "read_tensor_field", "tensor_fields", "load_bytes", "check_rgl",
+           "load_rgl", "RGLBRDF", "HEADER_LIMIT", "MAX_FIELDS", "RGL_BYTES_PER_ELEMENT"]
 
 _MAGIC = b"tensor_file\0"
 _DTYPES = {1: "u1", 2: "i1", 3: "<u2", 4: "<i2", 5: "<u4", 6: "<i4", 7: "<u8", 8: "<i8",
            9: "<f2", 10: "<f4", 11: "<f8"}
 
 
+#: The most header bytes a tensor file's field table may take (read before any field).
+HEADER_LIMIT = 1 << 20
+#: The most fields a tensor file may declare (an RGL file has 11).
+MAX_FIELDS = 4096
+#: Peak memory of loading an RGL file (:class:`RGLBRDF`) per element of its fields, bytes,
+#: besides the file's own bytes: the vndf warp's float64 copies, CDFs and their normalized
+#: copies (about 50 bytes an element, measured: 7.4 times a real float32 file in all).
+RGL_BYTES_PER_ELEMENT = 64
+
+
 def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
-    """The field table of a tensor file's header: name -> (dtype, shape, offset), each
-    field checked to end within ``file_size`` bytes. ``data`` holds at least the header."""
+    """The field table of a tensor file's header: name -> (dtype, shape, offset), checked by
+    :func:`_check_layout` against ``file_size`` bytes. ``data`` holds at least the header;
+    only its first :data:`HEADER_LIMIT` bytes are read."""
+    data = data[:HEADER_LIMIT]
     if len(data) < 18 or data[:12] != _MAGIC:
         raise FormatError(path, f"wrong magic {data[:12]!r}, expected {_MAGIC!r} "
                                 "(not an RGL tensor file)")
@@ -30,8 +44,11 @@ def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
     if (major, minor) != (1, 0):
         raise FormatError(path, f"unsupported tensor file version {major}.{minor}, expected 1.0")
     (count,) = struct.unpack_from("<I", data, 14)
+    if count > MAX_FIELDS:
+        raise FormatError(path, f"the header declares {count:,} fields; a tensor file may "
+                                f"have at most {MAX_FIELDS:,} (an RGL file has 11)")
     pos = 18
-    table = {}
+    entries = []
     try:
         for _ in range(count):
             (name_len,) = struct.unpack_from("<H", data, pos)
@@ -46,17 +63,88 @@ def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
             pos += 8 * ndim
             if code not in _DTYPES:
                 raise FormatError(path, f"field {name!r} has unknown dtype code {code}")
-            dtype = np.dtype(_DTYPES[code])
-            size = math.prod(shape) * dtype.itemsize
-            if offset + size > file_size:
-                raise FormatError(path, f"wrong size: field {name!r} needs bytes "
-                                        f"{offset}..{offset + size}, file has {file_size} "
-                                        "(truncated?)")
-            table[name] = (dtype, shape, offset)
+            entries.append((name, np.dtype(_DTYPES[code]), shape, offset))
     except (struct.error, UnicodeDecodeError):
         raise FormatError(path, f"truncated or corrupt header (field table of {count} fields "
                                 f"ends past byte {pos} of {len(data)})") from None
-    return table
+    _check_layout(path, entries, pos, file_size)
+    return {name: (dtype, shape, offset) for name, dtype, shape, offset in entries}
+
+
+def _check_layout(path: Path, entries, header_end: int, file_size: int) -> None:
+    """Refuse a field table whose fields do not each lie within the file, after the header,
+    apart from one another (one name once): what is declared is then at most what the file
+    holds, and the memory of loading it follows from the file's size."""
+    spans, seen = [], set()
+    for name, dtype, shape, offset in entries:
+        if name in seen:
+            raise FormatError(path, f"field {name!r} is declared twice")
+        seen.add(name)
+        size = math.prod(shape) * dtype.itemsize
+        if offset + size > file_size:
+            raise FormatError(path, f"wrong size: field {name!r} needs bytes "
+                                    f"{offset}..{offset + size}, file has {file_size} "
+                                    "(truncated?)")
+        if size and offset < header_end:
+            raise FormatError(path, f"field {name!r} starts at byte {offset}, inside the "
+                                    f"header (which ends at byte {header_end})")
+        if size:
+            spans.append((offset, offset + size, name))
+    spans.sort()
+    for (_, end, a), (start, _, b) in zip(spans, spans[1:]):
+        if start < end:
+            raise FormatError(path, f"fields {a!r} and {b!r} overlap (bytes {start}..{end}); "
+                                    "each field of a tensor file has bytes of its own")
+
+
+def tensor_fields(path) -> tuple[dict[str, tuple], int]:
+    """The field table of a tensor file (name -> (dtype, shape, offset)) and the file's
+    size, from its header alone; the fields checked to lie within the file without
+    overlapping (:func:`read_tensor_file` checks the same).
+
+    Raises
+    ------
+    FormatError
+        As :func:`read_tensor_file`, before any field is read.
+    """
+    path = Path(path)
+    with open(path, "rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        return _field_table(path, fh.read(HEADER_LIMIT), size), size
+
+
+def load_bytes(fields: dict[str, tuple], file_size: int) -> int:
+    """Peak memory of loading a tensor file as an :class:`RGLBRDF`, bytes: the file and
+    :data:`RGL_BYTES_PER_ELEMENT` for each element of its fields (:func:`tensor_fields`).
+
+    Examples
+    --------
+    >>> load_bytes({"rgb": (np.dtype("<f4"), (1, 2, 3, 4, 4), 64)}, 448)
+    6592
+    """
+    elements = sum(math.prod(shape) for _, shape, _ in fields.values())
+    return file_size + RGL_BYTES_PER_ELEMENT * elements
+
+
+def check_rgl(path) -> int:
+    """Refuse, from its header alone, an RGL file whose fields do not fit the file
+    (:func:`tensor_fields`) or whose loading would exceed the memory limit
+    (:func:`gonio.memory.check_memory`); returns the bytes of loading it
+    (:func:`load_bytes`). Every load of a tensor file goes through it.
+
+    Raises
+    ------
+    FormatError
+        A damaged or aliasing field table (one line naming the file and the field).
+    MemoryLimitError
+        A file too large for the memory.
+    """
+    path = Path(path)
+    fields, size = tensor_fields(path)
+    nbytes = load_bytes(fields, size)
+    check_memory(f"loading {path.name} ({len(fields)} fields, {size:,} bytes)", nbytes,
+                 "load it on a machine with more memory")
+    return nbytes
 
 
 def read_tensor_file(path) -> dict[str, np.ndarray]:
@@ -75,16 +163,17 @@ def read_tensor_file(path) -> dict[str, np.ndarray]:
     Raises
     ------
     FormatError
-        Wrong magic, unknown version or dtype, or a field reaching past the end of the file.
+        Wrong magic, unknown version or dtype, a field reaching past the end of the file,
+        into the header or into another field (:func:`check_rgl`, before the fields are
+        read).
+    MemoryLimitError
+        Loading the file would exceed the memory limit (:func:`check_rgl`).
     """
     path = Path(path)
+    check_rgl(path)
     data = path.read_bytes()
     return {name: np.frombuffer(data, dtype, math.prod(shape), offset).reshape(shape)
             for name, (dtype, shape, offset) in _field_table(path, data, len(data)).items()}
-
-
-#: The most header bytes :func:`read_tensor_field` reads to find its field.
-HEADER_LIMIT = 1 << 20
 
 
 def read_tensor_field(path, name: str) -> np.ndarray | None:
@@ -217,6 +306,37 @@ class _Conditional:
         return np.stack([ux, uy], axis=-1)
 
 
+def _check_angles(path, theta_i, phi_i) -> None:
+    """Refuse, naming the field, incident angles that the evaluation cannot interpolate
+    between: ``theta_i`` and ``phi_i`` non-empty lists, finite and strictly increasing,
+    ``theta_i`` in [0, pi/2] and ``phi_i`` in [-pi, pi] radians."""
+    for name, values, hi in (("theta_i", theta_i, np.pi / 2), ("phi_i", phi_i, np.pi)):
+        lo = 0.0 if name == "theta_i" else -np.pi
+        if values.ndim != 1 or values.size == 0:
+            raise FormatError(path, f"field {name!r} must be a non-empty list of angles; "
+                                    f"got shape {values.shape}")
+        if not np.all(np.isfinite(values)) or np.any(np.diff(values) <= 0):
+            raise FormatError(path, f"field {name!r} must increase strictly (finite angles, "
+                                    f"radians); got " + ", ".join(f"{v:.4g}" for v in values[:8])
+                              + (", ..." if values.size > 8 else ""))
+        if values[0] < lo - 1e-6 or values[-1] > hi + 1e-6:
+            raise FormatError(path, f"field {name!r} must lie in [{lo:.4g}, {hi:.4g}] "
+                                    f"radians; got {values[0]:.4g}..{values[-1]:.4g}")
+
+
+def _check_grids(path, fields) -> None:
+    """Refuse, naming the field, a grid the evaluation cannot interpolate in: every 2-D grid
+    (``ndf``, ``sigma``, the last two axes of ``vndf`` and ``rgb``) at least 2 x 2;
+    ``jacobian`` non-empty."""
+    for name in ("ndf", "sigma", "vndf", "rgb"):
+        grid = fields[name].shape[-2:]
+        if min(grid) < 2:
+            raise FormatError(path, f"field {name!r} is a {grid[0]} x {grid[1]} grid; the "
+                                    "interpolation needs at least 2 x 2")
+    if np.asarray(fields["jacobian"]).size == 0:
+        raise FormatError(path, "field 'jacobian' is empty; expected one flag")
+
+
 class RGLBRDF:
     """A measured BRDF from an RGL tensor file, evaluated as Mitsuba 3's ``measured`` plugin.
 
@@ -252,6 +372,7 @@ class RGLBRDF:
                                     "RGL tensor file")
         theta_i = np.asarray(fields["theta_i"], np.float64)
         phi_i = np.asarray(fields["phi_i"], np.float64)
+        _check_angles(path, theta_i, phi_i)
         ndf, sigma, vndf, rgb = (fields[k] for k in ("ndf", "sigma", "vndf", "rgb"))
         nphi, nth = phi_i.shape[0], theta_i.shape[0]
         if (ndf.ndim != 2 or sigma.ndim != 2 or vndf.shape[:2] != (nphi, nth) or vndf.ndim != 4
@@ -259,6 +380,7 @@ class RGLBRDF:
             raise FormatError(path, "field shapes do not match an RGB RGL tensor file: "
                               f"phi_i {phi_i.shape}, theta_i {theta_i.shape}, ndf {ndf.shape}, "
                               f"sigma {sigma.shape}, vndf {vndf.shape}, rgb {rgb.shape}")
+        _check_grids(path, fields)
         self.isotropic = nphi <= 2
         self.jacobian = bool(np.asarray(fields["jacobian"]).ravel()[0])
         self.reduction = 0

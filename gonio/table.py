@@ -11,7 +11,12 @@ import numpy as np
 
 from brdf.frames import normalize, to_angles
 
-__all__ = ["Table"]
+__all__ = ["Table", "MAX_META_BYTES"]
+
+#: The most bytes a table file's metadata may take (a CSV file's ``# key: value`` comment
+#: lines, an OpenEXR file's ``microcyl_meta`` attribute): the metadata microcyl writes is a
+#: few kilobytes, and parsed JSON takes tens of times its bytes.
+MAX_META_BYTES = 1 << 20
 
 
 def _as_n3(name: str, value, n: int | None) -> np.ndarray:

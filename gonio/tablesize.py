@@ -75,9 +75,16 @@ LINE_ENDS = (b"\n", b"\r", b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\xc2\x
 _LINE_END = re.compile(rb"\r\n|[\n\r\x0b\x0c\x1c-\x1e]|\xc2\x85|\xe2\x80[\xa8\xa9]")
 
 
+#: Every byte but the one-byte line ends, deleted to count those.
+_NOT_ENDS = bytes(b for b in range(256) if bytes([b]) not in LINE_ENDS)
+
+
 def _count_ends(buf: bytes) -> int:
     """Line ends in ``buf`` as ``str.splitlines`` counts them (``\\r\\n`` is one)."""
-    return sum(buf.count(e) for e in LINE_ENDS) - buf.count(b"\r\n")
+    n = len(buf.translate(None, _NOT_ENDS)) - buf.count(b"\r\n")
+    if not buf.isascii():
+        n += sum(buf.count(e) for e in LINE_ENDS[7:])
+    return n
 
 
 @dataclasses.dataclass
@@ -103,23 +110,26 @@ class _TextScan:
         self._comments(chunk)
         if self.fields or len(self.pending) > _CHUNK:
             return
-        *complete, self.pending = _LINE_END.split(self.pending + chunk)
-        for line in complete:
-            if self._first_fields(line):
-                break
+        buf, start = self.pending + chunk, 0
+        for m in _LINE_END.finditer(buf):
+            if self._first_fields(buf[start:m.start()]):
+                return
+            start = m.end()
+        self.pending = buf[start:]
 
     def _comments(self, chunk: bytes) -> None:
-        if b"#" not in chunk:
-            if self.in_comment:
-                m = _LINE_END.search(chunk)
-                self.comment_bytes += len(chunk) if m is None else m.start()
-                self.in_comment = m is None
-            return
-        pieces = _LINE_END.split(chunk)
-        for k, piece in enumerate(pieces):
-            self.in_comment = b"#" in piece or (k == 0 and self.in_comment)
-            if self.in_comment:
-                self.comment_bytes += len(piece)
+        """Count the bytes from each ``#`` to its line's end."""
+        pos = 0
+        if self.in_comment:                     # a comment line goes on from the last chunk
+            m = _LINE_END.search(chunk)
+            pos = len(chunk) if m is None else m.start()
+            self.comment_bytes += pos
+            self.in_comment = m is None
+        while (h := chunk.find(b"#", pos)) >= 0:
+            m = _LINE_END.search(chunk, h)
+            pos = len(chunk) if m is None else m.end()
+            self.comment_bytes += (len(chunk) if m is None else m.start()) - h
+            self.in_comment = m is None
 
     def _first_fields(self, line: bytes) -> bool:
         s = line.strip().removeprefix(b"\xef\xbb\xbf").strip()

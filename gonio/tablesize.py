@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import re
 from pathlib import Path
 
@@ -148,7 +149,8 @@ class _TextScan:
 def _scan(path: Path, sep) -> _TextScan:
     scan = _TextScan(sep)
     with open(path, "rb") as fh:
-        while chunk := fh.read(_CHUNK):
+        step = min(_CHUNK, max(os.fstat(fh.fileno()).st_size, 1))   # no 4 MiB for a small file
+        while chunk := fh.read(step):
             scan.feed(chunk)
     scan.finish()
     return scan

@@ -28,7 +28,7 @@ from brdf.frames import from_angles
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.jsonplain import plain
-from gonio.table import MAX_META_BYTES, Table
+from gonio.table import Table, check_meta_size
 
 __all__ = ["read_exr", "write_exr", "image_layout", "from_angles", "meta_to_json",
            "check_headers"]
@@ -190,7 +190,7 @@ def check_headers(path, headers: list[dict]) -> None:
     """Refuse, from the headers of its parts alone (before a pixel is read), an OpenEXR file
     that is no microcyl table: several parts, a deep image (its pixels hold any number of
     samples each, which the image size does not tell), or a ``microcyl_meta`` attribute of
-    more than :data:`gonio.table.MAX_META_BYTES`.
+    more than :data:`gonio.table.MAX_META_BYTES` (:func:`gonio.table.check_meta_size`).
 
     Raises
     ------
@@ -212,12 +212,8 @@ one flat scanline or tiled image
     if kind not in (OpenEXR.scanlineimage, OpenEXR.tiledimage):
         raise FormatError(path, f"a deep OpenEXR image ({getattr(kind, 'name', kind)}); a "
                                 "microcyl table is one flat scanline or tiled image")
-    meta = headers[0].get("microcyl_meta", "")
-    size = len(meta.encode("utf-8", "replace")) if isinstance(meta, str) else len(str(meta))
-    if size > MAX_META_BYTES:
-        raise FormatError(path, f"the microcyl_meta attribute holds {size:,} bytes; a table's "
-                                f"metadata may hold at most {MAX_META_BYTES:,} (microcyl "
-                                "writes a few KB)")
+    meta = str(headers[0].get("microcyl_meta", ""))
+    check_meta_size(path, len(meta.encode("utf-8", "replace")), "the microcyl_meta attribute")
 
 
 def _check_channels(path: Path, chans: dict) -> bool:

@@ -2,17 +2,31 @@
 
 :func:`gonio.read` (and so every verb that reads a table) calls :func:`check_table` before
 parsing, so that a table too large for the memory is refused at once, in one line, instead of
-after minutes of parsing and a MemoryError. The estimate reads no more than it must:
+after minutes of parsing and a MemoryError. Each format's estimate counts what its parser
+builds, and reads no more than it must:
 
-- text tables (CSV, ALTA, CUReT): the rows by a count of line ends (chunks of 4 MiB, about a
-  second a gigabyte), the fields from the header line; the parse costs about
-  :data:`TEXT_BYTES_PER_ROW` + :data:`TEXT_BYTES_PER_FIELD` per field a row, plus
-  :data:`TEXT_BYTES_PER_BYTE` of the file (measured: 740 B a row for 5 fields, 1,280 for 10);
+- text tables (CSV, ALTA, CUReT): the rows by a count of line ends, every one that the
+  readers' ``str.splitlines`` splits on (:data:`LINE_ENDS`: ``\\r`` and the rarer ones too,
+  not ``\\n`` alone; chunks of 4 MiB, about a second a gigabyte), the fields from the header
+  line; the parse costs about :data:`TEXT_BYTES_PER_ROW` + :data:`TEXT_BYTES_PER_FIELD` per
+  field a row, plus :data:`TEXT_BYTES_PER_BYTE` of the file (measured: 740 B a row for 5
+  fields, 1,280 for 10), more for text that is not ASCII; a CSV file's ``#`` comment lines,
+  parsed as JSON metadata, are capped at :data:`gonio.table.MAX_META_BYTES` (refused over it)
+  and cost :data:`META_BYTES_PER_BYTE`;
 - OpenEXR: the data window and the channels of its header (OpenEXR's ``header_only``), no
   pixel read; :data:`EXR_BYTES_PER_PIXEL` plus 4 bytes a channel a pixel (290 measured for 10
-  channels);
-- MERL: its fixed size and the stride; RGL: the file's size and, from its header, the
+  channels), and the ``microcyl_meta`` attribute as a CSV file's metadata; a multi-part or
+  deep file (whose header does not tell its samples) is refused
+  (:func:`gonio.exr.check_headers`);
+- MERL: its fixed size and the stride; RGL: from its header, its fields checked to fit the
+  file without overlapping and the memory of loading them (:func:`gonio.rgl.check_rgl`,
+  which every load of an RGL file goes through, :func:`gonio.load_rgl` included), and the
   incident directions times the outgoing ones of ``step`` (:data:`RGL_BYTES_PER_PAIR`).
+
+A header that says the file is no table the reader can build (metadata over the cap, a deep
+or multi-part OpenEXR, RGL fields that overlap) is refused by :func:`estimate_table` as a
+:class:`gonio.FormatError` naming the file; a file the estimate cannot read at all is left
+to its reader, which says what is wrong.
 """
 
 from __future__ import annotations
@@ -29,11 +43,11 @@ import OpenEXR
 from gonio.csvtable import DELIMITERS
 from gonio.errors import FormatError
 from gonio.exr import check_headers
-from gonio.memory import check_memory, format_bytes
+from gonio.memory import check_memory
 from gonio.merl import FILE_SIZE as MERL_FILE_SIZE
 from gonio.merl import SHAPE as MERL_SHAPE
 from gonio.rgl import load_bytes, read_tensor_field, tensor_fields
-from gonio.table import MAX_META_BYTES
+from gonio.table import check_meta_size
 
 __all__ = ["Estimate", "estimate_table", "check_table", "text_estimate", "rgl_pairs",
            "TEXT_BYTES_PER_ROW", "TEXT_BYTES_PER_FIELD", "TEXT_BYTES_PER_BYTE",
@@ -194,10 +208,8 @@ def text_estimate(path, sep: str | tuple | None = ",", *, meta: bool = False) ->
     scan = _scan(path, sep)
     lines, fields = scan.lines, scan.fields
     size = path.stat().st_size
-    if meta and scan.comment_bytes > MAX_META_BYTES:
-        raise FormatError(path, f"the # comment lines hold {format_bytes(scan.comment_bytes)}; "
-                                f"a table's metadata may hold at most "
-                                f"{format_bytes(MAX_META_BYTES)} (microcyl writes a few KB)")
+    if meta:
+        check_meta_size(path, scan.comment_bytes, "the # comment lines")
     per_byte = TEXT_BYTES_PER_BYTE + (0 if scan.ascii else TEXT_BYTES_PER_WIDE_BYTE)
     nbytes = (lines * (TEXT_BYTES_PER_ROW + TEXT_BYTES_PER_FIELD * fields + TABLE_BYTES_PER_ROW)
               + per_byte * size + (META_BYTES_PER_BYTE * scan.comment_bytes if meta else 0))
@@ -265,6 +277,14 @@ def estimate_table(path, kind: str, **options) -> Estimate | None:
     """The size of the table ``path`` of format ``kind`` (:data:`gonio.io.READ_OPTIONS`'s
     names) read with ``options``; None when it cannot be told before reading: a file that
     cannot be opened, a header that cannot be read (the reader then says what is wrong).
+
+    Raises
+    ------
+    FormatError
+        A header that says the reader could not build the table: a CSV file's metadata
+        comments or an OpenEXR file's ``microcyl_meta`` over
+        :data:`gonio.table.MAX_META_BYTES`, a deep or multi-part OpenEXR file, RGL fields
+        outside the file, in its header or overlapping.
     """
     path = Path(path)
     try:

@@ -1,9 +1,9 @@
 """Parameter specification for fitting a model: bounds, priors, ties.
 
 The names, their bounds, units and priors come from the model's family
-(:mod:`analysis.families`: the microcylinder's are in :mod:`analysis.paramnames`, derived from
-:mod:`brdf.schema`, each baseline's from its ``PARAMS``); the parsing of ``--free``/``--tie``
-strings is in :mod:`analysis.paramnames`; this module re-exports the microcylinder's names.
+(:mod:`analysis.families`: the registered model's flat parameters, :class:`brdf.ParamSchema`);
+the parsing of ``--free``/``--tie`` strings is in :mod:`analysis.paramnames`; this module
+re-exports the microcylinder's names.
 
 Each parameter is free (sampled), fixed (at its default, normally the preset's value) or tied to
 another one (``eta2=eta1``: eta2 takes eta1's value; ``area2=1-area1``: the complement).
@@ -319,9 +319,10 @@ class ParamSpec:
         return np.where(ok, jac, -np.inf)
 
     def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """Keyword arguments of the model's ``prepare(...).eval``
-        (:meth:`analysis.families.ModelFamily.model_kwargs`): for the microcylinder each
-        (B..., 2), albedo (B..., 2, 3); for a baseline each scalar (B...), RGB (B..., 3)."""
+        """Keyword arguments of the model's forward model (its class's ``batch_kwargs``,
+        :meth:`analysis.families.ModelFamily.model_kwargs`): for the microcylinder each
+        (B..., 2), albedo (B..., 2, 3) and ``tangent_scale``; for a baseline each scalar
+        (B...), RGB (B..., 3)."""
         return self.family.model_kwargs(values)
 
     @property
@@ -340,7 +341,7 @@ class ParamSpec:
         }
 
     def __repr__(self) -> str:
-        model = "" if self.family.is_microcylinder else f", model={self.model!r}"
+        model = "" if self.family.is_default else f", model={self.model!r}"
         return f"ParamSpec(free={list(self.free)}, ties={self.ties}{model})"
 
 

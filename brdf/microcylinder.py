@@ -122,8 +122,8 @@ class MicrocylinderModel:
         return {**thread_values(self), "tangent_scale1": 1.0, "tangent_scale2": 1.0}
 
     def with_values(self, values: Mapping[str, float]):
-        """This fabric with some parameters changed (names of :data:`SCHEMA`; a colour only
-        with its three channels; a tangent scale multiplies the offsets).
+        """This fabric with some parameters changed (names of :data:`SCHEMA`; a colour's
+        channels not given keep their values; a tangent scale multiplies the offsets).
 
         Raises
         ------
@@ -133,6 +133,9 @@ class MicrocylinderModel:
         unknown = sorted(set(values) - set(SCHEMA.names))
         if unknown:
             raise ValueError(f"microcylinder: unknown parameter(s) {', '.join(unknown)}")
+        if any(n.startswith(_RGB) for n in values):       # a colour's other channels kept
+            values = {**{n: v for n, v in thread_values(self).items()
+                         if n.startswith(_RGB)}, **values}
         threads = []
         for j, t in zip(_THREADS, self.threads):
             change = {q: float(values[f"{q}{j}"]) for q in schema.SCALAR_PARAMS

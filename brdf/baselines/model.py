@@ -124,14 +124,15 @@ class BaselineModel:
         return out
 
     def with_values(self, values) -> "BaselineModel":
-        """A copy with some flat parameters changed (a colour only with its three
-        channels; validated)."""
+        """A copy with some flat parameters changed (validated; the rest, a colour's other
+        channels included, kept)."""
         schema = self.param_schema()
         unknown = sorted(set(values) - set(schema.names))
         if unknown:
             raise ValueError(f"{self.name}: unknown parameter(s) {', '.join(unknown)}; "
                              f"parameters: {', '.join(schema.names)}")
-        grouped = schema.grouped(values, lambda xs: tuple(float(x) for x in xs))
+        grouped = schema.grouped({**self.values(), **values},
+                                 lambda xs: tuple(float(x) for x in xs))
         return self.replace(**{q: v if isinstance(v, tuple) else float(v)
                                for q, v in grouped.items()})
 

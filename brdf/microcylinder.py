@@ -105,10 +105,20 @@ class MicrocylinderModel:
     #: The presets :meth:`start` takes (one is required on the command line).
     PRESETS: ClassVar[tuple[str, ...]] = PRESETS
 
+    #: The parameters constrained together (:meth:`admissible`).
+    CONSTRAINED: ClassVar[tuple[str, ...]] = ("area1", "area2")
+
     @classmethod
     def param_schema(cls) -> ParamSchema:
         """The flat parameters (:data:`SCHEMA`)."""
         return SCHEMA
+
+    @classmethod
+    def admissible(cls, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """Whether each set of values (arrays B...) makes a fabric beyond each parameter's own
+        range: the threads' areas sum to at most :data:`brdf.schema.AREA_SUM_MAX` (up to a
+        rounding margin of 1e-12), (B...) bool."""
+        return np.asarray(values["area1"] + values["area2"] <= schema.AREA_SUM_MAX + 1e-12)
 
     @classmethod
     def start(cls, preset: str | None = None, options: Mapping | None = None):

@@ -69,7 +69,9 @@ class Model(SampledBRDF, Protocol):
     the model a fit starts from (``PRESETS`` the presets it takes, none for most);
     ``batch_kwargs(values)``, the keyword arguments of ``prepare(wi, wo).eval`` from flat
     values (B...); a fit's defaults ``DEFAULT_FREE`` (None: every parameter) and
-    ``DEFAULT_TIES``, and ``BASE_PARAM`` (the colour that carries the level of f_r, or None).
+    ``DEFAULT_TIES``, and ``BASE_PARAM`` (the colour that carries the level of f_r, or None);
+    ``admissible(values)``, whether values in range make a model together (B...) bool, for
+    the parameters ``CONSTRAINED`` together (a fabric's two areas; none for most).
 
     Instance level: ``eval``, ``sample``, ``pdf`` (:class:`SampledBRDF`); ``values()``
     (every flat parameter by name), ``with_values(values)`` (a copy with some changed);
@@ -91,6 +93,7 @@ class Model(SampledBRDF, Protocol):
     DEFAULT_TIES: ClassVar[tuple[str, ...]]
     BASE_PARAM: ClassVar[str | None]
     PRESETS: ClassVar[tuple[str, ...]]
+    CONSTRAINED: ClassVar[tuple[str, ...]]
 
     @classmethod
     def param_schema(cls):
@@ -99,6 +102,10 @@ class Model(SampledBRDF, Protocol):
     @classmethod
     def start(cls, preset=None, options=None) -> "Model":
         """The model a fit starts from."""
+
+    @classmethod
+    def admissible(cls, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """Whether each set of flat values (B...) makes a model together."""
 
     @classmethod
     def batch_kwargs(cls, values: Mapping[str, np.ndarray]) -> dict:

@@ -88,6 +88,9 @@ def check_protocol(cls):
     for group, names in schema.aliases.items():
         assert [schema[n].channel for n in names] == [0, 1, 2] and group not in schema
     assert model.with_values({}).values() == model.values()
+    assert set(cls.CONSTRAINED) <= set(schema.names)
+    start = {n: np.array([v]) for n, v in model.values().items()}
+    assert cls.admissible(start).tolist() == [True]
 
 
 def check_shapes_and_broadcasting(cls):
@@ -216,6 +219,11 @@ def test_microcylinder_values_round_trip_through_the_fabric():
     assert moved.options == fab.options and moved.name == fab.name
     with pytest.raises(ValueError, match="thread 2: kd"):
         fab.with_values({"kd2": 1.5})
+    # the areas are constrained together: what with_values refuses, admissible says
+    areas = {"area1": np.array([0.5, 0.6]), "area2": np.array([0.5, 0.6])}
+    assert type(fab).admissible(areas).tolist() == [True, False]
+    with pytest.raises(ValueError, match="areas must sum to at most 1"):
+        fab.with_values({"area1": 0.6, "area2": 0.6})
 
 
 # -- a toy model, registered in the test -------------------------------------------------------

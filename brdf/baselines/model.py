@@ -72,6 +72,8 @@ class BaselineModel:
     DEFAULT_TIES: ClassVar[tuple[str, ...]] = ()
     #: No presets: a baseline starts from its parameters' typical values.
     PRESETS: ClassVar[tuple[str, ...]] = ()
+    #: No parameters constrained together (:meth:`admissible`).
+    CONSTRAINED: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, **values):
         known = {p.name: p for p in self.PARAMS}
@@ -102,6 +104,11 @@ class BaselineModel:
         """The flat parameters: a scalar row by its name, an RGB one per channel
         (``base_r``, ``base_g``, ``base_b``; the alias ``base``)."""
         return ParamSchema.from_rows(cls.PARAMS)
+
+    @classmethod
+    def admissible(cls, values) -> np.ndarray:
+        """Every set of values in range is a model: True for each (B...)."""
+        return np.ones(np.broadcast(*values.values()).shape if values else (), dtype=bool)
 
     @classmethod
     def start(cls, preset: str | None = None, options=None) -> "BaselineModel":

@@ -39,7 +39,7 @@ Where each of MODEL.md's names runs (the hot path), and its transliteration from
 """
 
 
-from brdf import directions, frames, sampling, schema, terms
+from brdf import directions, frames, microcylinder, sampling, schema, terms
 from brdf.forward import Forward
 from brdf.curve import TangentCurve
 from brdf.fabric import Fabric, Prepared
@@ -61,5 +61,5 @@ __all__ = [
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
     "MAX_TANGENT_SAMPLES", "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
     "Model", "MODELS", "DEFAULT_MODEL", "model_class", "model_name", "model_names",
-    "ParamSchema", "FlatParam", "Forward", "FabricForward",
+    "ParamSchema", "FlatParam", "Forward", "FabricForward", "microcylinder",
 ]

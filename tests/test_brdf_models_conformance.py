@@ -17,6 +17,7 @@ integrating to 1 and sample's weight being f_r cos / pdf; the batched forward mo
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -26,7 +27,8 @@ import brdf
 from _chi2 import cell_integrals, chi2_pvalue, histogram, sidak
 from analysis.albedo import albedo
 from analysis.families import family
-from analysis.fit import LogPosterior, fit_spec, forward_model
+from analysis.fit import LogPosterior, fit_fabric, fit_spec, forward_model
+from analysis.fit.medians import median_fabric
 from brdf import MODELS
 from brdf.baselines import BaselineModel
 from brdf.schema import ParamInfo
@@ -251,7 +253,7 @@ class Toy(BaselineModel):
         return base[..., None, :] * lobe[..., None]
 
 
-def test_a_registered_toy_model_flows_through_the_checks_and_the_fit(monkeypatch):
+def test_a_registered_toy_model_flows_through_the_checks_and_the_fit(monkeypatch, tmp_path):
     monkeypatch.setitem(MODELS, "toy", Toy)
     for check in CHECKS:
         check(Toy, **({"alpha": 0.01} if check is check_sampler_against_pdf else {}))
@@ -276,3 +278,11 @@ def test_a_registered_toy_model_flows_through_the_checks_and_the_fit(monkeypatch
         want = (np.array([v["base_r"], v["base_g"], v["base_b"]]) * (v["k"] + 2.0)
                 / (2.0 * math.pi) * ((wi[:, 2] * wo[:, 2]) ** v["k"])[:, None])
         np.testing.assert_allclose(pred[b], want, rtol=1e-12)
+    # and a whole fit: results.json names it, its medians make a Toy near the truth
+    r = fit_fabric(table, Toy(), spec, tmp_path / "toy", max_steps=120, check_every=60,
+                   seed=2, progress=False)
+    assert json.loads((tmp_path / "toy" / "results.json").read_text())["model"] == "toy"
+    med = median_fabric(tmp_path / "toy")
+    assert isinstance(med.fabric, Toy) and med.model_name == "toy" and med.preset is None
+    assert r.summary["k"]["lo95"] < 2.0 < r.summary["k"]["hi95"]
+    np.testing.assert_allclose(med.fabric.base, (0.2, 0.5, 0.8), rtol=0.05)

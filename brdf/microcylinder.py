@@ -53,8 +53,8 @@ _ROWS = tuple(schema.THREAD[n] for n in schema.SCALAR_PARAMS + _RGB)
 _THREADS = (1, 2)
 
 #: The parameters the shading takes (both threads).
-_SHADING = ParamSchema(sum((ParamSchema.from_rows(_ROWS, str(j), plausible_fallback=True).params
-                            for j in _THREADS), ()))
+_SHADING = ParamSchema.from_rows(_ROWS, "1", plausible_fallback=True) \
+    + ParamSchema.from_rows(_ROWS, "2", plausible_fallback=True)
 #: Every parameter of the model: the shading's, then the tangent scales.
 SCHEMA = _SHADING + ParamSchema.from_rows([TANGENT_SCALE], "1") \
     + ParamSchema.from_rows([TANGENT_SCALE], "2")

@@ -1,17 +1,15 @@
-"""The fit's parameter names, bounds and priors, derived from :mod:`brdf.schema`; ``--free`` and
-``--tie`` strings.
+"""The parsing of a fit's parameter names (``--free`` and ``--tie`` strings, TOML spec files)
+against a model's catalogue, and the fit's own parameters.
 
-Model parameters are named by quantity and thread number: ``eta1``, ``kd1``, ``gamma_s1``,
-``gamma_v1``, ``area1``, ``albedo1_r``, ``albedo1_g``, ``albedo1_b`` and the same with ``2``:
-the scalar parameters of :data:`brdf.schema.THREAD_PARAMS`, then each RGB one per channel. Their
-bounds are the schema's typical ranges (inside the ranges a Thread accepts), their units the
-schema's, their priors log-uniform where the schema's range spans decades (``log_scale``) and
-uniform otherwise, their fallback defaults the schema's typical values.
+A model's parameter names are its flat parameters (:class:`brdf.ParamSchema`, from the model
+protocol; :class:`analysis.families.ModelFamily`). The microcylinder's
+(:mod:`brdf.microcylinder`: ``eta1``, ``kd1``, ``gamma_s1``, ``gamma_v1``, ``area1``,
+``albedo1_r``, ... and the same with ``2``, then ``tangent_scale1``/``tangent_scale2``) are
+the default catalogue :data:`CATALOGUE` and are re-exported here.
 
-The fit adds its own parameters: ``tangent_scale1``/``tangent_scale2`` (a factor on a thread's
-tangent offsets), ``scale`` (a nuisance overall factor on f_r, for relative data such as CUReT)
-and ``log_noise`` (natural log of the noise standard deviation in the likelihood's residual
-space, for tables without sigma).
+The fit adds its own parameters: ``scale`` (a nuisance overall factor on f_r, for relative
+data such as CUReT) and ``log_noise`` (natural log of the noise standard deviation in the
+likelihood's residual space, for tables without sigma).
 """
 
 from __future__ import annotations
@@ -23,62 +21,37 @@ from typing import Mapping
 
 import numpy as np
 
-from brdf import schema
+from brdf import microcylinder, schema
+from brdf.paramschema import PRIORS
 
 __all__ = ["BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES", "DEFAULT_FREE", "DEFAULT_TIES",
            "defaults_from_fabric", "parse_free", "parse_ties", "base_of", "checked_defaults",
            "checked_bounds", "checked_priors", "checked_ties", "resolve_ties", "checked_toml",
-           "PRIORS", "TOML_KEYS", "Catalogue", "CATALOGUE"]
+           "PRIORS", "TOML_KEYS", "Catalogue", "CATALOGUE", "EXTRA_PARAMS"]
 
-#: The priors a parameter may take.
-PRIORS = ("uniform", "log-uniform")
-
-#: Natural-unit (lo, hi, prior, unit, fallback default) of an entry derived from the schema.
+#: Natural-unit (lo, hi, prior, unit, fallback default) of a parameter.
 Entry = tuple[float, float, str, str, float]
-
-
-def _entry(info: schema.ParamInfo) -> Entry:
-    lo, hi = info.typical
-    prior = "log-uniform" if info.log_scale else "uniform"
-    return (float(lo), float(hi), prior, info.unit, float(info.typical_value))
-
 
 _RGB = tuple(p.name for p in schema.THREAD_PARAMS if p.kind == "rgb")
 
-#: Base quantities: (lo, hi, prior, unit, fallback default), per thread: the schema's scalar
-#: parameters, its RGB ones per channel (``albedo_r`` ...), and the fit's ``tangent_scale``.
-BASE_PARAMS: dict[str, Entry] = {
-    **{name: _entry(schema.THREAD[name]) for name in schema.SCALAR_PARAMS},
-    **{f"{name}_{c}": _entry(schema.THREAD[name]) for name in _RGB for c in schema.RGB_CHANNELS},
-    "tangent_scale": (0.25, 2.0, "uniform", "1", 1.0),
-}
-#: The fit's parameters that belong to no thread.
+_BASES = schema.SCALAR_PARAMS + (microcylinder.TANGENT_SCALE.name,)
+#: The fit's parameters that belong to no model.
 EXTRA_PARAMS: dict[str, Entry] = {
     "scale": (1e-4, 1e4, "log-uniform", "1", 1.0),
     "log_noise": (-12.0, 3.0, "uniform", "ln(residual unit)", -3.0),
 }
 
-
-def _thread_name(base: str, j: int) -> str:
-    head, _, channel = base.rpartition("_")
-    if head in _RGB and channel in schema.RGB_CHANNELS:
-        return f"{head}{j}_{channel}"
-    return f"{base}{j}"
-
-
-#: Names of the model parameters proper (what ``prepare(...).eval`` takes), both threads.
-MODEL_PARAM_NAMES: tuple[str, ...] = tuple(
-    _thread_name(b, j) for j in (1, 2) for b in BASE_PARAMS if b != "tangent_scale")
-#: Every parameter name a spec knows.
-PARAM_NAMES: tuple[str, ...] = MODEL_PARAM_NAMES + ("tangent_scale1", "tangent_scale2") \
-    + tuple(EXTRA_PARAMS)
+#: The microcylinder's shading parameters, both threads.
+MODEL_PARAM_NAMES: tuple[str, ...] = microcylinder.MODEL_PARAM_NAMES
+#: Every parameter name a microcylinder fit knows.
+PARAM_NAMES: tuple[str, ...] = microcylinder.SCHEMA.names + tuple(EXTRA_PARAMS)
 #: Group aliases accepted by ``--free``: ``albedo1`` is its three channels.
-ALIASES = {f"{name}{j}": tuple(f"{name}{j}_{c}" for c in schema.RGB_CHANNELS)
-           for j in (1, 2) for name in _RGB}
-
-#: The default free set (8 parameters) and ties: one eta for both threads, area2 = 1 - area1.
-DEFAULT_FREE = ("eta1", "kd1", "kd2", "gamma_s1", "gamma_v1", "gamma_s2", "gamma_v2", "area1")
-DEFAULT_TIES = ("eta2=eta1", "area2=1-area1")
+ALIASES = microcylinder.ALIASES
+#: The microcylinder's default free set (8 parameters) and ties.
+DEFAULT_FREE = microcylinder.DEFAULT_FREE
+DEFAULT_TIES = microcylinder.DEFAULT_TIES
+#: A microcylinder's thread values by name (:func:`brdf.microcylinder.thread_values`).
+defaults_from_fabric = microcylinder.thread_values
 
 
 @dataclasses.dataclass(frozen=True)
@@ -109,9 +82,15 @@ def base_of(name: str) -> tuple[str, int | None]:
     if m and m.group(1) in _RGB and m.group(3) in schema.RGB_CHANNELS:
         return f"{m.group(1)}_{m.group(3)}", int(m.group(2))
     m = re.fullmatch(r"([a-z_]+?)([12])", name)
-    if m and m.group(1) in BASE_PARAMS:
+    if m and m.group(1) in _BASES:
         return m.group(1), int(m.group(2))
     return name, None
+
+
+#: The microcylinder's base quantities (per thread, an RGB one per channel, and the tangent
+#: scale): (lo, hi, prior, unit, fallback default), as thread 1's entries.
+BASE_PARAMS: dict[str, Entry] = {base_of(p.name)[0]: p.entry for p in microcylinder.SCHEMA
+                                 if base_of(p.name)[1] == 1}
 
 
 def entry(name: str) -> Entry:
@@ -205,33 +184,6 @@ def parse_ties(ties, cat: Catalogue = CATALOGUE) -> dict[str, tuple[str, str]]:
             raise ValueError(f"tie {t!r}: {target} is already tied to {out[target][0]}; "
                              f"tie each parameter once")
         out[target] = tie
-    return out
-
-
-def defaults_from_fabric(fab) -> dict[str, float]:
-    """Default values of every model parameter from a fabric's threads (natural units).
-
-    Parameters
-    ----------
-    fab : object with ``threads``
-        Two threads with the scalar parameters of :data:`brdf.schema.SCALAR_PARAMS` (``eta``,
-        ``kd``, ``gamma_s``, ``gamma_v`` in degrees, ``area``) and ``albedo`` (one or 3 values).
-
-    Examples
-    --------
-    >>> import brdf
-    >>> d = defaults_from_fabric(brdf.fabric("linen_plain"))
-    >>> d["gamma_s1"], round(d["albedo2_g"], 12), tuple(d) == MODEL_PARAM_NAMES
-    (12.0, 0.24, True)
-    """
-    out: dict[str, float] = {}
-    for j, th in enumerate(fab.threads, start=1):
-        for name in schema.SCALAR_PARAMS:
-            out[f"{name}{j}"] = float(getattr(th, name))
-        for name in _RGB:
-            rgb = np.broadcast_to(np.asarray(getattr(th, name), float), (3,))
-            for c, a in zip(schema.RGB_CHANNELS, rgb):
-                out[f"{name}{j}_{c}"] = float(a)
     return out
 
 

@@ -1,9 +1,9 @@
 """Parameter specification for fitting a model: bounds, priors, ties.
 
 The names, their bounds, units and priors come from the model's family
-(:mod:`analysis.families`: the microcylinder's are in :mod:`analysis.paramnames`, derived from
-:mod:`brdf.schema`, each baseline's from its ``PARAMS``); the parsing of ``--free``/``--tie``
-strings is in :mod:`analysis.paramnames`; this module re-exports the microcylinder's names.
+(:mod:`analysis.families`: the registered model's flat parameters, :class:`brdf.ParamSchema`);
+the parsing of ``--free``/``--tie`` strings is in :mod:`analysis.paramnames`; this module
+re-exports the microcylinder's names.
 
 Each parameter is free (sampled), fixed (at its default, normally the preset's value) or tied to
 another one (``eta2=eta1``: eta2 takes eta1's value; ``area2=1-area1``: the complement).
@@ -34,7 +34,6 @@ from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_
                                  checked_priors, checked_ties, checked_toml,
                                  defaults_from_fabric, parse_free, parse_ties,
                                  resolve_ties, unknown)
-from brdf import schema
 from gonio.statefields import load_toml
 
 __all__ = ["Param", "ParamSpec", "INTERNAL_LIMIT", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
@@ -301,27 +300,30 @@ class ParamSpec:
         """Log prior (up to a constant) for internal ``theta`` (B..., ndim) -> (B...,).
 
         Flat in each natural value (or its log) within the bounds: in the internal logit
-        coordinates the sum of log p + log(1 - p); -inf beyond +-INTERNAL_LIMIT, or where
-        area1 + area2 > 1 or a tied value leaves its own bounds.
+        coordinates the sum of log p + log(1 - p); -inf beyond +-INTERNAL_LIMIT, where the
+        model refuses the values together (its ``admissible``: a fabric's area1 + area2 > 1)
+        or a tied value leaves its own bounds.
         """
         theta = np.asarray(theta, dtype=np.float64)
         ok = np.all((theta >= self.lower) & (theta <= self.upper) & np.isfinite(theta), axis=-1)
         with np.errstate(invalid="ignore"):
             jac = -(np.logaddexp(0.0, theta) + np.logaddexp(0.0, -theta)).sum(axis=-1)
-        areas = "area1" in self.params and any(n.startswith("area") for n in self.free)
-        if self.ties or areas:
+        cls = self.family.cls
+        joint = bool(set(cls.CONSTRAINED) & set(self.free))
+        if self.ties or joint:
             v = self.values(theta)
-            if "area1" in self.params:
-                ok &= v["area1"] + v["area2"] <= schema.AREA_SUM_MAX + 1e-12
+            if cls.CONSTRAINED:
+                ok &= cls.admissible(v)
             for target in self.ties:
                 p = self.params[target]
                 ok &= (v[target] >= p.lo) & (v[target] <= p.hi)
         return np.where(ok, jac, -np.inf)
 
     def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """Keyword arguments of the model's ``prepare(...).eval``
-        (:meth:`analysis.families.ModelFamily.model_kwargs`): for the microcylinder each
-        (B..., 2), albedo (B..., 2, 3); for a baseline each scalar (B...), RGB (B..., 3)."""
+        """Keyword arguments of the model's forward model (its class's ``batch_kwargs``,
+        :meth:`analysis.families.ModelFamily.model_kwargs`): for the microcylinder each
+        (B..., 2), albedo (B..., 2, 3) and ``tangent_scale``; for a baseline each scalar
+        (B...), RGB (B..., 3)."""
         return self.family.model_kwargs(values)
 
     @property
@@ -340,7 +342,7 @@ class ParamSpec:
         }
 
     def __repr__(self) -> str:
-        model = "" if self.family.is_microcylinder else f", model={self.model!r}"
+        model = "" if self.family.is_default else f", model={self.model!r}"
         return f"ParamSpec(free={list(self.free)}, ties={self.ties}{model})"
 
 

@@ -15,8 +15,8 @@ A source is one of
 :func:`resolve` returns a :class:`Source`: its kind, a label for tables and legends, the
 BRDF (a :class:`brdf.Fabric` for every kind but ``table``) and the path it came from.
 :data:`Source.model` names the model a fit is of: ``microcylinder``, or a baseline model
-(``lambert``, ...; :mod:`brdf.baselines`) whose :attr:`Source.brdf` is that model at the
-fit's posterior medians (a :class:`brdf.baselines.BaselineModel`: ``eval``, ``sample``,
+(``lambert``, ...; :data:`brdf.MODELS`) whose :attr:`Source.brdf` is that model at the
+fit's posterior medians (a :class:`brdf.Model`: ``eval``, ``sample``,
 ``pdf``, not a fabric: fabric-only options refuse it).
 """
 
@@ -67,7 +67,7 @@ class Source:
     brdf: object
     path: Path | None = None
     preset: str | None = None
-    model: str = "microcylinder"
+    model: str = brdf.DEFAULT_MODEL
 
     @property
     def is_fabric(self) -> bool:

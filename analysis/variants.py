@@ -27,7 +27,7 @@ class Named:
     name : str
     brdf : object
         ``eval(wi, wo)`` -> RGB f_r (..., 3) in 1/sr (e.g. a
-        :class:`brdf.baselines.BaselineModel`).
+        registered model of :data:`brdf.MODELS`).
     model : str
         Its model's name (``lambert``, ...).
     """

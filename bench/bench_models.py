@@ -1,6 +1,6 @@
 """Every model of a fit side by side: eval rate, and a fit to one CUReT fabric and one RGL felt.
 
-For each model (``microcylinder`` and every baseline of :data:`brdf.baselines.MODELS`):
+For each model (every model of :data:`brdf.MODELS`: ``microcylinder`` and the baselines):
 
 - the eval rate (pairs per second) of ``eval`` on random pairs, and of the batched
   ``prepare(wi, wo).eval`` a fit calls (parameter sets x pairs per second);

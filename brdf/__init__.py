@@ -4,6 +4,10 @@ The model as ``../shared/spec/MODEL.md`` specifies it: threads with tangent curv
 of two threads, the paper's six presets, and every variant; importance sampling of a fabric
 (:mod:`brdf.sampling`: ``Fabric.sample``, ``Fabric.pdf``). NumPy and SciPy only.
 
+:data:`MODELS` registers every model by name (``microcylinder``, the fabric, and the baselines
+of :mod:`brdf.baselines`), each a :class:`Model`: flat parameters (:class:`ParamSchema`),
+``eval``, ``sample``, ``pdf`` and a batched forward model for fits.
+
 A :class:`Fabric` checks its threads and options and compiles them into a frozen
 :class:`FabricPlan` (``Fabric.plan``: the typed options, :class:`FabricOptions`, and each
 thread's constants); ``Fabric.eval``, :class:`Prepared`, the sampler and the Mitsuba plugin
@@ -35,15 +39,19 @@ Where each of MODEL.md's names runs (the hot path), and its transliteration from
 """
 
 
-from brdf import directions, frames, sampling, schema, terms
+from brdf import directions, frames, microcylinder, sampling, schema, terms
+from brdf.forward import Forward
 from brdf.curve import TangentCurve
 from brdf.fabric import Fabric, Prepared
 from brdf.options import (GAP_METHODS, MAX_TANGENT_SAMPLES, OPTIONS, SAMPLING_METHODS,
                           TRANSMISSION_METHODS, FabricOptions, Gap, TangentSampling,
                           Transmission)
+from brdf.microcylinder import FabricForward
+from brdf.models import DEFAULT_MODEL, MODELS, model_class, model_name, model_names
+from brdf.paramschema import FlatParam, ParamSchema
 from brdf.plan import FabricPlan, ThreadPlan
 from brdf.presets import PRESETS, check_preset, fabric, preset_threads
-from brdf.protocols import BRDF, SampledBRDF, ThreadedBRDF
+from brdf.protocols import BRDF, Model, SampledBRDF, ThreadedBRDF
 from brdf.thread import Thread
 
 __all__ = [
@@ -52,4 +60,6 @@ __all__ = [
     "check_preset",
     "OPTIONS", "SAMPLING_METHODS", "TRANSMISSION_METHODS", "GAP_METHODS", "directions", "frames",
     "MAX_TANGENT_SAMPLES", "schema", "terms", "sampling", "BRDF", "ThreadedBRDF", "SampledBRDF",
+    "Model", "MODELS", "DEFAULT_MODEL", "model_class", "model_name", "model_names",
+    "ParamSchema", "FlatParam", "Forward", "FabricForward", "microcylinder",
 ]

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from brdf import sampling, schema
+from brdf.microcylinder import MicrocylinderModel
 from brdf.options import GAP_METHODS, OPTIONS, TRANSMISSION_METHODS, FabricOptions
 from brdf.plan import FabricPlan
 from brdf.prepared import Prepared
@@ -16,8 +17,12 @@ from brdf.thread import html_table as thread_html_table
 __all__ = ["Fabric", "Prepared", "OPTIONS", "TRANSMISSION_METHODS", "GAP_METHODS"]
 
 
-class Fabric:
+class Fabric(MicrocylinderModel):
     r"""The microcylinder BRDF of a woven fabric (Sadeghi et al. 2013).
+
+    The model ``microcylinder`` of :data:`brdf.MODELS`: its flat parameters, ``start``,
+    ``values``, ``with_values``, ``batch_kwargs`` and ``forward`` come from
+    :class:`brdf.microcylinder.MicrocylinderModel`.
 
     Parameters
     ----------

@@ -26,7 +26,6 @@ import os
 from pathlib import Path
 from typing import Callable
 
-import brdf
 import gonio
 from gonio.io import READ_SUFFIXES
 from analysis.families import MICROCYLINDER, family
@@ -95,9 +94,8 @@ class BatchJob:
     def fabric(self):
         """The start model: the preset's fabric with its options (a baseline model at its
         typical values)."""
-        if self.model == MICROCYLINDER:
-            return brdf.fabric(self.preset, **self.fabric_options)
-        return family(self.model).start(options=self.fabric_options)
+        fam = family(self.model)
+        return fam.start(self.preset if fam.presets else None, self.fabric_options)
 
     def param_spec(self, fab=None, table=None):
         """The :class:`~analysis.params.ParamSpec` of this fit (checks every name); ``table``
@@ -286,9 +284,7 @@ def jobs_from_inputs(inputs, *, preset: str | None, free=None, ties=None, spec=N
         A missing input, a file gonio cannot read, CUReT without samples, an unknown preset,
         or a spec with unknown parameters (naming the table).
     """
-    family(model)                                         # an unknown model: one line
-    if model == MICROCYLINDER:
-        brdf.check_preset(preset)
+    family(model).check_preset(preset)            # an unknown model or preset: one line
     sample_list = parse_samples(samples)
     base = dict(model=model, preset=preset or BatchJob.preset, free=None if free is None else tuple(free),
                 ties=None if ties is None else tuple(ties), spec=spec, fit=dict(fit or {}),
@@ -321,8 +317,7 @@ def jobs_from_inputs(inputs, *, preset: str | None, free=None, ties=None, spec=N
 def _check(job: BatchJob) -> None:
     """The preset, its options and the spec of a job, or a ValueError naming the table."""
     try:
-        if job.model == MICROCYLINDER:
-            brdf.check_preset(job.preset)
+        family(job.model).check_preset(job.preset)
         job.param_spec()
     except ValueError as exc:
         raise ValueError(f"table {job.name} ({job.path}): {exc}") from None

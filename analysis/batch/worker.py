@@ -7,7 +7,7 @@ from pathlib import Path
 
 from analysis.batch.jobs import BatchJob, read_job_table
 from analysis.fit.driver import estimate_fit_time
-from analysis.families import MICROCYLINDER
+from analysis.families import family
 from analysis.fit.posterior import forward_model
 from analysis.fit.workflow import fit_fabric
 
@@ -47,7 +47,7 @@ def run_job(job: BatchJob, out_dir) -> dict:
         fit_kw = dict(job.fit)
         fit_kw.setdefault("threads", 1)
         extra = job.config_extra
-        if extra is None and job.model != MICROCYLINDER:
+        if extra is None and not family(job.model).presets:
             extra = {"sample": job.sample}
         elif extra is None:
             extra = {"fabric": job.preset, "options": fab.options, "sample": job.sample}

@@ -41,7 +41,7 @@ from analysis.fit.driver import with_nuisance
 from analysis.fit.posterior import LogPosterior, forward_model
 from analysis.fit.workflow import fit_spec
 from analysis.likelihood import Likelihood, is_grey
-from analysis.params import DEFAULT_FREE, DEFAULT_TIES, ParamSpec
+from analysis.params import ParamSpec
 
 __all__ = ["FisherReport", "fisher_information", "table_information", "suggest_free",
            "suggest_for_file",
@@ -272,18 +272,21 @@ def _noise_at_start(spec: ParamSpec, lik: Likelihood, logpost: LogPosterior) -> 
 
 def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
     """The candidates of :func:`suggest_free`: ``free`` / ``ties`` / ``toml`` as
-    :func:`analysis.fit.fit_spec` takes them when given; otherwise for the microcylinder the
-    default free set (:data:`analysis.params.DEFAULT_FREE` and its ties) plus both threads'
-    albedos for an RGB table (a grey table cannot tell the channels apart), for a baseline
-    model its default free set for the table (every parameter, with
-    :meth:`analysis.families.ModelFamily.default_free`'s identifiability choices)."""
-    if not family_of(fabric).is_microcylinder:
+    :func:`analysis.fit.fit_spec` takes them when given; otherwise for a model with a default
+    free set of its own (``DEFAULT_FREE``: the microcylinder's) that set and its ties plus its
+    colours for an RGB table (a grey table cannot tell the channels apart: the
+    microcylinder's two albedos), for any other model its default free set for the table
+    (every parameter, with :meth:`analysis.families.ModelFamily.default_free`'s
+    identifiability choices)."""
+    fam = family_of(fabric)
+    if fam.cls.DEFAULT_FREE is None:
         return fit_spec(fabric, free, ties, toml, table=table)
     if free is None and toml is None:
-        free = list(DEFAULT_FREE)
-        ties = list(DEFAULT_TIES) if ties is None else ties
+        free, default_ties, _ = fam.default_free()
+        free = list(free)
+        ties = list(default_ties) if ties is None else ties
         if not is_grey(np.asarray(table.values, dtype=np.float64)):
-            free += ["albedo1", "albedo2"]
+            free += list(fam.schema.colours)
     return fit_spec(fabric, free, ties, toml)
 
 

@@ -1,7 +1,7 @@
 """The fabric of a fit's posterior medians: what ``microcyl export`` writes for a renderer.
 
 A fit of a baseline model (``microcyl fit --model lambert``) gives that model at its medians
-(a :class:`brdf.baselines.BaselineModel`, :attr:`MedianFabric.fabric`) in the same way;
+(a registered model of :data:`brdf.MODELS`, :attr:`MedianFabric.fabric`) in the same way;
 :attr:`MedianFabric.model_name` says which model it is.
 
 A fit folder holds ``results.json`` (each free parameter's median) and ``fit_config.json``
@@ -20,11 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-import brdf
 from analysis.families import family
 from analysis.fit.checkpoint import CONFIG_FILE, read_config
 from analysis.fit.results import read_results
-from brdf import schema
+from brdf.models import DEFAULT_MODEL
 from gonio.statefields import MAX_MAGNITUDE, FileFields
 
 __all__ = ["MedianFabric", "median_fabric", "FitModel"]
@@ -36,7 +35,7 @@ class FitModel:
 
     Attributes
     ----------
-    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+    fabric : brdf.Model (brdf.Fabric, a baseline)
         The median fabric (tangent offsets already scaled by ``tangent_scale``), or the
         median baseline model.
     scale : float
@@ -58,7 +57,7 @@ class MedianFabric:
 
     Attributes
     ----------
-    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+    fabric : brdf.Model (brdf.Fabric, a baseline)
         Named after the preset the fit started from, with the fit's options (a fit of a
         baseline model: that model at the medians).
     preset : str or None
@@ -71,7 +70,7 @@ class MedianFabric:
     converged : bool or None
         The fit's verdict (``results.json``).
     model_name : str
-        The model fitted (``microcylinder`` or a baseline's name).
+        The model fitted (its name in :data:`brdf.MODELS`).
     """
 
     fabric: object
@@ -79,12 +78,12 @@ class MedianFabric:
     values: dict
     free: tuple
     converged: bool | None
-    model_name: str = "microcylinder"
+    model_name: str = DEFAULT_MODEL
 
     @property
     def is_fabric(self) -> bool:
-        """Whether this is a microcylinder fabric (not a baseline model)."""
-        return self.model_name == "microcylinder"
+        """Whether the model has presets (a microcylinder fabric, named after one)."""
+        return self.preset is not None
 
     @property
     def scale(self) -> float:
@@ -108,7 +107,7 @@ def _config(folder: Path) -> dict:
     extra = cfg.get("extra", {})   # `microcyl fit` and fit-batch: fabric; fit-measured: preset
     preset = extra.get("fabric")
     return {"preset": extra.get("preset") if preset is None else preset,
-            "model": cfg.get("model", "microcylinder"),
+            "model": cfg.get("model", DEFAULT_MODEL),
             "options": dict(extra.get("options") or {}),
             "params": spec["params"], "ties": spec.get("ties", {}),
             "free": tuple(spec["free"])}
@@ -157,31 +156,27 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
     if results["model"] != fam.name:
         raise ValueError(f"{folder}: results.json is a fit of model {ascii(results['model'])}"
                          f", {CONFIG_FILE} of {fam.name}")
-    if not fam.is_microcylinder:
-        return _median_baseline(folder, fam, cfg, results)
-    if cfg["preset"] not in brdf.PRESETS:
+    presets = fam.cls.PRESETS
+    if presets and cfg["preset"] not in presets:
         raise ValueError(f"{folder / CONFIG_FILE}: cannot tell which preset was fitted "
                          f"({cfg['preset']!r}); name it")
+    missing = [n for n in fam.model_names if n not in cfg["params"]]
+    if missing:
+        raise ValueError(f"{folder / CONFIG_FILE}: config.spec.params: no value of "
+                         f"{', '.join(missing)} (parameters of model {fam.name})")
     values = _values(folder, cfg, results)
-    threads = []
-    for j, t in enumerate(brdf.preset_threads(cfg["preset"]), start=1):
-        change = {q: values[f"{q}{j}"] for q in schema.SCALAR_PARAMS if f"{q}{j}" in values}
-        rgb = [f"albedo{j}_{c}" for c in schema.RGB_CHANNELS]
-        if all(k in values for k in rgb):
-            change["albedo"] = tuple(values[k] for k in rgb)
-        scale = values.get(f"tangent_scale{j}", 1.0)
-        if scale != 1.0:
-            change["offsets"] = tuple(np.clip(np.asarray(t.offsets) * scale, -90, 90).tolist())
-        try:
-            threads.append(t.replace(**change))
-        except ValueError as exc:
-            raise ValueError(f"{folder}: the fit's values make no valid fabric (thread {j}: "
-                             f"{exc})") from None
+    preset = cfg["preset"] if presets else None
     try:
-        fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+        start = fam.start(preset, cfg["options"])
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{folder / CONFIG_FILE}: config.extra.options: {exc}") from None
-    return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))
+    try:
+        model = start.with_values({n: values[n] for n in fam.model_names})
+    except ValueError as exc:
+        raise ValueError(f"{folder}: the fit's values make no valid {fam.name} model "
+                         f"({exc})") from None
+    return MedianFabric(model, preset, values, cfg["free"], results.get("converged"),
+                        fam.name)
 
 
 def _values(folder: Path, cfg: dict, results: dict) -> dict:
@@ -198,18 +193,3 @@ def _values(folder: Path, cfg: dict, results: dict) -> dict:
     for target, (source, kind) in cfg["ties"].items():
         values[target] = values[source] if kind == "equal" else 1.0 - values[source]
     return values
-
-
-def _median_baseline(folder: Path, fam, cfg: dict, results: dict) -> MedianFabric:
-    """A baseline model's fit at its medians."""
-    missing = [n for n in fam.model_names if n not in cfg["params"]]
-    if missing:
-        raise ValueError(f"{folder / CONFIG_FILE}: config.spec.params: no value of "
-                         f"{', '.join(missing)} (parameters of model {fam.name})")
-    values = _values(folder, cfg, results)
-    try:
-        model = fam.build(values)
-    except ValueError as exc:
-        raise ValueError(f"{folder}: the fit's values make no valid {fam.name} model "
-                         f"({exc})") from None
-    return MedianFabric(model, None, values, cfg["free"], results.get("converged"), fam.name)

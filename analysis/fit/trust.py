@@ -29,9 +29,8 @@ import numpy as np
 import scipy.special
 
 from analysis.fit.adequacy import adequacy
-from analysis.paramnames import base_of
+from analysis.families import family
 from analysis.params import INTERNAL_LIMIT
-from brdf import schema
 
 __all__ = ["warning", "fit_warnings", "assess", "CHECKS", "prior_sd", "flat_values",
            "BOUND_ZONE", "SD_RATIO", "CORR_MAX", "PRIOR_DRAWS"]
@@ -150,14 +149,12 @@ def correlated(result) -> list[dict]:
 
 
 def _typical(name: str, spec=None):
-    """brdf.schema's plausible range of a fit parameter (its typical range where it gives
-    none); None for the fit's own parameters (scale, noise, tangent scales). For a baseline
-    model's fit (``spec.family``) its ParamInfo's plausible range, or None."""
-    if spec is not None and not spec.family.is_microcylinder:
-        return spec.family.plausible(name)
-    base, _ = base_of(name)
-    info = schema.THREAD.get(base) or schema.THREAD.get(base.rsplit("_", 1)[0])
-    return None if info is None else (info.plausible or info.typical)
+    """The plausible range of a fit parameter (the model's flat parameter's,
+    :attr:`brdf.FlatParam.plausible`: for a microcylinder thread parameter brdf.schema's
+    plausible range, its typical range where it gives none); None for the fit's own
+    parameters (scale, noise) and where the model gives none (tangent scales). The model is
+    ``spec.family``'s (no spec: the default model)."""
+    return (family() if spec is None else spec.family).plausible(name)
 
 
 def implausible(result) -> list[dict]:

@@ -28,7 +28,7 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
 
     Parameters
     ----------
-    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+    fabric : brdf.Model (brdf.Fabric, a baseline)
         The model fitted (its family, :func:`analysis.families.family_of`); gives the
         defaults (fixed values and the start).
     free : str or sequence of str, optional
@@ -115,7 +115,7 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     Parameters
     ----------
     table : gonio.Table
-    fabric : brdf.Fabric or brdf.baselines.BaselineModel
+    fabric : brdf.Model (brdf.Fabric, a baseline)
         The model whose parameters ``spec`` fixes and whose geometry is evaluated (of the
         spec's family).
     spec : analysis.params.ParamSpec

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from analysis.fit.fisher import STEP
-from analysis.fit.posterior import FabricModel, LogPosterior
+from analysis.fit.posterior import LogPosterior, forward_model
 from analysis.params import ParamSpec
 
 __all__ = ["whitened_jacobians", "information", "rows_per_pair"]
@@ -85,7 +85,7 @@ def whitened_jacobians(fabric, spec: ParamSpec, thetas, wi, wo, instrument, *,
     out = np.zeros((thetas.shape[0], m, r, d))
     if m == 0:
         return out
-    post = LogPosterior(spec, None, FabricModel(fabric, wi, wo))
+    post = LogPosterior(spec, None, forward_model(fabric, wi, wo))
     cos_i = wi[:, 2]
     above = (cos_i > 0) & (wo[:, 2] > 0)
     h = STEP * np.eye(d)

@@ -2,13 +2,13 @@
 
 Each is a :class:`~brdf.baselines.model.BaselineModel`: validated parameters with units and
 ranges (``PARAMS``), ``eval(wi, wo)`` (RGB f_r in 1/sr, no cosine), a batched
-``prepare(wi, wo).eval(**params)`` for fits, ``sample`` and ``pdf``. :data:`MODELS` maps each
-model's name to its class.
+``prepare(wi, wo).eval(**params)`` for fits, ``sample`` and ``pdf``, and the rest of the
+model protocol (:class:`brdf.Model`). Each is registered by name in :data:`brdf.MODELS`.
 
 Examples
 --------
->>> list(MODELS), model_class("zeltner").__name__
-(['lambert', 'charlie', 'ashikhmin', 'zeltner'], 'Zeltner')
+>>> Zeltner.name, Zeltner.param_schema().names[:3]
+('zeltner', ('base_r', 'base_g', 'base_b'))
 """
 
 from __future__ import annotations
@@ -21,17 +21,4 @@ from brdf.baselines.sheen import SHEEN, SheenModel
 from brdf.baselines.zeltner import Zeltner
 
 __all__ = ["BaselineModel", "PreparedBaseline", "SheenModel", "Lambert", "Charlie", "Ashikhmin",
-           "Zeltner", "MODELS", "model_class", "BASE", "SHEEN"]
-
-#: The baseline models by name.
-MODELS: dict[str, type[BaselineModel]] = {cls.name: cls for cls in (Lambert, Charlie,
-                                                                     Ashikhmin, Zeltner)}
-
-
-def model_class(name: str) -> type[BaselineModel]:
-    """The baseline model class named ``name``; ValueError listing the names otherwise."""
-    try:
-        return MODELS[name]
-    except (KeyError, TypeError):
-        raise ValueError(f"unknown model {name!r}; baseline models: "
-                         f"{', '.join(MODELS)}") from None
+           "Zeltner", "BASE", "SHEEN"]

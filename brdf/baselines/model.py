@@ -27,7 +27,9 @@ from typing import ClassVar, Mapping
 
 import numpy as np
 
+from brdf.forward import Forward
 from brdf.frames import flat_pairs, normalize
+from brdf.paramschema import ParamSchema
 from brdf.schema import ParamInfo
 
 __all__ = ["BaselineModel", "PreparedBaseline", "LUMINANCE"]
@@ -64,6 +66,14 @@ class BaselineModel:
     #: The parameters whose luminance weights the sampler's cosine / uniform mixture.
     BASE_PARAM: ClassVar[str | None] = "base"
     SHEEN_PARAM: ClassVar[str | None] = None
+    #: A fit's default free set: None, every parameter (with the fit's identifiability
+    #: choices for the table); no ties.
+    DEFAULT_FREE: ClassVar[tuple[str, ...] | None] = None
+    DEFAULT_TIES: ClassVar[tuple[str, ...]] = ()
+    #: No presets: a baseline starts from its parameters' typical values.
+    PRESETS: ClassVar[tuple[str, ...]] = ()
+    #: No parameters constrained together (:meth:`admissible`).
+    CONSTRAINED: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, **values):
         known = {p.name: p for p in self.PARAMS}
@@ -87,6 +97,62 @@ class BaselineModel:
     def replace(self, **values) -> "BaselineModel":
         """A copy with some parameters changed (validated)."""
         return type(self)(**{**self.params(), **values})
+
+    # -- the model protocol (brdf.Model): the flat parameters a fit samples -----------------
+    @classmethod
+    def param_schema(cls) -> ParamSchema:
+        """The flat parameters: a scalar row by its name, an RGB one per channel
+        (``base_r``, ``base_g``, ``base_b``; the alias ``base``)."""
+        return ParamSchema.from_rows(cls.PARAMS)
+
+    @classmethod
+    def admissible(cls, values) -> np.ndarray:
+        """Every set of values in range is a model: True for each (B...)."""
+        return np.ones(np.broadcast(*values.values()).shape if values else (), dtype=bool)
+
+    @classmethod
+    def start(cls, preset: str | None = None, options=None) -> "BaselineModel":
+        """The model at its parameters' typical values (no preset, no option)."""
+        if preset is not None:
+            raise ValueError(f"model {cls.name} has no preset ({preset!r})")
+        if options:
+            raise ValueError(f"model {cls.name} takes no fabric option "
+                             f"({', '.join(sorted(options))})")
+        return cls()
+
+    def values(self) -> dict[str, float]:
+        """Every flat parameter by name (natural units)."""
+        out = {}
+        for q, v in self.params().items():
+            if np.ndim(v):
+                out.update({f"{q}_{c}": float(x) for c, x in zip("rgb", v)})
+            else:
+                out[q] = float(v)
+        return out
+
+    def with_values(self, values) -> "BaselineModel":
+        """A copy with some flat parameters changed (validated; the rest, a colour's other
+        channels included, kept)."""
+        schema = self.param_schema()
+        unknown = sorted(set(values) - set(schema.names))
+        if unknown:
+            raise ValueError(f"{self.name}: unknown parameter(s) {', '.join(unknown)}; "
+                             f"parameters: {', '.join(schema.names)}")
+        grouped = schema.grouped({**self.values(), **values},
+                                 lambda xs: tuple(float(x) for x in xs))
+        return self.replace(**{q: v if isinstance(v, tuple) else float(v)
+                               for q, v in grouped.items()})
+
+    @classmethod
+    def batch_kwargs(cls, values) -> dict[str, np.ndarray]:
+        """:meth:`PreparedBaseline.eval`'s keyword arguments from every flat parameter's
+        values (B...): each scalar (B...), each RGB one (B..., 3)."""
+        return cls.param_schema().grouped(values)
+
+    def forward(self, wi, wo) -> Forward:
+        """The forward model at the pairs (wi, wo): :class:`brdf.forward.Forward` (float64
+        only, so no ``with_dtype``)."""
+        return Forward(self, wi, wo)
 
     def __eq__(self, other):
         return type(other) is type(self) and other.params() == self.params()

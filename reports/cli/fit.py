@@ -16,7 +16,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from analysis.families import MICROCYLINDER
+from analysis.families import family
 from analysis.fit import fit_fabric, fit_spec
 from analysis.fit.fisher import suggest_for_file
 from analysis.fit.workflow import check_fit_size
@@ -67,7 +67,7 @@ def _spec_from_args(args, fab, table=None):
 
 def _config_extra(args, fab) -> dict:
     """What the fit records of its start (and matches on resume)."""
-    if args.model != MICROCYLINDER:
+    if not family(args.model).presets:
         return {"sample": args.sample}
     return {"fabric": args.fabric, "options": fab.options, "sample": args.sample}
 

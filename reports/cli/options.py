@@ -302,19 +302,20 @@ def add_model_arguments(p) -> None:
 
 
 def start_model(args):
-    """The model a fit starts from: the preset ``--fabric`` with the variant flags for the
-    microcylinder, a baseline model at its typical values otherwise; one line for
-    ``--fabric`` (or a variant flag) with a baseline, or no ``--fabric`` for the
-    microcylinder."""
+    """The model a fit starts from: for a model with presets (the microcylinder) the preset
+    ``--fabric`` with the variant flags, any other model at its typical values; one line for
+    ``--fabric`` (or a variant flag) with a model without presets, or no ``--fabric`` for one
+    with."""
     fam = family(args.model)
-    if fam.is_microcylinder:
+    if fam.presets:
         if args.fabric is None:
-            raise ValueError("--fabric PRESET is required for --model microcylinder (the "
+            raise ValueError(f"--fabric PRESET is required for --model {fam.name} (the "
                              f"preset gives the fixed values and the start): "
-                             f"{', '.join(brdf.PRESETS)}")
-        return fabric_from_args(brdf.check_preset(args.fabric), args)
+                             f"{', '.join(fam.presets)}")
+        return fam.start(fam.check_preset(args.fabric), fabric_options(args))
     if args.fabric is not None:
-        raise ValueError(f"--fabric applies to --model microcylinder only; --model "
+        with_presets = " / ".join(m for m in model_names() if family(m).presets)
+        raise ValueError(f"--fabric applies to --model {with_presets} only; --model "
                          f"{fam.name} starts from its own typical values (drop --fabric)")
     given = fabric_options(args)
     if given:

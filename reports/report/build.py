@@ -9,7 +9,6 @@ import time
 from pathlib import Path
 
 import brdf
-from brdf.baselines import BaselineModel
 from analysis.folderlock import output_lock
 from gonio.atomic import file_mode
 from gonio.progress import progress_bar
@@ -129,8 +128,8 @@ def _fabric_header(rep: FabricReport, colour, run: dict) -> Markup:
     if isinstance(rep.fabric, brdf.Fabric):
         what = ("A preset fabric" if rep.name in brdf.PRESETS else "A fabric") \
             + " of the microcylinder cloth model (Sadeghi et al. 2013)"
-    elif isinstance(rep.fabric, BaselineModel):
-        what = f"A fit of the baseline model {rep.fabric.name} (not the microcylinder)"
+    elif isinstance(rep.fabric, brdf.Model):
+        what = f"A fit of the baseline model {brdf.model_name(rep.fabric)} (not the microcylinder)"
     else:
         what = "A BRDF that is no microcylinder fabric"
     lede = html("{}; energy: {}.", what,

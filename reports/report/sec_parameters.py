@@ -6,7 +6,8 @@ import dataclasses
 from typing import Any
 
 from brdf import schema
-from brdf.baselines import BaselineModel
+from brdf.models import model_name
+from brdf.protocols import Model, ThreadedBRDF
 from reports.report.markup import fmt, html, plain_json, table
 from reports.report.page import Page
 from reports.report.settings import Section
@@ -25,15 +26,23 @@ def parameters_of(fab) -> dict:
     """Plain data of a BRDF's threads (the :data:`THREAD_FIELDS`) and options.
 
     A BRDF without threads or options (a measured table, a user's analytic model) gives an
-    empty list and dict; a baseline model (:mod:`brdf.baselines`) adds ``model`` (its name)
-    and ``values`` (its parameters).
+    empty list and dict; a registered model without threads (:data:`brdf.MODELS`: the
+    baselines) adds ``model`` (its name) and ``values`` (its parameters by row, a colour as
+    its three channels).
     """
     threads = [{f: plain_json(getattr(t, f, None)) for f in THREAD_FIELDS}
                for t in getattr(fab, "threads", ()) or ()]
     out = {"threads": threads, "options": plain_json(dict(getattr(fab, "options", {}) or {}))}
-    if isinstance(fab, BaselineModel):
-        out.update(model=fab.name, values=plain_json(fab.params()))
+    if isinstance(fab, Model) and not isinstance(fab, ThreadedBRDF):
+        out.update(model=model_name(fab),
+                   values=plain_json(fab.param_schema().grouped(fab.values(), tuple)))
     return out
+
+
+def _rows(model) -> list:
+    """The rows (:class:`brdf.schema.ParamInfo`) of a model's flat parameters, in order, a
+    colour once."""
+    return [p.info for p in model.param_schema() if p.group is None or p.channel == 0]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,7 +68,7 @@ def section_parameters(p: Page) -> Section:
         values = standard_values(p.fabric)
         rows = [[q.name, ", ".join(fmt(x) for x in v) if isinstance(v, (list, tuple))
                  else fmt(v), q.unit, q.description]
-                for q, v in zip(type(p.fabric).PARAMS, params["values"].values())]
+                for q, v in zip(_rows(p.fabric), params["values"].values())]
         return Section(html("<p>The baseline model <b>{}</b> (not the microcylinder).</p>{}"
                             "<p>Data: {}</p>", params["model"],
                             table(["parameter", "value", "unit", "meaning"], rows), link),

@@ -27,6 +27,7 @@ from analysis.budget import format_seconds
 from analysis.folderlock import output_lock
 from gonio.progress import progress_bar
 from gonio.safenames import check_component
+from gonio.terminal import shown
 
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3      # glibc's mallopt parameters
 
@@ -107,13 +108,21 @@ def _ignore_sigint():
 
 
 def describe_row(row: dict) -> str:
-    """One line for a finished table."""
+    """One line for a finished table, through :func:`gonio.terminal.shown` (its error may
+    quote the table's file: a column name, a metadata value).
+
+    Examples
+    --------
+    >>> print(describe_row({"name": "x", "status": "error", "error": "bad \\x1b[2J"}))
+    x: error: bad \\x1b[2J
+    """
     if row["status"] == "error":
-        return f"{row['name']}: error: {row['error']}"
+        return shown(f"{row['name']}: error: {row['error']}")
     verdict = "converged" if row["status"] == "converged" else "NOT converged"
     resumed = (f"; resumed from step {row['resumed_from']}" if row.get("resumed_from")
                else "")
-    return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
+    return shown(f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s)"
+                 f"{resumed}")
 
 
 def estimate_batch(todo: list[BatchJob], workers: int | None = None,

@@ -53,6 +53,7 @@ def run_job(job: BatchJob, out_dir) -> dict:
         elif extra is None:
             extra = {"fabric": job.preset, "options": fab.options, "sample": job.sample}
         result = fit_fabric(table, fab, spec, folder, plots=job.plots, progress=False,
+                            table_file=job.path,
                             config_extra=extra, **fit_kw)
     except Exception as exc:        # noqa: BLE001 - the batch records it and goes on
         return error_row(job, exc, time.perf_counter() - t0)

@@ -21,6 +21,7 @@ from analysis.fit import fit_fabric, fit_spec
 from analysis.fit.fisher import suggest_for_file
 from analysis.fit.workflow import check_fit_size
 from analysis.fit.loo import HIGH_K
+from analysis.fit.outputs import check_fit_folder
 from gonio.terminal import shown
 from reports.cli import lazy
 from reports.cli import options as cliutil
@@ -85,13 +86,15 @@ def run(args) -> int:
     check_fit_size(args.table, spec, args.walkers,
                    **cliutil.reader_options(args.table, sample=args.sample))
     out = cliutil.check_writable_dir(Path(args.output))
+    check_fit_folder(out, args.table)       # files it did not write, or the table: refused
     table = read_table(args.table, args.sample)
     spec = _spec_from_args(args, fab, table)     # a baseline's default free set: the table's
     plots = None
     if not args.no_plots:
         plots = lazy.plots().fit_diagnostics.write_fit_plots
     result = fit_fabric(
-        table, fab, spec, out, plots=plots, progress=cliutil.progress(args), **fit_kw,
+        table, fab, spec, out, plots=plots, table_file=args.table,
+        progress=cliutil.progress(args), **fit_kw,
         notify=lambda line: print(shown(line), file=sys.stderr, flush=True),
         config_extra=_config_extra(args, fab))
     print(f"model: {spec.model}" + "".join(f"; {n}" for n in spec.notes))

@@ -25,7 +25,7 @@ from gonio.atomic import atomic_write, is_temporary
 from gonio.terminal import shown
 
 __all__ = ["FIT_MARKER", "FIT_FILES", "STATE_FILES", "PLOT_FILES", "check_fit_folder",
-           "claim_fit_folder", "fit_folder_files"]
+           "claim_fit_folder", "release_fit_folder", "fit_folder_files"]
 
 #: The marker of a fit's folder: the files the fits there wrote (or were about to).
 FIT_MARKER = ".microcyl-fit"
@@ -149,3 +149,26 @@ def claim_fit_folder(out, files) -> None:
     with atomic_write(out / FIT_MARKER, "w") as fh:
         json.dump({"kind": _KIND, "files": sorted(wanted)}, fh, indent=1)
         fh.write("\n")
+
+
+def release_fit_folder(out) -> None:
+    """Remove the marker of the folder ``out`` when no fit file is there (a fit refused
+    before it wrote any: the table too small, the chains over the memory limit), so that
+    the folder is left as it was, and a new one empty (removed with the lock). Call while
+    holding the folder's lock.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> d = Path(tempfile.mkdtemp())
+    >>> claim_fit_folder(d, ["results.json"]); release_fit_folder(d); sorted(os.listdir(d))
+    []
+    """
+    out = Path(out)
+    try:
+        held = [e for e in os.listdir(out)
+                if e not in (LOCK_NAME, FIT_MARKER) and not is_temporary(e)]
+        if not held:
+            os.unlink(out / FIT_MARKER)
+    except OSError:
+        pass

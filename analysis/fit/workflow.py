@@ -12,7 +12,8 @@ from analysis.budget import check_fit_rows
 from analysis.fit.checkpoint import table_digest
 from analysis.fit.driver import FitOptions, fit
 from analysis.fit.loo import psis_loo
-from analysis.fit.outputs import PLOT_FILES, STATE_FILES, check_fit_folder, claim_fit_folder
+from analysis.fit.outputs import (PLOT_FILES, STATE_FILES, check_fit_folder, claim_fit_folder,
+                                  release_fit_folder)
 from analysis.families import family_of
 from analysis.fit.posterior import forward_model
 from analysis.fit.quality import fit_quality
@@ -147,8 +148,12 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     with output_lock(out, "fit"):
         check_fit_folder(out, table_file)
         claim_fit_folder(out, STATE_FILES + (PLOT_FILES if plots is not None else ()))
-        result = fit(table, spec, forward_model(fabric, table.wi, table.wo), out_dir=out,
-                     **fit_kw)
+        try:
+            result = fit(table, spec, forward_model(fabric, table.wi, table.wo), out_dir=out,
+                         **fit_kw)
+        except BaseException:
+            release_fit_folder(out)     # refused before its first file: the folder as it was
+            raise
         result.quality = fit_quality(result, table)
         t0 = time.perf_counter()
         result.loo = psis_loo(result, table_digest(table))

@@ -33,6 +33,7 @@ from gonio.atomic import atomic_write
 from gonio.csvtable import ANGLE_RANGES, ANGLES
 from gonio.errors import FormatError
 from gonio.geometry import HORIZON_EPS
+from gonio.csvcells import comment_text, text_cells
 from gonio.terminal import shown
 from gonio.travel import check_angles, order_for_travel, travel
 
@@ -58,7 +59,7 @@ def _header_lines(header) -> list[str]:
         if not isinstance(key, str) or not _KEY.fullmatch(key):
             raise ValueError(f"header key {shown(key)!r} must be a name of letters, digits, "
                              f"'_', '.', '-' (starting with a letter or '_')")
-        lines.append(f"# {key}: {shown(value).strip()}\n")
+        lines.append(f"# {key}: {comment_text(shown(value).strip())}\n")
     size = sum(len(s.encode()) for s in lines) + len(_INTRO)
     if len(lines) + 1 > MAX_HEADER_LINES or size > MAX_HEADER_BYTES:
         raise ValueError(f"header: {len(lines)} lines, {size} bytes; a plan file's comments "
@@ -83,7 +84,7 @@ def _column_text(name, values, n: int) -> list[str]:
         if not t.isprintable() or any(c in t for c in ",;\t") or t != t.strip():
             raise ValueError(f"column {name!r}, pair {k + 1}: {shown(t)!r} must be "
                              f"printable, without ',', ';', tabs or surrounding spaces")
-    return text
+    return text_cells(text)
 
 
 def _check_ranges(a: np.ndarray) -> None:

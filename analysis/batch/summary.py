@@ -13,6 +13,7 @@ import math
 from pathlib import Path
 
 import gonio
+from gonio.csvcells import text_cells
 from gonio.safenames import check_component
 from gonio.statefields import FileFields
 
@@ -86,6 +87,16 @@ def check_row(row, path, i: int) -> dict:
     return row
 
 
+def _cell(value):
+    """A value of a row as a CSV cell: empty for None (or missing), numbers as numbers, text
+    (and anything else, an unknown row's list or object) as text."""
+    if value is None:
+        return ""
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    return json.dumps(gonio.plain(value, nonfinite="null"))
+
+
 class BatchSummary:
     """The rows of a batch, by table name, in the batch's order.
 
@@ -145,7 +156,9 @@ class BatchSummary:
         return out
 
     def write(self, names=None) -> None:
-        """Write ``summary.json`` and ``summary.csv`` atomically."""
+        """Write ``summary.json`` and ``summary.csv`` atomically; the CSV's text cells
+        through :func:`gonio.csvcells.text_cell` (a name ``=HYPERLINK(...)`` is written
+        ``'=HYPERLINK(...)``: a spreadsheet shows it, never evaluates it)."""
         rows = self.ordered(names)
         doc = {"schema": SCHEMA[0], "version": SCHEMA[1], "counts": self.counts(),
                "tables": rows}
@@ -156,9 +169,9 @@ class BatchSummary:
         for r in rows:
             columns += [k for k in r if k not in columns]
         buf = io.StringIO()
-        w = csv.DictWriter(buf, fieldnames=columns, restval="", lineterminator="\n")
-        w.writeheader()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(text_cells(columns))       # a cell a spreadsheet would evaluate: quoted
         for r in rows:
-            w.writerow({k: ("" if v is None else v) for k, v in r.items()})
+            w.writerow(text_cells(_cell(r.get(k)) for k in columns))
         with gonio.atomic_write(self.dir / SUMMARY_CSV, "w") as f:
             f.write(buf.getvalue())

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from analysis.fit.checkpoint import CHECKPOINT_FILE, CONFIG_FILE
 from analysis.fit.loo import LOO_FILE
-from analysis.folderlock import LOCK_NAME
+from analysis.folderlock import LOCK_NAME, refuse_report_folder
 from gonio.atomic import atomic_write, is_temporary
 from gonio.terminal import shown
 
@@ -129,6 +129,7 @@ def check_fit_folder(out, table_file=None) -> None:
                                    f"writes its files there: choose another output folder"))
     if os.path.islink(out) or not os.path.isdir(out):
         return                          # missing: created; a link: refused by the lock
+    refuse_report_folder(out, "fit")
     ours = fit_folder_files(out) | {LOCK_NAME, FIT_MARKER}
     foreign = {e for e in os.listdir(out) if e not in ours and not is_temporary(e)}
     if foreign:

@@ -104,3 +104,17 @@ def test_comment_helpers():
     assert json.loads(comment_json(json.dumps("x,=1,-2"))) == "x,=1,-2"
     assert comment_json(json.dumps([1, -2])) == "[1, -2]"
     assert comment_text("a,@b,-3") == "a,'@b,-3"
+
+
+def test_every_csv_writer_goes_through_csvcells():
+    """A module that makes a csv writer imports gonio.csvcells: a new CSV writer is not
+    forgotten."""
+    root = Path(__file__).resolve().parents[1]
+    missed = []
+    for pkg in ("brdf", "gonio", "analysis", "reports"):
+        for path in (root / pkg).rglob("*.py"):
+            text = path.read_text(encoding="utf-8")
+            if ("csv.writer(" in text or "csv.DictWriter(" in text) and \
+                    "gonio.csvcells import" not in text:
+                missed.append(str(path.relative_to(root)))
+    assert missed == []

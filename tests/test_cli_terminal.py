@@ -70,6 +70,15 @@ def test_info_shows_the_metadata_escaped(tmp_path):
     assert f"format: {SHOWN}\n" in out and f"units: {SHOWN}\n" in out
 
 
+def test_a_warning_naming_a_hostile_file_is_escaped(tmp_path):
+    t = tmp_path / f"{HOSTILE}.csv"
+    t.write_text(f"{HEADER}\n0.5,0,0.5,3.1,0.1,0.1,0.1\n")      # radians: a TableWarning
+    p = microcyl("info", t)
+    assert p.returncode == 0, p.stderr
+    clean(p, f"microcyl info: warning: {tmp_path}/{SHOWN}.csv: every angle is within the "
+             f"range of radians")
+
+
 def test_a_column_name_in_a_read_error_is_escaped(tmp_path):
     t = tmp_path / "t.csv"
     t.write_text(f"{HEADER},{COLUMN}\n{ROW.strip()},1\n", encoding="utf-8")

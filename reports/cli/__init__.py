@@ -120,11 +120,11 @@ def _run(args):
     ``microcyl`` logger (shown with -q too); other warnings as Python shows them."""
     log = logging.getLogger("microcyl")
     with warnings.catch_warnings():
-        shown = warnings.showwarning
+        python_shows = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
             if not issubclass(category, TableWarning):
-                return shown(message, category, filename, lineno, file, line)
+                return python_shows(message, category, filename, lineno, file, line)
             text = " ".join(str(message).split())
             log.warning(f"microcyl {args.command}: warning: {shown(text)}")
 

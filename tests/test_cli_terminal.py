@@ -5,6 +5,7 @@ Each is a field or a name holding an ESC sequence (set the title, clear the scre
 U+202E, run as a user types it; no control byte reaches stdout or stderr and the escaped text
 is shown (:func:`gonio.terminal.shown`)."""
 
+import io
 import json
 import os
 import shutil
@@ -16,6 +17,7 @@ import numpy as np
 import pytest
 
 from _fitmodels import fabric_table
+from gonio.progress import progress_bar, progress_line
 from gonio.terminal import shown
 from test_cli_fit import _write_csv
 
@@ -157,3 +159,14 @@ def test_fit_batch_lines_show_a_hostile_file_name_escaped(tmp_path):
     assert f"{src}/{SHOWN}.csv: line 1: unknown column(s) {COLUMN_SHOWN};" in line
     assert line.count(SHOWN) == 1                 # the file named once
     assert "1 errors" in text
+
+
+def test_a_progress_label_and_line_are_escaped(monkeypatch):
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    with progress_bar(2, desc=f"{HOSTILE}: fit", unit="table") as bar:
+        bar.update(2)
+    progress_line(f"{HOSTILE}: step 20")
+    out = err.getvalue()
+    assert not [c for c in CONTROLS if c in out], repr(out)
+    assert f"{SHOWN}: fit: 100%" in out and f"{SHOWN}: step 20\n" in out

@@ -33,7 +33,8 @@ from pathlib import Path
 from gonio.atomic import TEMP_PREFIX, is_temporary, temporary_stem
 
 __all__ = ["output_lock", "FolderBusy", "remove_stale_temporaries", "LOCK_NAME",
-           "REPORT_MARKER", "lock_name", "missing_folders", "remove_empty_folders"]
+           "REPORT_MARKER", "lock_name", "missing_folders", "remove_empty_folders",
+           "refuse_report_folder"]
 
 #: The lock file inside a locked folder.
 LOCK_NAME = ".microcyl.lock"
@@ -195,7 +196,10 @@ def _open_folder(path: Path, create: bool, follow: bool = False) -> tuple[int, l
         raise OSError(f"output folder {path} cannot be opened: {exc.strerror}") from None
 
 
-def _refuse_report_folder(path: Path, what: str) -> None:
+def refuse_report_folder(path, what: str) -> None:
+    """Refuse the folder ``path`` (a ValueError naming it) for a run of kind ``what`` when it
+    holds a report (:data:`REPORT_MARKER`): the next report there replaces it whole."""
+    path = Path(path)
     if os.path.lexists(path / REPORT_MARKER):
         raise ValueError(f"output folder {path} holds a microcyl report ({REPORT_MARKER}); a "
                          f"{what} would be deleted by the next report there; choose another "
@@ -245,7 +249,7 @@ def _clean(path: Path, inside: bool, what: str) -> None:
         remove_stale_temporaries(full.parent, full.name)
         return
     if what != "report":
-        _refuse_report_folder(path, what)
+        refuse_report_folder(path, what)
     remove_stale_temporaries(full)
     if full.name:
         remove_stale_temporaries(full.parent, full.name)

@@ -24,6 +24,7 @@ from gonio.travel import order_for_travel
 from gonio.merl import MerlBRDF, load_merl, merl_table, read_merl, write_merl
 from gonio.rgl import RGLBRDF, load_rgl
 from gonio.table import Table
+from gonio.terminal import shown
 
 __all__ = [
     "Table", "FormatError", "TableWarning", "read", "write", "load_rgl", "load_merl", "read_curet",
@@ -32,5 +33,5 @@ __all__ = [
     "merl_table", "write_merl", "MerlBRDF", "RGLBRDF", "atomic_write", "plain", "json_line", "meta_text", "progress_bar",
     "Geometry", "Instrument", "measure", "full_grid", "plane", "rusinkiewicz", "merl_grid",
     "pairs", "pairs_from_angles", "from_spec", "write_pairs_csv", "read_pairs_header",
-    "order_for_travel",
+    "order_for_travel", "shown",
 ]

@@ -12,6 +12,7 @@ import numpy as np
 
 from brdf import validate
 from gonio.atomic import atomic_write
+from gonio.csvcells import comment_json
 from gonio.errors import FormatError, TableWarning
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
@@ -85,7 +86,7 @@ def write_csv(table: Table, path, digits: int | None = None) -> None:
                 "comment lines start with #\n")
         for key, value in table.meta.items():
             if _KEY.match(f"{key}: x"):
-                f.write(f"# {key}: {json.dumps(plain(value))}\n")
+                f.write(f"# {key}: {comment_json(json.dumps(plain(value)))}\n")
         f.write(",".join(cols) + "\n")
         for a in range(0, len(table), _WRITE_ROWS):
             rows = zip(*(format_numbers(x[a:a + _WRITE_ROWS],

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 
+from gonio.terminal import shown
+
 __all__ = ["FormatError", "TableWarning"]
 
 
@@ -19,7 +21,9 @@ class FormatError(ValueError):
     path : str or os.PathLike
         The offending file.
     problem : str
-        What is wrong with it.
+        What is wrong with it. The message (file name and problem, which may quote the
+        file: a column name, a metadata key) is one line through
+        :func:`gonio.terminal.shown`: what the file holds reaches a terminal escaped.
 
     Examples
     --------
@@ -28,12 +32,14 @@ class FormatError(ValueError):
     't.csv: line 3: expected 7 columns, got 5'
     >>> isinstance(err, ValueError), err.path
     (True, 't.csv')
+    >>> print(FormatError("t.csv", "line 1: unknown column(s) \\x1b[2J"))
+    t.csv: line 1: unknown column(s) \\x1b[2J
     """
 
     def __init__(self, path, problem: str):
         self.path = os.fspath(path)
         self.problem = problem
-        super().__init__(f"{self.path}: {problem}")
+        super().__init__(shown(f"{self.path}: {problem}"))
 
 
 class TableWarning(UserWarning):

@@ -13,7 +13,7 @@ from gonio.geomspec import from_spec
 from gonio.instrument import Instrument, cone_directions
 from gonio.jsonplain import plain
 from gonio.progress import progress_bar
-from gonio.statefields import one_line
+from gonio.terminal import shown
 from gonio.table import Table
 
 __all__ = ["measure", "toolkit_version", "describe_brdf"]
@@ -197,7 +197,7 @@ def _check_reach(geometry: Geometry, instrument: Instrument) -> None:
     """Refuse, before any work, a geometry with pairs out of the instrument's reach."""
     if instrument.has_limits:
         instrument.check_reachable(geometry.wi, geometry.wo,
-                                   f"geometry {one_line(geometry.spec or geometry.kind)}")
+                                   f"geometry {shown(geometry.spec or geometry.kind)}")
 
 
 def _chunk_of(chunk) -> int:

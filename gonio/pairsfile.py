@@ -33,7 +33,8 @@ from gonio.atomic import atomic_write
 from gonio.csvtable import ANGLE_RANGES, ANGLES
 from gonio.errors import FormatError
 from gonio.geometry import HORIZON_EPS
-from gonio.statefields import one_line
+from gonio.csvcells import comment_text, text_cells
+from gonio.terminal import shown
 from gonio.travel import check_angles, order_for_travel, travel
 
 __all__ = ["write_pairs_csv", "read_pairs_header", "order_for_travel", "travel",
@@ -56,9 +57,9 @@ def _header_lines(header) -> list[str]:
     lines = []
     for key, value in (header or {}).items():
         if not isinstance(key, str) or not _KEY.fullmatch(key):
-            raise ValueError(f"header key {one_line(key)!r} must be a name of letters, digits, "
+            raise ValueError(f"header key {shown(key)!r} must be a name of letters, digits, "
                              f"'_', '.', '-' (starting with a letter or '_')")
-        lines.append(f"# {key}: {one_line(value).strip()}\n")
+        lines.append(f"# {key}: {comment_text(shown(value).strip())}\n")
     size = sum(len(s.encode()) for s in lines) + len(_INTRO)
     if len(lines) + 1 > MAX_HEADER_LINES or size > MAX_HEADER_BYTES:
         raise ValueError(f"header: {len(lines)} lines, {size} bytes; a plan file's comments "
@@ -68,7 +69,7 @@ def _header_lines(header) -> list[str]:
 
 def _column_text(name, values, n: int) -> list[str]:
     if not isinstance(name, str) or not _COLUMN.fullmatch(name) or name in PLAN_COLUMNS:
-        raise ValueError(f"column name {one_line(name)!r} must be lower-case letters, digits "
+        raise ValueError(f"column name {shown(name)!r} must be lower-case letters, digits "
                          f"and '_' (starting with a letter or '_'), not one of "
                          f"{', '.join(PLAN_COLUMNS)}")
     v = np.asarray(values)
@@ -81,9 +82,9 @@ def _column_text(name, values, n: int) -> list[str]:
     text = [str(x) for x in v.tolist()]
     for k, t in enumerate(text):
         if not t.isprintable() or any(c in t for c in ",;\t") or t != t.strip():
-            raise ValueError(f"column {name!r}, pair {k + 1}: {one_line(t)!r} must be "
+            raise ValueError(f"column {name!r}, pair {k + 1}: {shown(t)!r} must be "
                              f"printable, without ',', ';', tabs or surrounding spaces")
-    return text
+    return text_cells(text)
 
 
 def _check_ranges(a: np.ndarray) -> None:
@@ -119,7 +120,7 @@ def write_pairs_csv(path, angles_deg, header: Mapping[str, str] | None = None,
     header : mapping of str to str, optional
         ``# key: value`` lines, in this order: keys names of letters, digits, ``_.-``;
         values written with :func:`str`, one line (unprintable characters escaped,
-        :func:`gonio.statefields.one_line`).
+        :func:`gonio.terminal.shown`).
     columns : mapping of str to array, optional
         Extra columns after the angles, one value a pair (in the rows' given order):
         numbers (floats written to round-trip) or printable text without delimiters.
@@ -214,5 +215,5 @@ def read_pairs_header(path) -> dict[str, str]:
             raise FormatError(path, f"line {lineno}: not UTF-8 text; not a plan file") from None
         m = _COMMENT.fullmatch(line)
         if m:
-            out[m.group(1)] = one_line(m.group(2).strip())
+            out[m.group(1)] = shown(m.group(2).strip())
     return out

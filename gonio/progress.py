@@ -6,6 +6,8 @@ import sys
 
 import tqdm.auto
 
+from gonio.terminal import shown
+
 __all__ = ["progress_bar", "interactive", "progress_line", "LineStream", "PIPE_INTERVAL"]
 
 
@@ -33,9 +35,9 @@ def interactive(stream=None) -> bool:
 
 def progress_line(text: str, stream=None) -> None:
     """One line of progress on ``stream`` (default stderr), flushed: what a job writes to
-    a pipe or a log file instead of a bar."""
+    a pipe or a log file instead of a bar (escaped by :func:`gonio.terminal.shown`)."""
     stream = sys.stderr if stream is None else stream
-    print(text, file=stream, flush=True)
+    print(shown(text), file=stream, flush=True)
 
 
 #: Seconds between two lines of a bar on a pipe or a file (:class:`LineStream`).
@@ -80,7 +82,8 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
     total : int or None
         Units of work (None while unknown: no ETA is shown).
     desc, unit : str
-        Label and unit name.
+        Label and unit name (escaped by :func:`gonio.terminal.shown`: a name read from a
+        file reaches the terminal as text, never as a control).
     enabled : bool
         False gives tqdm's disabled bar: the same methods (``update``, ``set_postfix``,
         ``set_description``, ``close``, use as a context manager), drawing nothing.
@@ -92,6 +95,7 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
     >>> with progress_bar(3, desc="demo", unit="item", enabled=False) as bar:
     ...     bar.update(3)
     """
+    desc, unit = shown(desc), shown(unit)
     # looked up on each call (not bound at import), so a patched tqdm.auto.tqdm is used
     if enabled and not interactive():
         return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=True,

@@ -141,7 +141,7 @@ def check_component(name, *, source, entry: str) -> str:
     return name
 
 
-def safe_component(name: str) -> str:
+def safe_component(name: str, avoid=()) -> str:
     """``name`` made into a safe path component: unchanged when it is one already, else its
     unsafe characters replaced by ``_``, leading dots and surrounding white space removed,
     shortened, and ``-`` and an 8-digit digest of the original name appended (two names that
@@ -152,6 +152,10 @@ def safe_component(name: str) -> str:
     Parameters
     ----------
     name : str
+    avoid : iterable of str
+        Names the component must not be, case ignored (the files of the folder it goes
+        into, such as a batch's ``summary.json``): ``name`` equal to one of them gets the
+        digest appended too.
 
     Returns
     -------
@@ -168,10 +172,12 @@ def safe_component(name: str) -> str:
     'my table'
     >>> safe_component("../x")
     '_x-d6b96a97'
+    >>> safe_component("Summary.JSON", avoid=["summary.json"])
+    'Summary.JSON-987884bf'
     """
     if not isinstance(name, str):
         raise TypeError(f"a name must be a string; got {type(name).__name__}")
-    if name_problem(name) is None:
+    if name_problem(name) is None and name.casefold() not in {a.casefold() for a in avoid}:
         return name
     keep = "".join("_" if (c in _SEPARATORS or c in _RESERVED
                            or unicodedata.category(c).startswith("C")) else c for c in name)

@@ -29,9 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from gonio.safeopen import MAX_STATE_BYTES, read_bytes, read_text
+from gonio.terminal import shown
 
-__all__ = ["FileFields", "load_json", "loads_json", "load_toml", "one_line", "MAX_DEPTH",
-           "MAX_MAGNITUDE"]
+__all__ = ["FileFields", "load_json", "loads_json", "load_toml", "MAX_DEPTH", "MAX_MAGNITUDE"]
 
 #: Deepest nesting of lists and objects a state file may hold (microcyl writes at most ~6).
 MAX_DEPTH = 64
@@ -43,16 +43,9 @@ MAX_MAGNITUDE = 1e6
 _MISSING = object()
 
 
-def one_line(text) -> str:
-    """``text`` with every unprintable character (a newline, a control or format character)
-    written as its escape, so that an error naming a field read from a file stays one line.
-
-    Examples
-    --------
-    >>> one_line("kd1\\n.lo")
-    'kd1\\\\n.lo'
-    """
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+#: The same function as :func:`gonio.terminal.shown` (the one escape of text read from a
+#: file), under the name its first callers used.
+one_line = shown
 
 
 def _short(value, limit: int = 60) -> str:
@@ -144,11 +137,11 @@ class FileFields:
               ) -> ValueError:
         """The one-line error: ``FILE: FIELD must be ALLOWED; got VALUE`` (``got`` the text
         shown for the value instead of its repr)."""
-        field = one_line(field)
+        field = shown(field)
         if got is None and value is _MISSING:
             return ValueError(f"{self.path}: {field} must be {allowed}; it is missing")
         return ValueError(f"{self.path}: {field} must be {allowed}; "
-                          f"got {one_line(_short(value) if got is None else got)}")
+                          f"got {shown(_short(value) if got is None else got)}")
 
     @staticmethod
     def name(where: str, key) -> str:

@@ -103,9 +103,8 @@ def test_a_refused_fit_leaves_no_new_folder(tmp_path, capsys):
         (few, ["--free", "gamma_s1,kd1,eta1", "--tie", "none"], "3 valid values"),
         (silk, ["--free", "kd1", "--walkers", "2000000", "--max-steps", "20000"], "memory"),
     ]
-    existing = tmp_path / "existing"
-    existing.mkdir()
-    (existing / "notes.txt").write_text("mine")
+    existing = tmp_path / "existing"      # empty: a folder of the user's files is refused
+    existing.mkdir()                      # before the table is read (test_cli_fit_outputs)
     for table_path, extra, message in cases:
         new = tmp_path / "new" / "deeper"
         for out in (new, existing):
@@ -115,7 +114,7 @@ def test_a_refused_fit_leaves_no_new_folder(tmp_path, capsys):
             err = capsys.readouterr().err
             assert message in err and len(err.strip().splitlines()) == 1, err
             assert not (tmp_path / "new").exists(), (extra, sorted(tmp_path.iterdir()))
-            assert sorted(p.name for p in existing.iterdir()) == ["notes.txt"]
+            assert sorted(p.name for p in existing.iterdir()) == []
 
 
 def test_fit_prints_each_warning_after_the_verdict(tmp_path):

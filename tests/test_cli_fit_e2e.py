@@ -69,7 +69,10 @@ def test_fit_with_progress_bar_to_convergence(silk_csv, tmp_path):
     assert set(doc["plots"]) == {"corner", "traces", "lobes", "residuals", "adequacy", "pit"}
     assert all((out / f"{k}.png").stat().st_size > 1000 for k in doc["plots"])
     assert "CONVERGED" in stdout and f"results: {out / 'results.json'}" in stdout
-    assert sorted(q.name for q in out.iterdir() if q.name.startswith(".")) == []  # no temp
+    # no temporary; the marker listing what the fit wrote (issue 35: a resume's own files)
+    assert sorted(q.name for q in out.iterdir() if q.name.startswith(".")) == [".microcyl-fit"]
+    listed = json.loads((out / ".microcyl-fit").read_text())["files"]
+    assert {q.name for q in out.iterdir()} - {".microcyl-fit"} <= set(listed)
 
 
 def test_only_the_calling_thread_opens_files(monkeypatch, tmp_path):

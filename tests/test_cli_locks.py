@@ -4,6 +4,7 @@ another kind of output, a planted symbolic link, or a user's own ``.tmp`` files.
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -201,12 +202,21 @@ def test_a_fit_keeps_a_users_tmp_files_and_removes_its_own(table_csv, tmp_path):
     assert len(stale) == 1                      # a killed fit's temporary
     stale = stale[0]
     r = microcyl("fit", table_csv, *FIT, "-o", out)
-    assert r.returncode == 0, r.stderr
+    # the user's files: a fit does not write where they are (issue 35), and keeps them
+    assert r.returncode == 1 and last_line(r).endswith(
+        "holds files a fit did not write (.checkpoint.h5.abcdefgh.tmp, .mydata.tmp, "
+        ".notes.tmp); a fit replaces its files there: move them away or choose another "
+        "folder"), r.stderr
     assert (out / ".mydata.tmp" / "run1.csv").read_text() == "1,2,3\n"
     assert (out / ".notes.tmp").read_text() == "notes"
     assert (out / ".checkpoint.h5.abcdefgh.tmp").exists()
-    assert not stale.exists()
+    for mine in (".mydata.tmp", ".notes.tmp", ".checkpoint.h5.abcdefgh.tmp"):
+        shutil.move(out / mine, tmp_path / mine)
+    r = microcyl("fit", table_csv, *FIT, "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert not stale.exists()                   # the killed fit's temporary: removed
     assert (out / "results.json").is_file()
+    assert (tmp_path / ".mydata.tmp" / "run1.csv").read_text() == "1,2,3\n"
 
 
 def test_the_batch_page_takes_the_batch_folders_lock(tmp_path):

@@ -21,12 +21,13 @@ from pathlib import Path
 from typing import Callable
 
 from analysis.batch.jobs import BatchJob
-from analysis.batch.summary import BatchSummary
+from analysis.batch.summary import BatchSummary, check_not_batch_file
 from analysis.batch.worker import error_row, estimate_job, run_job
 from analysis.budget import format_seconds
 from analysis.folderlock import output_lock
 from gonio.progress import progress_bar
 from gonio.safenames import check_component
+from gonio.terminal import shown
 
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3      # glibc's mallopt parameters
 
@@ -107,13 +108,21 @@ def _ignore_sigint():
 
 
 def describe_row(row: dict) -> str:
-    """One line for a finished table."""
+    """One line for a finished table, through :func:`gonio.terminal.shown` (its error may
+    quote the table's file: a column name, a metadata value).
+
+    Examples
+    --------
+    >>> print(describe_row({"name": "x", "status": "error", "error": "bad \\x1b[2J"}))
+    x: error: bad \\x1b[2J
+    """
     if row["status"] == "error":
-        return f"{row['name']}: error: {row['error']}"
+        return shown(f"{row['name']}: error: {row['error']}")
     verdict = "converged" if row["status"] == "converged" else "NOT converged"
     resumed = (f"; resumed from step {row['resumed_from']}" if row.get("resumed_from")
                else "")
-    return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
+    return shown(f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s)"
+                 f"{resumed}")
 
 
 def estimate_batch(todo: list[BatchJob], workers: int | None = None,
@@ -207,7 +216,8 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
         On Ctrl-C, after writing the summaries (every fit resumable from its checkpoint).
     ValueError
         Duplicate job names (case ignored), a name that is not a safe file name
-        (:func:`gonio.safenames.check_component`) or a bad ``workers``.
+        (:func:`gonio.safenames.check_component`) or is one of the batch's own files
+        (:data:`analysis.batch.summary.BATCH_FILES`), or a bad ``workers``.
     FolderBusy
         Another run (batch, fit, report) holds ``out_dir``'s lock
         (:func:`analysis.folderlock.output_lock`).
@@ -215,6 +225,7 @@ def run_batch(jobs: list[BatchJob], out_dir, *, workers: int | None = None,
     names = [j.name for j in jobs]
     for n in names:                     # each names its folder: DIR/<name>
         check_component(n, source="run_batch", entry="job name")
+        check_not_batch_file(n, "run_batch", "job name")
     if len(set(n.casefold() for n in names)) != len(names):
         raise ValueError("job names must be unique in a batch (case ignored)")
     if workers is not None and workers < 1:

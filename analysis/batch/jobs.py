@@ -11,7 +11,9 @@ Each table's folder in the batch's output is named by :func:`table_names` from t
 tables alone, never from their order, so the same inputs in another order name the same
 folders: the stem (``FOLDER_SS`` for CUReT), made a safe file name
 (:func:`gonio.safenames.safe_component`: a table ``...exr``, whose stem is ``..``, gets
-``_-<digest>``); where stems collide (case ignored), the path relative to the tables' common
+``_-<digest>``, and so does a stem that names one of the batch's own files,
+:data:`analysis.batch.summary.BATCH_FILES`: ``summary.json.csv`` gets
+``summary.json-<digest>``); where stems collide (case ignored), the path relative to the tables' common
 folder (``a/x.csv`` and ``b/x.csv`` give ``a_x`` and ``b_x``), then with its suffix
 (``x_csv``, ``x_exr``), then with a digest of that path. A table named twice is fitted once.
 """
@@ -31,6 +33,7 @@ from gonio.io import READ_SUFFIXES
 from analysis.families import MICROCYLINDER, family
 from analysis.fit.workflow import fit_spec
 from gonio.curet import N_SAMPLES
+from analysis.batch.summary import BATCH_FILES
 from gonio.safenames import digest, safe_component
 from gonio.statefields import load_toml
 
@@ -194,8 +197,8 @@ def _candidates(path: Path, sample: int | None, root: Path) -> list[str]:
         label = "_".join(rel.parent.parts + (f"{sample:02d}",)) if rel.parent.parts else base
         full = "_".join(rel.parts).replace(".", "_") + f"_{sample:02d}"
     key = f"{rel.as_posix()}#{sample}"
-    return [safe_component(base), safe_component(label), safe_component(full),
-            f"{safe_component(label)[:80]}-{digest(key)}"]
+    return [safe_component(base, BATCH_FILES), safe_component(label, BATCH_FILES),
+            safe_component(full, BATCH_FILES), f"{safe_component(label)[:80]}-{digest(key)}"]
 
 
 def table_names(tables) -> list[str]:

@@ -13,14 +13,21 @@ import math
 from pathlib import Path
 
 import gonio
+from gonio.csvcells import text_cells
 from gonio.safenames import check_component
+from gonio.terminal import shown
 from gonio.statefields import FileFields
 
 __all__ = ["BatchSummary", "SUMMARY_CSV", "SUMMARY_JSON", "SCHEMA", "FIRST_COLUMNS",
-           "STATUSES", "check_row"]
+           "STATUSES", "BATCH_FILES", "check_row", "check_not_batch_file"]
 
 SUMMARY_CSV = "summary.csv"
 SUMMARY_JSON = "summary.json"
+#: The batch's own files in its folder, which no table's folder may be named (case ignored):
+#: the summaries, the batch page (``reports.report_batch.PAGE``) and fit-measured's
+#: summary (``analysis.measured.SUMMARY_FILE``). (The lock and the temporaries start with a
+#: dot, which no safe name does.)
+BATCH_FILES = (SUMMARY_JSON, SUMMARY_CSV, "index.html", "measured.json")
 SCHEMA = ("microcyl-batch", 1)
 #: The columns every row has, first in the CSV.
 FIRST_COLUMNS = ("name", "status", "error", "steps", "wall_s")
@@ -37,6 +44,26 @@ def _bad(path, field: str, allowed: str, value) -> ValueError:
 
 def _count(v) -> bool:
     return isinstance(v, int) and not isinstance(v, bool) and v >= 0
+
+
+def check_not_batch_file(name: str, source, entry: str) -> str:
+    """``name`` unless it is one of :data:`BATCH_FILES` (case ignored): a table's folder of
+    that name would stand where the batch writes its own file. ``ValueError`` naming
+    ``source`` and ``entry`` otherwise.
+
+    Examples
+    --------
+    >>> check_not_batch_file("t0", "run_batch", "job name")
+    't0'
+    >>> check_not_batch_file("Summary.json", "run_batch", "job name")
+    Traceback (most recent call last):
+    ...
+    ValueError: run_batch: job name: 'Summary.json' is the name of a file of the batch (summary.json, summary.csv, index.html, measured.json); refused
+    """
+    if isinstance(name, str) and name.casefold() in {f.casefold() for f in BATCH_FILES}:
+        raise ValueError(f"{source}: {entry}: {shown(repr(name))} is the name of a file of the "
+                         f"batch ({', '.join(BATCH_FILES)}); refused")
+    return name
 
 
 def check_row(row, path, i: int) -> dict:
@@ -64,6 +91,8 @@ def check_row(row, path, i: int) -> dict:
         raise _bad(path, where, "an object", row)
     check_component(row.get("name"), source=path, entry=f"{where}.name")
     check_component(row.get("folder", row["name"]), source=path, entry=f"{where}.folder")
+    check_not_batch_file(row["name"], path, f"{where}.name")
+    check_not_batch_file(row.get("folder", row["name"]), path, f"{where}.folder")
     if row.get("status") not in STATUSES:
         raise _bad(path, f"{where}.status", f"one of {', '.join(STATUSES)}", row.get("status"))
     for k in _STRINGS:
@@ -86,6 +115,16 @@ def check_row(row, path, i: int) -> dict:
     return row
 
 
+def _cell(value):
+    """A value of a row as a CSV cell: empty for None (or missing), numbers as numbers, text
+    (and anything else, an unknown row's list or object) as text."""
+    if value is None:
+        return ""
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    return json.dumps(gonio.plain(value, nonfinite="null"))
+
+
 class BatchSummary:
     """The rows of a batch, by table name, in the batch's order.
 
@@ -105,6 +144,10 @@ class BatchSummary:
         self.dir = Path(out_dir)
         self.rows: dict[str, dict] = {}
         path = self.dir / SUMMARY_JSON
+        if path.is_dir() and not path.is_symlink():
+            raise ValueError(f"{path} is a folder, not the batch summary (the folder of a "
+                             f"table named {SUMMARY_JSON}.*, from a microcyl that did not "
+                             f"avoid the batch's file names?); move it away")
         if path.exists():
             try:
                 doc = json.loads(path.read_text(encoding="utf-8"))
@@ -145,7 +188,9 @@ class BatchSummary:
         return out
 
     def write(self, names=None) -> None:
-        """Write ``summary.json`` and ``summary.csv`` atomically."""
+        """Write ``summary.json`` and ``summary.csv`` atomically; the CSV's text cells
+        through :func:`gonio.csvcells.text_cell` (a name ``=HYPERLINK(...)`` is written
+        ``'=HYPERLINK(...)``: a spreadsheet shows it, never evaluates it)."""
         rows = self.ordered(names)
         doc = {"schema": SCHEMA[0], "version": SCHEMA[1], "counts": self.counts(),
                "tables": rows}
@@ -156,9 +201,9 @@ class BatchSummary:
         for r in rows:
             columns += [k for k in r if k not in columns]
         buf = io.StringIO()
-        w = csv.DictWriter(buf, fieldnames=columns, restval="", lineterminator="\n")
-        w.writeheader()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(text_cells(columns))       # a cell a spreadsheet would evaluate: quoted
         for r in rows:
-            w.writerow({k: ("" if v is None else v) for k, v in r.items()})
+            w.writerow(text_cells(_cell(r.get(k)) for k in columns))
         with gonio.atomic_write(self.dir / SUMMARY_CSV, "w") as f:
             f.write(buf.getvalue())

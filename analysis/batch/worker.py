@@ -10,6 +10,7 @@ from analysis.fit.driver import estimate_fit_time
 from analysis.families import family
 from analysis.fit.posterior import forward_model
 from analysis.fit.workflow import fit_fabric
+from gonio.terminal import shown
 
 __all__ = ["run_job", "estimate_job", "result_row", "error_row"]
 
@@ -52,6 +53,7 @@ def run_job(job: BatchJob, out_dir) -> dict:
         elif extra is None:
             extra = {"fabric": job.preset, "options": fab.options, "sample": job.sample}
         result = fit_fabric(table, fab, spec, folder, plots=job.plots, progress=False,
+                            table_file=job.path,
                             config_extra=extra, **fit_kw)
     except Exception as exc:        # noqa: BLE001 - the batch records it and goes on
         return error_row(job, exc, time.perf_counter() - t0)
@@ -99,7 +101,8 @@ def result_row(job: BatchJob, result, wall_s: float) -> dict:
 def error_row(job: BatchJob, exc: BaseException, wall_s: float = 0.0) -> dict:
     """The row of a table whose fit failed: the error in one line, naming the file."""
     text = " ".join(str(exc).split()) or type(exc).__name__
-    if job.path not in text and Path(job.path).name not in text:
+    named = (job.path, Path(job.path).name)
+    if not any(n in text or shown(n) in text for n in named):     # a FormatError: escaped
         text = f"{job.path}: {text}"
     row = _base(job)
     row.update(status="error", error=f"{type(exc).__name__}: {text}",

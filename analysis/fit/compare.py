@@ -25,6 +25,7 @@ from analysis.families import model_names
 from analysis.fit.checkpoint import CONFIG_FILE
 from analysis.fit.loo import HIGH_K, LOO_FILE, import_arviz, load_loo
 from analysis.fit.results import read_results
+from gonio.terminal import shown
 
 __all__ = ["compare_fits", "read_fit", "difference_in_se", "FIT_KEYS"]
 
@@ -65,8 +66,9 @@ def read_fit(folder) -> dict:
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise ValueError(f"{cpath}: unreadable fit configuration ({exc})") from None
         if str(recorded) != table:
-            raise ValueError(f"{folder / LOO_FILE} was computed for another table ({table}) "
-                             f"than {cpath} records ({recorded}); run the same `microcyl "
+            raise ValueError(f"{folder / LOO_FILE} was computed for another table "
+                             f"({shown(table)}) than {cpath} records ({shown(recorded)}); run "
+                             f"the same `microcyl "
                              f"fit` again to recompute it")
     if not table:
         raise ValueError(f"{folder / LOO_FILE}: records no table digest; run the same "
@@ -83,8 +85,9 @@ def _check_same_data(fits: list[dict], names: list[str]) -> None:
     first, name0 = fits[0], names[0]
     for fit, name in zip(fits[1:], names[1:]):
         if fit["table"] != first["table"]:
-            raise ValueError(f"{name} is a fit of another table (digest {fit['table']}) than "
-                             f"{name0} (digest {first['table']}); compare ranks fits of one "
+            raise ValueError(f"{name} is a fit of another table (digest {shown(fit['table'])}) "
+                             f"than {name0} (digest {shown(first['table'])}); compare ranks "
+                             f"fits of one "
                              f"table")
         a, b = first["loo"], fit["loo"]
         if not (np.array_equal(a.point, b.point) and np.array_equal(a.channel, b.channel)):

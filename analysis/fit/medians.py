@@ -25,6 +25,7 @@ from analysis.fit.checkpoint import CONFIG_FILE, read_config
 from analysis.fit.results import read_results
 from brdf.models import DEFAULT_MODEL
 from gonio.statefields import MAX_MAGNITUDE, FileFields
+from gonio.terminal import shown
 
 __all__ = ["MedianFabric", "median_fabric", "FitModel"]
 
@@ -187,7 +188,7 @@ def _values(folder: Path, cfg: dict, results: dict) -> dict:
     missing = [n for n in cfg["free"] if n not in medians]
     if missing:
         raise ValueError(f"{folder / 'results.json'}: no median for free parameter(s) "
-                         f"{', '.join(missing)}")
+                         f"{shown(', '.join(missing))}")
     values.update({n: float(medians[n]["median"]) for n in cfg["free"]})
     _check_magnitudes(folder, values, cfg["free"])
     for target, (source, kind) in cfg["ties"].items():

@@ -42,6 +42,7 @@ import numpy as np
 from analysis import diagnostics
 from analysis.fit.quality import residuals
 from gonio import atomic_write
+from gonio.csvcells import comment_text, text_cell
 from gonio.jsonplain import plain
 from gonio.statefields import FileFields, load_json
 
@@ -236,9 +237,11 @@ def write_results(result: FitResult, out_dir) -> tuple[Path, Path]:
     lines = ["parameter," + ",".join(SUMMARY_COLUMNS)]
     for n in result.names:
         s = result.summary[n]
-        lines.append(n + "," + ",".join(
-            s[c] if isinstance(s[c], str) else f"{float(s[c]):.8g}" for c in SUMMARY_COLUMNS))
-    lines.append(f"# converged,{str(result.converged).lower()},{result.reason}")
+        lines.append(text_cell(n) + "," + ",".join(
+            text_cell(s[c]) if isinstance(s[c], str) else f"{float(s[c]):.8g}"
+            for c in SUMMARY_COLUMNS))
+    lines.append(f"# converged,{str(result.converged).lower()},"
+                 f"{comment_text(str(result.reason))}")
     with atomic_write(cpath, "w") as fh:
         fh.write("\n".join(lines) + "\n")
     return jpath, cpath

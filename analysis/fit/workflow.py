@@ -12,6 +12,8 @@ from analysis.budget import check_fit_rows
 from analysis.fit.checkpoint import table_digest
 from analysis.fit.driver import FitOptions, fit
 from analysis.fit.loo import psis_loo
+from analysis.fit.outputs import (PLOT_FILES, STATE_FILES, check_fit_folder, claim_fit_folder,
+                                  release_fit_folder)
 from analysis.families import family_of
 from analysis.fit.posterior import forward_model
 from analysis.fit.quality import fit_quality
@@ -97,14 +99,17 @@ def check_fit_size(path, spec: ParamSpec, walkers: int | None = None, **read_opt
 
 
 def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
-               **fit_kw) -> FitResult:
+               table_file=None, **fit_kw) -> FitResult:
     """Fit ``fabric``'s free parameters to ``table`` and write the results into ``out_dir``.
 
     The fit (:func:`analysis.fit.fit`) checkpoints into ``out_dir`` and resumes there; the
     folder is locked meanwhile (:func:`analysis.folderlock.output_lock`, the lock a batch or a
     report there takes too: a second run into it is refused, ``another fit is running in DIR
     (pid N)``; a folder holding a report is refused), and temporaries a killed fit left in it
-    are removed. Then the
+    are removed. A folder holding files no fit wrote there, or the table file itself, is
+    refused (:func:`analysis.fit.outputs.check_fit_folder`); the files the fit will write are
+    listed in the folder's marker first (:func:`~analysis.fit.outputs.claim_fit_folder`), so
+    the next fit there, a resume, takes them for its own. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
     colours and their CIEDE2000 difference), the PSIS-LOO (:func:`analysis.fit.loo.psis_loo`:
     ``loo`` in the results, its pointwise values in ``loo.npz``, the LOO-PIT test in
@@ -126,6 +131,8 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         ``reports.plots.fit_diagnostics.write_fit_plots``); ``model_factory(wi, wo)`` is a
         forward model (:func:`~analysis.fit.posterior.forward_model`) of the model at
         other pairs.
+    table_file : path, optional
+        The file ``table`` was read from: refused when it lies in ``out_dir``.
     **fit_kw
         Passed to :func:`analysis.fit.fit`.
 
@@ -139,8 +146,14 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         raise ValueError(f"the spec is of model {spec.model}, the start of model "
                          f"{family_of(fabric).name}")
     with output_lock(out, "fit"):
-        result = fit(table, spec, forward_model(fabric, table.wi, table.wo), out_dir=out,
-                     **fit_kw)
+        check_fit_folder(out, table_file)
+        claim_fit_folder(out, STATE_FILES + (PLOT_FILES if plots is not None else ()))
+        try:
+            result = fit(table, spec, forward_model(fabric, table.wi, table.wo), out_dir=out,
+                         **fit_kw)
+        except BaseException:
+            release_fit_folder(out)     # refused before its first file: the folder as it was
+            raise
         result.quality = fit_quality(result, table)
         t0 = time.perf_counter()
         result.loo = psis_loo(result, table_digest(table))
@@ -150,6 +163,7 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         result.loo.save(out)
         if plots is not None:
             files = plots(result, table, lambda wi, wo: forward_model(fabric, wi, wo), out)
+            claim_fit_folder(out, [Path(v).name for v in files.values()])
             result.plots = {k: Path(v).name for k, v in files.items()}
         write_results(result, out)
     return result

@@ -16,6 +16,7 @@ from analysis import colour
 from analysis.views.common import check_quantity, eval_brdf, reduce_quantity
 from analysis.views.lobes import plane_directions
 from gonio.atomic import atomic_write
+from gonio.csvcells import text_cell
 
 __all__ = ["plane_points", "plane_lights", "plane_incidences", "table_panels", "table_points",
            "plane_data", "reduce_sigma", "TablePanelView", "compute_table_panel",
@@ -325,5 +326,5 @@ def write_table_data(path, rows) -> Path:
         out = csv.writer(fh, lineterminator="\n")
         out.writerow(DATA_COLUMNS)
         for name, *numbers in rows:
-            out.writerow([name, *(repr(float(v)) for v in numbers)])
+            out.writerow([text_cell(name), *(repr(float(v)) for v in numbers)])
     return path

@@ -18,6 +18,7 @@ import sys
 import warnings
 
 from gonio.errors import TableWarning
+from gonio.terminal import shown
 
 __all__ = ["main", "build_parser", "COMMAND_MODULES"]
 
@@ -92,13 +93,21 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _ShownFormatter(logging.Formatter):
+    """Each line of a log message through :func:`gonio.terminal.shown`: a file or table name
+    in a "wrote ..." line or a warning reaches the terminal escaped, never as a control."""
+
+    def format(self, record):
+        return shown(super().format(record), lines=True)
+
+
 def _configure_logging(args) -> None:
     """Diagnostics ("wrote FILE", what a verb is about to do) go through the ``microcyl``
     logger to stderr: INFO by default, DEBUG with -v, WARNING with -q (``microcyl -q VERB``
     or a long verb's own ``VERB -q``). Results go to stdout."""
     log = logging.getLogger("microcyl")
     log.handlers[:] = [logging.StreamHandler(sys.stderr)]
-    log.handlers[0].setFormatter(logging.Formatter("%(message)s"))
+    log.handlers[0].setFormatter(_ShownFormatter("%(message)s"))
     log.propagate = False
     quiet = getattr(args, "log_quiet", False) or getattr(args, "quiet", False)
     log.setLevel(logging.DEBUG if getattr(args, "log_verbose", False)
@@ -111,13 +120,13 @@ def _run(args):
     ``microcyl`` logger (shown with -q too); other warnings as Python shows them."""
     log = logging.getLogger("microcyl")
     with warnings.catch_warnings():
-        shown = warnings.showwarning
+        python_shows = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
             if not issubclass(category, TableWarning):
-                return shown(message, category, filename, lineno, file, line)
+                return python_shows(message, category, filename, lineno, file, line)
             text = " ".join(str(message).split())
-            log.warning(f"microcyl {args.command}: warning: {text}")
+            log.warning(f"microcyl {args.command}: warning: {shown(text)}")
 
         warnings.showwarning = show
         return args.func(args)
@@ -148,13 +157,15 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(devnull, sys.stdout.fileno())   # and the flush at exit must not fail either
         return 0
     except KeyboardInterrupt as exc:      # a fit says where its checkpoint is
-        print(f"microcyl {args.command}: {str(exc) or 'interrupted'}", file=sys.stderr)
+        print(f"microcyl {args.command}: {shown(str(exc) or 'interrupted')}", file=sys.stderr)
         return 130
     except (ValueError, OSError, KeyError, RuntimeError) as exc:
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        if isinstance(exc, OSError) and getattr(exc, "filename", None) and exc.filename not in message:
-            message = f"{exc.filename}: {message}"
-        print(f"microcyl {args.command}: error: {message}", file=sys.stderr)
+        # the first line (a file's text in it escaped: one line, no terminal control)
+        message = str(exc).strip().split("\n")[0] if str(exc).strip() else type(exc).__name__
+        filename = getattr(exc, "filename", None) if isinstance(exc, OSError) else None
+        if filename and str(filename) not in message:
+            message = f"{filename}: {message}"
+        print(f"microcyl {args.command}: error: {shown(message)}", file=sys.stderr)
         return 1
     return int(status or 0)
 

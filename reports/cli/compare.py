@@ -15,6 +15,7 @@ import logging
 from analysis.fit.compare import FIT_KEYS, compare_fits, difference_in_se
 from analysis.fit.loo import HIGH_K
 from gonio.jsonplain import plain
+from gonio.terminal import shown
 
 __all__ = ["register", "run", "format_table"]
 
@@ -39,7 +40,8 @@ def register(sub):
 
 
 def format_table(rows: list[dict]) -> str:
-    """The ranking as a text table, then one line per fit behind the best.
+    """The ranking as a text table, then one line per fit behind the best (names and the
+    table's digest, read from the fits' files, through :func:`gonio.terminal.shown`).
 
     Examples
     --------
@@ -58,7 +60,7 @@ def format_table(rows: list[dict]) -> str:
     """
     head = ["rank", "fit", "model", "elpd", "se", "d_elpd", "d_se", "p_loo", f"k>{HIGH_K}",
             "converged"]
-    body = [[str(i + 1), r["fit"], r["model"], f"{r['elpd']:.1f}", f"{r['se']:.1f}",
+    body = [[str(i + 1), shown(r["fit"]), shown(r["model"]), f"{r['elpd']:.1f}", f"{r['se']:.1f}",
              f"{r['d_elpd']:.1f}", f"{r['d_se']:.1f}", f"{r['p_loo']:.1f}",
              str(r["n_high_k"]),
              {True: "yes", False: "no", None: "-"}[r["converged"]]] for i, r in enumerate(rows)]
@@ -66,11 +68,12 @@ def format_table(rows: list[dict]) -> str:
     lines = [" ".join(x[c].ljust(width[c]) if c in (1, 2) else x[c].rjust(width[c])
                       for c in range(len(head))).rstrip() for x in [head] + body]
     best = rows[0]
-    lines.append(f"{best['values']} values of table {best['table']}; d_elpd: the best fit's "
+    lines.append(f"{best['values']} values of table {shown(best['table'])}; d_elpd: the best fit's "
                  f"elpd minus each fit's, d_se its standard error")
     for r in rows[1:]:
         n_se = difference_in_se(r)
-        lines.append(f"{r['fit']} ({r['model']}): behind {best['fit']} ({best['model']}) by "
+        lines.append(f"{shown(r['fit'])} ({shown(r['model'])}): behind {shown(best['fit'])} "
+                     f"({shown(best['model'])}) by "
                      f"{r['d_elpd']:.1f} ± "
                      f"{r['d_se']:.1f} ({n_se:.1f} standard errors)")
     return "\n".join(lines)

@@ -21,6 +21,7 @@ import logging
 
 from analysis.fabricfile import SUFFIXES, write_fabric_file
 from analysis.fit.medians import median_fabric
+from gonio.terminal import shown
 from reports.cli import options as cliutil
 
 __all__ = ["register", "run"]
@@ -57,7 +58,7 @@ def run(args) -> int:
         med = median_fabric(src.path)
         verdict = ("converged" if med.converged
                    else "NOT converged (medians of an unfinished fit)")
-        print(f"{med.preset}: medians of {', '.join(med.free)} ({verdict}) -> {out}")
+        print(shown(f"{med.preset}: medians of {', '.join(med.free)} ({verdict}) -> {out}"))
     else:
-        print(f"{src.label} ({src.kind}) -> {out}")
+        print(shown(f"{src.label} ({src.kind}) -> {out}"))
     return 0

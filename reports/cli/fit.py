@@ -21,6 +21,8 @@ from analysis.fit import fit_fabric, fit_spec
 from analysis.fit.fisher import suggest_for_file
 from analysis.fit.workflow import check_fit_size
 from analysis.fit.loo import HIGH_K
+from analysis.fit.outputs import check_fit_folder
+from gonio.terminal import shown
 from reports.cli import lazy
 from reports.cli import options as cliutil
 
@@ -84,18 +86,20 @@ def run(args) -> int:
     check_fit_size(args.table, spec, args.walkers,
                    **cliutil.reader_options(args.table, sample=args.sample))
     out = cliutil.check_writable_dir(Path(args.output))
+    check_fit_folder(out, args.table)       # files it did not write, or the table: refused
     table = read_table(args.table, args.sample)
     spec = _spec_from_args(args, fab, table)     # a baseline's default free set: the table's
     plots = None
     if not args.no_plots:
         plots = lazy.plots().fit_diagnostics.write_fit_plots
     result = fit_fabric(
-        table, fab, spec, out, plots=plots, progress=cliutil.progress(args), **fit_kw,
-        notify=lambda line: print(line, file=sys.stderr, flush=True),
+        table, fab, spec, out, plots=plots, table_file=args.table,
+        progress=cliutil.progress(args), **fit_kw,
+        notify=lambda line: print(shown(line), file=sys.stderr, flush=True),
         config_extra=_config_extra(args, fab))
     print(f"model: {spec.model}" + "".join(f"; {n}" for n in spec.notes))
-    print(format_summary(result))
-    print(format_warnings(result))
+    print(shown(format_summary(result), lines=True))
+    print(shown(format_warnings(result), lines=True))
     q = result.quality
     print(f"residuals at the posterior median: rms {q['rms_residual']:.4f} in the "
           f"likelihood's space, {q['rms_normalized']:.2f} in units of the noise")
@@ -116,7 +120,7 @@ def _suggest(args, fit_kw, fab) -> int:
     report, kept = suggest_for_file(args.table, fab, args.free, cliutil.split_ties(args.tie),
                                     args.spec, read_options=given,
                                     likelihood=fit_kw["likelihood"], nu=fit_kw["nu"])
-    print(format_information(report, kept, args.table))
+    print(shown(format_information(report, kept, args.table), lines=True))
     return 0
 
 

@@ -21,6 +21,7 @@ import gonio
 import gonio.io
 from analysis.measurejob import measure_to_file
 from gonio.geometry import SPEC_HELP
+from gonio.terminal import shown
 from reports.cli import options as cliutil
 from reports.cli.instrument import add_instrument_options, instrument_from_args
 
@@ -62,6 +63,6 @@ def run(args) -> int:
                                            progress=cliutil.progress(args), notify=log.info)
     bad = int((~table.valid).any(axis=1).sum())
     note = f", {bad} with a negative or missing value" if bad else ""
-    print(f"{src.label}: {len(table)} pairs on {geometry.spec} "
-          f"(rotation {args.rotation:g} deg{note}) -> {out}")
+    print(shown(f"{src.label}: {len(table)} pairs on {geometry.spec} "
+                f"(rotation {args.rotation:g} deg{note}) -> {out}"))
     return 0

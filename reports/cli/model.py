@@ -15,6 +15,7 @@ import gonio
 from analysis import sources
 from analysis.folderlock import output_lock
 from analysis.fit.results import read_results
+from gonio.terminal import shown
 from reports.cli import lazy
 from reports.cli import options as cliutil
 from reports.report_batch import write_batch_page
@@ -153,6 +154,6 @@ def run_report(args):
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))
     for name, src in zip(names, chosen):
         lum = standard_luminance(src.brdf)
-        print(f"{name:31s} " + " ".join(f"{x:19.6g}" for x in lum))
+        print(f"{shown(name):31s} " + " ".join(f"{x:19.6g}" for x in lum))
     log.info(f"wrote {index} (data: {index.parent / 'summary.json'})")
     return 0

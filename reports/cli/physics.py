@@ -11,6 +11,7 @@ from analysis import sources
 from analysis.energy import VARIANTS, EnergyReport
 from analysis.plausibility import energy_document, reciprocity_document, sanity_results
 from analysis.variants import Named
+from gonio.terminal import shown
 from reports.cli import options as cliutil
 from reports.prose import energy_statements, energy_summary, reciprocity_statements
 
@@ -187,10 +188,10 @@ def run_energy(args) -> int:
                           furnace=not args.no_furnace, workers=args.workers,
                           progress=cliutil.progress(args), statements=energy_statements,
                           json_path=args.json)
-    print(format_energy_summary(doc))
+    print(shown(format_energy_summary(doc), lines=True))
     if args.verbose:
         print()
-        print(format_energy(doc))
+        print(shown(format_energy(doc), lines=True))
     if args.json is not None:
         log.info(f"wrote {Path(args.json)}")
     return 0
@@ -247,7 +248,7 @@ def run_reciprocity(args) -> int:
         presets, variants, tables=tables, n=args.n, seed=args.seed, grid_step=args.grid_step,
         channel=args.channel, data_dir=None if args.no_felts else cliutil.data_dir(args.data),
         statements=reciprocity_statements, json_path=args.json)
-    print(format_reciprocity(doc))
+    print(shown(format_reciprocity(doc), lines=True))
     if args.json is not None:
         log.info(f"wrote {Path(args.json)}")
     return 0
@@ -273,7 +274,7 @@ def run_sanity(args) -> int:
     results = sanity_results({s.label: s.label if s.kind == "preset" else s.brdf
                               for s in chosen}, json_path=args.json)
     for name, r in results.items():
-        print("\n".join(format_sanity(name, r)))
+        print(shown("\n".join(format_sanity(name, r)), lines=True))
     if args.json is not None:
         log.info(f"wrote {Path(args.json)}")
     return 0 if all(r.ok for r in results.values()) else 1

@@ -22,6 +22,7 @@ from analysis.planning import DEFAULT_CANDIDATES, DEFAULT_DRAWS, MAX_BUDGET
 from analysis.planning.draws import MAX_DRAWS
 from analysis.planning.workflow import plan_file
 from gonio.geometry import SPEC_HELP
+from gonio.terminal import shown
 from reports.cli import lazy
 from reports.cli import options as cliutil
 from reports.cli.instrument import add_instrument_options, instrument_from_args
@@ -89,8 +90,8 @@ def _print(p, csv: Path, png: Path) -> None:
     n = p.budget
     what = "fit posterior" if p.source == "posterior" else "local prior"
     after = f" after {p.n_measured} measured" if p.n_measured else ""
-    print(f"{p.fabric}: {n} pairs{after} chosen from {p.n_candidates} candidates "
-          f"({p.candidates}), {p.draws} draws of the {what} -> {csv}, {png}")
+    print(shown(f"{p.fabric}: {n} pairs{after} chosen from {p.n_candidates} candidates "
+                f"({p.candidates}), {p.draws} draws of the {what} -> {csv}, {png}"))
     head = ("parameter", "unit", "plan", f"uniform {n}", f"uniform {3 * n}")
     rows = [(r["parameter"], r["unit"], f"{r['plan']:.4g}", f"{r['uniform']:.4g}",
              f"{r['uniform3']:.4g}") for r in p.table()]

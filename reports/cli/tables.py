@@ -9,6 +9,7 @@ from pathlib import Path
 import gonio
 from analysis.folderlock import output_lock
 from analysis.tablefacts import table_facts
+from gonio.terminal import shown
 from reports.cli import options as cliutil
 
 log = logging.getLogger("microcyl")
@@ -62,12 +63,12 @@ def run_convert(args):
 
 def describe(table) -> str:
     """A few lines on what a table holds (:func:`analysis.tablefacts.table_facts`, used by
-    ``microcyl info``)."""
+    ``microcyl info``); the text of its metadata through :func:`gonio.terminal.shown`."""
     f = table_facts(table)
     note = "" if f["angles_over"] == "all rows" else " (rows with data)"
-    lines = [f"source: {gonio.meta_text(f['source'])}", f"format: {f['format']}",
+    lines = [f"source: {gonio.meta_text(f['source'])}", f"format: {shown(f['format'])}",
              f"rows: {f['rows']}",
-             f"units: {f['units']}"]
+             f"units: {shown(f['units'])}"]
     lines += [f"{k}: {lo:.4g} .. {hi:.4g} deg{note}" for k, (lo, hi) in f["angles_deg"].items()]
     lines += [f"{k}: " + ("none valid" if r is None else f"{r[0]:.6g} .. {r[1]:.6g}")
               for k, r in f["values"].items()]

@@ -12,6 +12,7 @@ import brdf
 from analysis.folderlock import output_lock
 from gonio.atomic import file_mode
 from gonio.progress import progress_bar
+from gonio.terminal import shown
 from reports.report.folder import (check_output_dir, check_report_folder, make_build_folder,
                                    swap_into_place, write_file, write_marker)
 from reports.plots.common import series_styles
@@ -91,7 +92,7 @@ def _fabric_page(tmp: Path, name: str, given, sections, q, fit_results, bar) -> 
     pg = Page(tmp, name, fab, q, preset=name if given is None else None,
               fit_results=fit_results.get(name))
     for sec in sections:
-        bar.set_description(f"{name}: {sec}")
+        bar.set_description(shown(f"{name}: {sec}"))
         rep.runs.append(run_section(sec, pg))
         bar.update(1)
     return rep

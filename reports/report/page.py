@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
+from gonio.csvcells import text_cells
 from reports.plots.common import FONT, save_figure
 from reports.report.folder import write_file
 from reports.report.markup import Markup, html, plain_json, url
@@ -90,12 +91,14 @@ class Page:
         return html('<a href="{}">{}</a>', url(self.rel(filename)), filename)
 
     def csv(self, filename: str, header: list[str], rows) -> Markup:
-        """Write ``rows`` as CSV (floats to 9 digits) beside the page, return a link to it."""
+        """Write ``rows`` as CSV (floats to 9 digits; text cells through
+        :func:`gonio.csvcells.text_cell`) beside the page, return a link to it."""
         buf = io.StringIO()
         w = csv.writer(buf)
-        w.writerow(header)
+        w.writerow(text_cells(header))
         for row in rows:
-            w.writerow([f"{v:.9g}" if isinstance(v, (float, np.floating)) else v for v in row])
+            w.writerow(text_cells(f"{v:.9g}" if isinstance(v, (float, np.floating)) else v
+                                  for v in row))
         write_file(self.path(filename), buf.getvalue())
         return self.link(filename)
 

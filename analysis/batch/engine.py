@@ -113,7 +113,11 @@ def describe_row(row: dict) -> str:
     verdict = "converged" if row["status"] == "converged" else "NOT converged"
     resumed = (f"; resumed from step {row['resumed_from']}" if row.get("resumed_from")
                else "")
-    return f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
+    kinds = [w for w in str(row.get("warnings") or "").split("; ") if w]
+    adequacy = {True: "; adequate", False: "; NOT ADEQUATE"}.get(row.get("adequate"), "")
+    warned = f", {len(kinds)} warning{'s' * (len(kinds) != 1)}" if kinds else ""
+    return (f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
+            f"{adequacy}{warned}")
 
 
 def estimate_batch(todo: list[BatchJob], workers: int | None = None,

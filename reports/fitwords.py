@@ -3,9 +3,9 @@
 ``microcyl compare`` prints and the measured page's models table says).
 
 Every sentence is made from the numbers it cites. A gap of elpd within :data:`SEPARATION_SE`
-standard errors does not separate two fits; one past it but within :data:`CLOSE_SE`, or one
-the block standard error (:func:`analysis.fit.compare.paired_structure`) puts back within
-:data:`SEPARATION_SE`, is a close call, and is worded so: the naive se treats the values
+standard errors does not separate two fits; one past it but within :data:`CLOSE_SE`, in the
+naive se or in the block standard error (:func:`analysis.fit.compare.paired_structure`), is a
+close call, and is worded so: the naive se treats the values
 as independent, and the residuals of a model that misses a feature run in streaks.
 """
 
@@ -96,7 +96,7 @@ def gap_sentence(best: str, other: str, d_elpd, d_se, *, block_se=None, lag1=Non
         return (f"The data cannot separate {best} and {other} (difference {d:.1f} ± {se:.1f}, "
                 f"within {SEPARATION_SE:g} se)")
     zb = None if block_se is None else gap_in_se(d, block_se)
-    if z <= CLOSE_SE or (zb is not None and zb <= SEPARATION_SE):
+    if z <= CLOSE_SE or (zb is not None and zb <= CLOSE_SE):
         text = f"{best} is ahead of {other} by {d:.1f} ± {se:.1f} ({z:.1f} se), a close call: "
         if zb is None:
             return text + "that se treats the values as independent, and residuals that run " \

@@ -174,3 +174,33 @@ def test_a_one_parameter_fit_matches_brute_force_leave_one_out(tmp_path):
     many = psis_loo(res, max_draws=4000)
     np.testing.assert_allclose(many.elpd_i, exact, atol=0.015)
     assert many.elpd == pytest.approx(exact.sum(), abs=0.05)
+
+
+def _loo_of(elpd_i):
+    n = len(elpd_i)
+    return Loo(np.asarray(elpd_i, float), np.zeros(n), np.full(n, 0.5), np.arange(n),
+               np.zeros(n, int), 1.0, 400, 1.0, "t")
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.6, 0.8])
+def test_the_block_se_of_a_difference_allows_for_streaks(rho):
+    """Pointwise differences that follow an AR(1) along the table, of lag-1 correlation rho:
+    the variance of their sum is n var (1 + rho) / (1 - rho) for large n, so the block se
+    should be the naive se times sqrt((1 + rho) / (1 - rho)); the lag-1 estimate near rho."""
+    from analysis.fit.compare import paired_structure
+    rng = np.random.default_rng(1)
+    n, reps = 3000, 60
+    ratios, lags = [], []
+    for _ in range(reps):
+        e = rng.normal(size=n)
+        d = np.empty(n)
+        d[0] = e[0] / np.sqrt(1 - rho ** 2)
+        for i in range(1, n):
+            d[i] = rho * d[i - 1] + e[i]
+        block, lag1 = paired_structure(_loo_of(d), _loo_of(np.zeros(n)))
+        ratios.append(block / np.sqrt(n * np.var(d)))
+        lags.append(lag1)
+    assert np.mean(lags) == pytest.approx(rho, abs=0.02)
+    want = np.sqrt((1 + rho) / (1 - rho))
+    # batch means with blocks of sqrt(n) = 55 values: a small bias (b / (b + 2 rho/(1-rho)))
+    assert np.mean(ratios) == pytest.approx(want, rel=0.08)

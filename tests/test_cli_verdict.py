@@ -138,6 +138,7 @@ def test_report_of_a_fit_folder_shows_its_fit_section(measured, tmp_path):
     page = (tmp_path / "rep" / f"{VELVET}.html").read_text()
     assert "no fitting results for this fabric" not in page
     assert "Adequate (the model describes the data): False" in page
+    assert "its fit is NOT adequate" in page               # the page's first sentence
     doc = _results(out, VELVET)
     for w in doc["warnings"]:
         assert f"<td>{w['kind']}</td>" in page

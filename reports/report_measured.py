@@ -24,7 +24,7 @@ from reports.fitwords import SEPARATION_SE, gap_sentence
 from reports.safehtml import Markup, html, join, table, url
 
 __all__ = ["read_measured", "measured_page", "PLOTS", "models_table", "models_verdict",
-           "SEPARATION_SE"]
+           "fit_verdict_html", "SEPARATION_SE"]
 
 #: The figures of a fit, in page order, with captions.
 PLOTS = {
@@ -157,8 +157,9 @@ def _loo_sentence(doc: dict) -> str:
     return text
 
 
-def _trust(doc: dict) -> Markup:
-    """A fit's adequacy verdict and its warnings, escaped."""
+def fit_verdict_html(doc: dict) -> Markup:
+    """A fit's adequacy verdict and its warnings (from its results document), escaped: the
+    measured page's and the batch page's."""
     head = {True: "adequate", False: "NOT adequate"}.get(doc.get("adequate"), "adequacy unknown")
     items = join(html("<li>{}: {}</li>", w.get("kind"), w.get("message"))
                  for w in doc.get("warnings") or [] if isinstance(w, dict))
@@ -220,7 +221,7 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
         body.append(_section(folder, name, e, verdict, rows, figs,
-                             _trust(doc) + _models_part(e)))
+                             fit_verdict_html(doc) + _models_part(e)))
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
                          "adequate": doc.get("adequate"), "warnings": doc.get("warnings", []),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),

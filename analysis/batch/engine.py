@@ -107,7 +107,15 @@ def _ignore_sigint():
 
 
 def describe_row(row: dict) -> str:
-    """One line for a finished table."""
+    """One line for a finished table: converged or not, at which step, in what time, and
+    whether the model is adequate and how many warnings the fit has.
+
+    Examples
+    --------
+    >>> describe_row({"name": "velvet", "status": "not_converged", "steps": 60,
+    ...               "wall_s": 4.2, "adequate": False, "warnings": "at_bound gamma_v1; misfit"})
+    'velvet: NOT converged at step 60 (4 s); NOT ADEQUATE, 2 warnings'
+    """
     if row["status"] == "error":
         return f"{row['name']}: error: {row['error']}"
     verdict = "converged" if row["status"] == "converged" else "NOT converged"
@@ -116,8 +124,8 @@ def describe_row(row: dict) -> str:
     kinds = [w for w in str(row.get("warnings") or "").split("; ") if w]
     adequacy = {True: "; adequate", False: "; NOT ADEQUATE"}.get(row.get("adequate"), "")
     warned = f", {len(kinds)} warning{'s' * (len(kinds) != 1)}" if kinds else ""
-    return (f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s){resumed}"
-            f"{adequacy}{warned}")
+    return (f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s)"
+            f"{adequacy}{warned}{resumed}")
 
 
 def estimate_batch(todo: list[BatchJob], workers: int | None = None,

@@ -48,7 +48,7 @@ from analysis.fit.results import read_results
 from analysis.folderlock import output_lock
 from analysis.families import MICROCYLINDER
 from analysis.measuredjson import load_measured_json
-from analysis.measuredmodels import fit_folder, models_entry, parse_models
+from analysis.measuredmodels import fit_folder, models_entry, parse_models, verdict_warnings
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write, meta_text, plain
@@ -335,13 +335,17 @@ def _entry(n: str, table, row: dict, out: Path) -> dict:
              "results": f"{n}/results.json"}
     if row["status"] == "error":
         return dict(entry, error=row["error"], values_used=0, quality={},
-                    albedo_delta_e2000=None, loo=None)
+                    albedo_delta_e2000=None, loo=None, adequate=None,
+                    adequate_reason="the fit failed", warnings=[])
     res = read_results(out / n / "results.json")
     quality = res.get("quality", {})
     return dict(entry, converged=bool(res["converged"]), reason=res["reason"],
                 values_used=res.get("fit", {}).get("points", {}).get("used"),
                 free=list(res["parameters"]), quality=quality,
-                albedo_delta_e2000=quality.get("albedo_delta_e2000"), loo=res.get("loo"))
+                albedo_delta_e2000=quality.get("albedo_delta_e2000"), loo=res.get("loo"),
+                adequate=res.get("adequate"),
+                adequate_reason=str(res.get("adequate_reason", "not checked")),
+                warnings=verdict_warnings(res))
 
 
 def _read_summary(path: Path) -> dict:

@@ -13,15 +13,20 @@ versions wrote fewer): ``title``, ``preset``, ``source``, ``reason``, ``error`` 
 null), ``converged`` (true/false), ``wall_s`` (a finite number >= 0 or null), ``free`` and
 ``ties`` (lists of strings), ``quality`` (an object whose ``rms_residual``,
 ``rms_normalized`` and ``albedo_delta_e2000`` are finite numbers >= 0 or null),
-``albedo_delta_e2000`` (the same) and ``results`` (the relative path of the dataset's
-``results.json``, default ``NAME/results.json``), and where several models were fitted
-(``fit-measured --models``, :mod:`analysis.measuredmodels`) ``models``: an object keyed by
-model names (safe file names), each with ``results`` (a relative path, checked like the
-dataset's), ``converged`` (true/false), ``adequate`` (true, false or null), ``rank``,
-``steps``, ``values_used`` (integers >= 0 or null), ``elpd``, ``d_elpd`` (finite numbers or
-null; elpd may be negative), ``se``, ``d_se``, ``rms_residual``, ``rms_normalized``,
+``albedo_delta_e2000`` (the same), ``results`` (the relative path of the dataset's
+``results.json``, default ``NAME/results.json``), the fit's verdict: ``adequate`` (true,
+false or null), ``adequate_reason`` (a string) and ``warnings`` (a list of objects whose
+``kind`` and ``message`` are strings and ``parameters`` a list of strings), and where
+several models were fitted (``fit-measured --models``, :mod:`analysis.measuredmodels`)
+``models``: an object keyed by model names (safe file names), each with ``results`` (a
+relative path, checked like the dataset's), ``converged`` (true/false), ``adequate``,
+``adequate_reason`` and ``warnings`` (as the dataset's), ``rank``, ``steps``,
+``values_used``, ``n_high_k`` (integers >= 0 or null), ``elpd``, ``d_elpd``, ``d_lag1``
+(finite numbers or null; elpd may be negative, d_lag1 is in [-1, 1]), ``se``, ``d_se``,
+``d_se_block``, ``pareto_k_max``, ``k_threshold``, ``rms_residual``, ``rms_normalized``,
 ``wall_s`` (finite numbers >= 0 or null), ``error`` (a string) and ``identifiability`` (a
-list of strings); and ``compare_error`` (a string). A dataset fitted by baseline models only
+list of strings); and ``compare_error`` (a string). Files written before the verdict was
+kept lack ``adequate``, ``warnings`` and the Pareto k fields: readers take them as unknown. A dataset fitted by baseline models only
 has no ``results`` of its own (:func:`has_microcylinder`).
 """
 
@@ -36,7 +41,7 @@ from gonio.statefields import FileFields
 
 __all__ = ["load_measured_json", "check_measured_doc", "results_path", "has_microcylinder"]
 
-_STRINGS = ("title", "preset", "source", "reason", "error")
+_STRINGS = ("title", "preset", "source", "reason", "error", "adequate_reason")
 _COUNTS = ("pairs", "values_used", "steps")
 _LISTS = ("free", "ties")
 _QUALITY = ("rms_residual", "rms_normalized", "albedo_delta_e2000")
@@ -72,6 +77,7 @@ def _entry(path, name: str, e) -> None:
             raise _bad(path, f"{where}.{k}", "a list of strings", e[k])
     if "converged" in e and not isinstance(e["converged"], bool):
         raise _bad(path, f"{where}.converged", "true or false", e["converged"])
+    _verdict(path, where, e)
     _number(path, f"{where}.wall_s", e.get("wall_s"))
     _number(path, f"{where}.albedo_delta_e2000", e.get("albedo_delta_e2000"))
     q = e.get("quality", {})
@@ -91,6 +97,25 @@ def _entry(path, name: str, e) -> None:
         _model(path, f"{where}.models.{m}", me)
 
 
+def _verdict(path, where: str, e: dict) -> None:
+    """A fit's ``adequate``, ``adequate_reason`` and ``warnings`` (each optional)."""
+    if e.get("adequate") is not None and not isinstance(e["adequate"], bool):
+        raise _bad(path, f"{where}.adequate", "true, false or null", e["adequate"])
+    if "adequate_reason" in e and not isinstance(e["adequate_reason"], str):
+        raise _bad(path, f"{where}.adequate_reason", "a string", e["adequate_reason"])
+    ws = e.get("warnings", [])
+    if not isinstance(ws, list):
+        raise _bad(path, f"{where}.warnings", "a list", ws)
+    for i, w in enumerate(ws):
+        ok = (isinstance(w, dict) and all(isinstance(w.get(k, ""), str)
+                                          for k in ("kind", "message"))
+              and isinstance(w.get("parameters", []), list)
+              and all(isinstance(x, str) for x in w.get("parameters", [])))
+        if not ok:
+            raise _bad(path, f"{where}.warnings[{i}]", "an object of strings (kind, message) "
+                       "and a list of strings (parameters)", w)
+
+
 def _model(path, where: str, e) -> None:
     """One model's entry of a dataset's ``models``."""
     if not isinstance(e, dict):
@@ -100,15 +125,15 @@ def _model(path, where: str, e) -> None:
             raise _bad(path, f"{where}.{k}", "a string", e[k])
     if "converged" in e and not isinstance(e["converged"], bool):
         raise _bad(path, f"{where}.converged", "true or false", e["converged"])
-    if e.get("adequate") is not None and not isinstance(e["adequate"], bool):
-        raise _bad(path, f"{where}.adequate", "true, false or null", e["adequate"])
-    for k in ("rank", "steps", "values_used"):
+    _verdict(path, where, e)
+    for k in ("rank", "steps", "values_used", "n_high_k"):
         v = e.get(k)
         if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 0):
             raise _bad(path, f"{where}.{k}", "an integer >= 0 or null", v)
-    for k in ("se", "d_se", "rms_residual", "rms_normalized", "wall_s"):
+    for k in ("se", "d_se", "d_se_block", "pareto_k_max", "k_threshold", "rms_residual",
+              "rms_normalized", "wall_s"):
         _number(path, f"{where}.{k}", e.get(k))
-    for k in ("elpd", "d_elpd"):
+    for k in ("elpd", "d_elpd", "d_lag1"):
         v = e.get(k)
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
                               or not math.isfinite(v)):

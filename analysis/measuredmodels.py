@@ -7,12 +7,16 @@ set for the table (:meth:`analysis.families.ModelFamily.default_free`: on CUReT'
 relative tables the colour channels are tied and the base colour fixed, the scale free).
 
 ``measured.json``'s entry of a dataset then holds ``models``: per model (:func:`models_entry`)
-its folder's ``results`` path, ``converged``, ``adequate``, ``elpd`` and ``se`` (PSIS-LOO),
-``rms_residual``, ``rms_normalized``, ``values_used``, ``steps``, ``error`` (a fit that
-failed) and, from :func:`analysis.fit.compare.compare_fits` over the models with a PSIS-LOO,
-``rank`` (1 the best), ``d_elpd`` (the best's elpd minus this one's) and ``d_se`` (the
-standard error of that difference from the paired pointwise values); ``compare_error`` says
-why no ranking was made (fits of different values of the table).
+its folder's ``results`` path, ``converged``, ``adequate`` and ``adequate_reason``,
+``warnings`` (results.json's: ``kind``, ``parameters``, ``message``), ``elpd`` and ``se``
+(PSIS-LOO) with ``pareto_k_max``, ``n_high_k`` and the ``k_threshold`` they are counted
+above, ``rms_residual``, ``rms_normalized``, ``values_used``, ``steps``, ``error`` (a fit
+that failed) and, from :func:`analysis.fit.compare.compare_fits` over the models with a
+PSIS-LOO, ``rank`` (1 the best), ``d_elpd`` (the best's elpd minus this one's), ``d_se`` (the
+standard error of that difference from the paired pointwise values), ``d_se_block`` and
+``d_lag1`` (its block se and the lag-1 autocorrelation of the pointwise differences:
+:func:`analysis.fit.compare.paired_structure`); ``compare_error`` says why no ranking was
+made (fits of different values of the table).
 
 Examples
 --------
@@ -28,14 +32,15 @@ from pathlib import Path
 
 from analysis.families import MICROCYLINDER, family, model_names
 from analysis.fit.compare import compare_fits
+from analysis.fit.loo import HIGH_K
 from analysis.fit.results import read_results
 from gonio.safenames import check_component
 
-__all__ = ["parse_models", "fit_folder", "models_entry", "MODEL_FIELDS"]
+__all__ = ["parse_models", "fit_folder", "models_entry", "verdict_warnings", "MODEL_FIELDS"]
 
 #: The numbers of each model's entry (finite numbers or null).
-MODEL_FIELDS = ("elpd", "se", "d_elpd", "d_se", "rms_residual", "rms_normalized",
-                "wall_s")
+MODEL_FIELDS = ("elpd", "se", "d_elpd", "d_se", "d_se_block", "d_lag1", "rms_residual",
+                "rms_normalized", "pareto_k_max", "k_threshold", "wall_s")
 
 
 def parse_models(text) -> tuple[str, ...]:
@@ -65,6 +70,22 @@ def fit_folder(dataset: str, model: str) -> str:
     return check_component(name, source="fit-measured", entry="dataset and model")
 
 
+def verdict_warnings(res: dict) -> list[dict]:
+    """The ``warnings`` of a results document as measured.json keeps them: per warning its
+    ``kind``, ``parameters`` and ``message`` as strings (anything else dropped).
+
+    Examples
+    --------
+    >>> verdict_warnings({"warnings": [{"kind": "at_bound", "parameters": ["eta1"],
+    ...                                 "message": "eta1 at its bound", "x": 1}, "junk"]})
+    [{'kind': 'at_bound', 'parameters': ['eta1'], 'message': 'eta1 at its bound'}]
+    """
+    return [{"kind": str(w.get("kind", "")),
+             "parameters": [str(x) for x in w.get("parameters") or []],
+             "message": str(w.get("message", ""))}
+            for w in res.get("warnings") or [] if isinstance(w, dict)]
+
+
 def _one(out: Path, folder: str, row: dict | None) -> dict:
     """The entry of one model's fit: from its results.json, or its batch row's error."""
     entry = {"results": f"{folder}/results.json", "converged": False, "adequate": None,
@@ -78,7 +99,11 @@ def _one(out: Path, folder: str, row: dict | None) -> dict:
     q = res.get("quality") or {}
     loo = res.get("loo") or {}
     return dict(entry, converged=bool(res["converged"]), adequate=res.get("adequate"),
-                elpd=loo.get("elpd"), se=loo.get("se"), rms_residual=q.get("rms_residual"),
+                adequate_reason=str(res.get("adequate_reason", "not checked")),
+                warnings=verdict_warnings(res),
+                elpd=loo.get("elpd"), se=loo.get("se"), pareto_k_max=loo.get("pareto_k_max"),
+                n_high_k=loo.get("n_high_k"), k_threshold=loo.get("k_threshold", HIGH_K),
+                rms_residual=q.get("rms_residual"),
                 rms_normalized=q.get("rms_normalized"),
                 values_used=(res.get("fit") or {}).get("points", {}).get("used"),
                 steps=(res.get("fit") or {}).get("steps", entry["steps"]),
@@ -104,7 +129,7 @@ def models_entry(out, dataset: str, models, rows: dict, previous: dict | None = 
     ranked = [m for m, e in doc.items() if e.get("elpd") is not None
               and (out / fit_folder(dataset, m) / "loo.npz").is_file()]
     for e in doc.values():
-        for k in ("rank", "d_elpd", "d_se"):
+        for k in ("rank", "d_elpd", "d_se", "d_se_block", "d_lag1"):
             e.pop(k, None)
     error = None
     if len(ranked) >= 2:
@@ -115,7 +140,8 @@ def models_entry(out, dataset: str, models, rows: dict, previous: dict | None = 
             error = str(exc)
         else:
             for k, r in enumerate(rows_c, start=1):
-                doc[r["fit"]].update(rank=k, d_elpd=r["d_elpd"], d_se=r["d_se"])
+                doc[r["fit"]].update(rank=k, d_elpd=r["d_elpd"], d_se=r["d_se"],
+                                     d_se_block=r["d_se_block"], d_lag1=r["d_lag1"])
     elif len(ranked) == 1:
         doc[ranked[0]].update(rank=1, d_elpd=0.0, d_se=0.0)
     return {"models": doc, **({"compare_error": error} if error else {})}

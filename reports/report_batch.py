@@ -1,7 +1,7 @@
 """The page of a batch fit: ``DIR/index.html`` from ``DIR/summary.json`` and each fit's files.
 
 One table row per fit (status, error, steps, wall time, the median and 95% interval of every
-free parameter), and for each fit its plots (corner, posterior predictive, ...) as linked
+free parameter), and for each fit its verdict (adequacy and warnings) and its plots (corner, posterior predictive, ...) as linked
 thumbnails; every link is relative, so the folder can be moved or served as it is. Every value
 read from summary.json or a results.json reaches the page through :mod:`reports.safehtml`.
 """
@@ -14,6 +14,7 @@ from analysis.batch.summary import SUMMARY_CSV, SUMMARY_JSON, BatchSummary
 from analysis.fit.results import read_results
 from gonio import atomic_write
 from gonio.safenames import check_component, check_inside
+from reports.report_measured import fit_verdict_html
 from reports.safehtml import Markup, html, join, json_script, text, url
 
 __all__ = ["write_batch_page", "PAGE", "CAPTIONS"]
@@ -93,8 +94,9 @@ def _fit_section(out: Path, row) -> Markup:
     plots = (html('<div class="plots">{}</div>', join(figs)) if figs
              else Markup("<p>no plots</p>"))
     return html('<h3 id="{}">{}</h3><p>{} &middot; <a href="{}">results.json</a> &middot; '
-                "<code>{}</code></p>{}", name, name, doc.get("reason", ""),
-                url(f"{row['folder']}/results.json"), row.get("path", ""), plots)
+                "<code>{}</code></p>{}{}", name, name, doc.get("reason", ""),
+                url(f"{row['folder']}/results.json"), row.get("path", ""),
+                fit_verdict_html(doc), plots)
 
 
 def write_batch_page(out_dir) -> Path:

@@ -16,18 +16,15 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-import math
-
 from analysis.fit.results import read_results
 from analysis.measuredjson import has_microcylinder, load_measured_json, results_path
 from gonio.safenames import check_component, check_inside
+from analysis.fit.loo import HIGH_K
+from reports.fitwords import SEPARATION_SE, gap_sentence
 from reports.safehtml import Markup, html, join, table, url
 
 __all__ = ["read_measured", "measured_page", "PLOTS", "models_table", "models_verdict",
-           "SEPARATION_SE"]
-
-#: A difference of elpd within this many standard errors does not separate two models.
-SEPARATION_SE = 2.0
+           "fit_verdict_html", "SEPARATION_SE"]
 
 #: The figures of a fit, in page order, with captions.
 PLOTS = {
@@ -153,15 +150,16 @@ def _loo_sentence(doc: dict) -> str:
         return ""
     text = (f"PSIS-LOO elpd {_elpd(loo)} (p_loo {_f(loo.get('p_loo'), '.1f')}; Pareto k "
             f"max {_f(loo.get('pareto_k_max'), '.2f')}, {_f(loo.get('n_high_k'), '.0f')} "
-            f"values above 0.7).")
+            f"values above {_f(loo.get('k_threshold', HIGH_K), '.2f')}).")
     pit = (doc.get("quality") or {}).get("loo_pit")
     if isinstance(pit, dict):
         text += f" LOO-PIT uniformity: Kolmogorov-Smirnov p = {_f(pit.get('ks_pvalue'), '.2g')}."
     return text
 
 
-def _trust(doc: dict) -> Markup:
-    """A fit's adequacy verdict and its warnings, escaped."""
+def fit_verdict_html(doc: dict) -> Markup:
+    """A fit's adequacy verdict and its warnings (from its results document), escaped: the
+    measured page's and the batch page's."""
     head = {True: "adequate", False: "NOT adequate"}.get(doc.get("adequate"), "adequacy unknown")
     items = join(html("<li>{}: {}</li>", w.get("kind"), w.get("message"))
                  for w in doc.get("warnings") or [] if isinstance(w, dict))
@@ -223,7 +221,7 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
         body.append(_section(folder, name, e, verdict, rows, figs,
-                             _trust(doc) + _models_part(e)))
+                             fit_verdict_html(doc) + _models_part(e)))
         summary[name] = {"converged": bool(e.get("converged")), "reason": e.get("reason"),
                          "adequate": doc.get("adequate"), "warnings": doc.get("warnings", []),
                          "quality": q, "albedo_delta_e2000": e.get("albedo_delta_e2000"),
@@ -243,35 +241,25 @@ def _ranked(models: dict) -> list[tuple[str, dict]]:
                   key=lambda me: (me[1].get("rank") is None, me[1].get("rank") or 0, me[0]))
 
 
-def _z(e: dict) -> float:
-    """A model's difference to the best in standard errors (inf for an exact difference)."""
-    d, se = float(e.get("d_elpd") or 0.0), float(e.get("d_se") or 0.0)
-    return d / se if se > 0 else (math.inf if d > 0 else 0.0)
-
-
 def _names(items) -> str:
     names = [m for m, _ in items]
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
 def models_verdict(models: dict, compare_error: str | None = None) -> str:
-    """One sentence from the ranking of a dataset's models (plain text): which models the
-    data cannot separate from the best (difference within :data:`SEPARATION_SE` se), which
-    it is preferred over and by how much, and which fits did not converge.
+    """Sentences from the ranking of a dataset's models (plain text): the gap from the best
+    to each other model in the words of ``microcyl compare``
+    (:func:`reports.fitwords.gap_sentence`: within :data:`SEPARATION_SE` se the data cannot
+    separate them; a close call says why), and which fits did not converge.
 
     Examples
     --------
     >>> models_verdict({"charlie": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
     ...                 "lambert": {"rank": 2, "d_elpd": 12.0, "d_se": 3.0}})
     'charlie is preferred over lambert by 12.0 ± 3.0 (4.0 se).'
-    >>> models_verdict({"a": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
-    ...                 "b": {"rank": 2, "d_elpd": 1.0, "d_se": 2.0}})
-    'The data cannot separate a and b (difference 1.0 ± 2.0, within 2 se).'
-    >>> models_verdict({"a": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
-    ...                 "b": {"rank": 2, "d_elpd": 50.0, "d_se": 18.0},
-    ...                 "c": {"rank": 3, "d_elpd": 50.0, "d_se": 69.0, "converged": False},
-    ...                 "d": {"rank": 4, "d_elpd": 68.0, "d_se": 6.0}})
-    'The data cannot separate a and c (difference 50.0 ± 69.0, within 2 se); a is preferred over b and d by at least 2.8 se (c did not converge: its elpd may still change).'
+    >>> print(models_verdict({"a": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
+    ...                       "b": {"rank": 2, "d_elpd": 1.0, "d_se": 2.0, "converged": False}}))
+    The data cannot separate a and b (difference 1.0 ± 2.0, within 2 se). (b did not converge: its elpd may still change.)
     """
     ranked = [(m, e) for m, e in _ranked(models) if e.get("rank") is not None]
     if compare_error:
@@ -279,34 +267,28 @@ def models_verdict(models: dict, compare_error: str | None = None) -> str:
     if len(ranked) < 2:
         return "Fewer than two models have a PSIS-LOO: nothing to rank."
     best = ranked[0][0]
-    close = [(m, e) for m, e in ranked[1:] if _z(e) <= SEPARATION_SE]
-    far = [(m, e) for m, e in ranked[1:] if _z(e) > SEPARATION_SE]
-    if close:
-        diffs = "; ".join(f"{float(e.get('d_elpd') or 0):.1f} ± {float(e.get('d_se') or 0):.1f}"
-                          for _, e in close)
-        text = (f"The data cannot separate {best} and {_names(close)} "
-                f"(difference{'s' if len(close) > 1 else ''} {diffs}, within "
-                f"{SEPARATION_SE:g} se)")
-        if far:
-            text += (f"; {best} is preferred over {_names(far)} by at least "
-                     f"{min(_z(e) for _, e in far):.1f} se")
-    else:
-        (second, e2), rest = far[0], far[1:]
-        text = (f"{best} is preferred over {second} by {float(e2['d_elpd']):.1f} ± "
-                f"{float(e2.get('d_se') or 0):.1f} ({_z(e2):.1f} se)")
-        if rest:
-            text += (f", and over {_names(rest)} by at least "
-                     f"{min(_z(e) for _, e in rest):.1f} se")
+    text = " ".join(gap_sentence(best, m, e.get("d_elpd"), e.get("d_se"),
+                                 block_se=e.get("d_se_block"), lag1=e.get("d_lag1")) + "."
+                    for m, e in ranked[1:])
     stuck = [(m, e) for m, e in ranked if e.get("converged") is False]
     if stuck:
         text += (f" ({_names(stuck)} did not converge: {'its' if len(stuck) == 1 else 'their'}"
-                 f" elpd may still change)")
-    return text + "."
+                 f" elpd may still change.)")
+    return text
+
+
+def _pareto(e: dict) -> str:
+    """``k max (n above threshold)`` of a model's entry, "-" without one."""
+    if e.get("pareto_k_max") is None:
+        return "-"
+    return (f"{_f(e['pareto_k_max'], '.2f')} ({_f(e.get('n_high_k'), '.0f')} > "
+            f"{_f(e.get('k_threshold', HIGH_K), '.2f')})")
 
 
 def models_table(models: dict) -> Markup:
     """The models of one dataset, best first: elpd ± se, the difference to the best ± its
-    se (and in se), residual rms (likelihood space, normalized), adequate, converged."""
+    se (and in se), residual rms (likelihood space, normalized), Pareto k, adequate, the
+    kinds of its warnings, converged."""
     rows = []
     for m, e in _ranked(models):
         d, se = e.get("d_elpd"), e.get("d_se")
@@ -314,12 +296,16 @@ def models_table(models: dict) -> Markup:
                                       + (f" ({float(d) / float(se):.1f} se)" if se else ""))
         if e.get("rank") == 1:
             diff = "best"
+        kinds = sorted({str(w.get("kind")) for w in e.get("warnings") or []
+                        if isinstance(w, dict)})
         rows.append([_f(e.get("rank"), ".0f"), m, _elpd(e), diff,
                      _f(e.get("rms_residual"), ".4f"), _f(e.get("rms_normalized"), ".2f"),
-                     {True: "yes", False: "NO"}.get(e.get("adequate"), "-"),
+                     _pareto(e), {True: "yes", False: "NO"}.get(e.get("adequate"), "-"),
+                     ", ".join(kinds) or ("-" if "warnings" not in e else "none"),
                      "yes" if e.get("converged") else "NO", e.get("error") or ""])
     return table(["rank", "model", "elpd (PSIS-LOO)", "best − this", "residual rms",
-                  "normalized rms", "adequate", "converged", "error"], rows)
+                  "normalized rms", "Pareto k max (values above)", "adequate", "warnings",
+                  "converged", "error"], rows)
 
 
 def _models_part(e: dict) -> Markup:

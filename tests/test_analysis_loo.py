@@ -1,15 +1,17 @@
 """Tests of analysis.fit.loo: PSIS-LOO against exact leave-one-out, against arviz.loo, and on
 a real fit (against WAIC from the same draws, and p_loo against the number of parameters)."""
 
+import dataclasses
 import json
+import warnings
 
 import numpy as np
 import pytest
 from scipy import stats
 from scipy.special import logsumexp
 
-from analysis.fit.loo import (HIGH_K, LOO_FILE, Loo, import_arviz, load_loo, psis_loo,
-                              psis_pointwise, thin_draws)
+from analysis.fit.loo import (HIGH_K, LOO_FILE, Loo, import_arviz, k_threshold, load_loo,
+                              psis_loo, psis_pointwise, thin_draws)
 
 
 def _normal_mean_problem(n=20, draws=4000, seed=1):
@@ -57,14 +59,34 @@ def test_a_value_no_draw_changes_has_an_exact_elpd_and_k_zero():
     assert out["elpd_i"][1] == pytest.approx(-2.5, abs=1e-12) and out["pareto_k"][1] == 0.0
 
 
+@pytest.mark.parametrize("draws", [60, 200, 400, 4000])
+def test_the_k_threshold_is_arviz_loos_own(draws):
+    """arviz.loo judges k against good_k, its sample-size threshold; ours is the same."""
+    az = import_arviz()
+    rng = np.random.default_rng(draws)
+    mu = rng.normal(size=(1, draws))
+    y = rng.normal(size=5)
+    idata = az.from_dict(posterior={"mu": mu},
+                         log_likelihood={"y": -0.5 * (y[None, None, :] - mu[..., None]) ** 2})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        good_k = az.loo(idata).good_k
+    assert k_threshold(draws) == pytest.approx(good_k, abs=1e-12)
+
+
 def test_high_k_is_warned_and_the_file_round_trips(tmp_path):
-    k = np.array([0.1, 0.75, 0.9, 0.2])
+    # 0.65 is above the threshold of 400 draws (1 - 1/log10 400 = 0.616), not above 0.7
+    k = np.array([0.1, 0.65, 0.9, 0.2])
     loo = Loo(np.array([-1.0, -2.0, -3.0, -1.5]), k, np.array([0.1, 0.5, 0.9, 0.3]),
               np.arange(4), np.zeros(4, int), 1.2, 400, 1.0, "abcd")
     assert loo.summary() == {"elpd": -7.5, "se": pytest.approx(np.sqrt(4 * np.var(
-        [-1.0, -2.0, -3.0, -1.5]))), "p_loo": 1.2, "pareto_k_max": 0.9, "n_high_k": 2}
+        [-1.0, -2.0, -3.0, -1.5]))), "p_loo": 1.2, "pareto_k_max": 0.9, "n_high_k": 2,
+        "k_threshold": pytest.approx(0.6156891), "draws": 400}
     (w,) = loo.warnings()
     assert w["kind"] == "pareto_k" and w["parameters"] == [] and "2 of 4 values" in w["message"]
+    assert "Pareto k > 0.62 (the threshold of 400 draws" in w["message"]
+    # with 10**5 draws the threshold is capped at 0.7: only 0.9 is high
+    assert dataclasses.replace(loo, draws=10**5).n_high_k == 1
     loo.save(tmp_path)
     back = load_loo(tmp_path)
     assert back.table == "abcd" and back.draws == 400 and np.array_equal(back.pareto_k, k)
@@ -98,8 +120,10 @@ def test_a_fit_has_its_loo_close_to_waic_and_p_loo_near_its_parameters(silk_fit)
     out, res = silk_fit
     doc = json.loads((out / "results.json").read_text())
     loo = doc["loo"]
-    assert set(loo) == {"elpd", "se", "p_loo", "pareto_k_max", "n_high_k"}
-    assert loo["n_high_k"] == 0 and loo["pareto_k_max"] < HIGH_K
+    assert set(loo) == {"elpd", "se", "p_loo", "pareto_k_max", "n_high_k", "k_threshold",
+                        "draws"}
+    assert loo["k_threshold"] == pytest.approx(min(1 - 1 / np.log10(loo["draws"]), HIGH_K))
+    assert loo["n_high_k"] == 0 and loo["pareto_k_max"] < loo["k_threshold"]
     assert not [w for w in doc["warnings"] if w["kind"] == "pareto_k"]
     # two free parameters and a noise model that is right: p_loo near 2
     assert 1.3 < loo["p_loo"] < 3.0
@@ -150,3 +174,33 @@ def test_a_one_parameter_fit_matches_brute_force_leave_one_out(tmp_path):
     many = psis_loo(res, max_draws=4000)
     np.testing.assert_allclose(many.elpd_i, exact, atol=0.015)
     assert many.elpd == pytest.approx(exact.sum(), abs=0.05)
+
+
+def _loo_of(elpd_i):
+    n = len(elpd_i)
+    return Loo(np.asarray(elpd_i, float), np.zeros(n), np.full(n, 0.5), np.arange(n),
+               np.zeros(n, int), 1.0, 400, 1.0, "t")
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.6, 0.8])
+def test_the_block_se_of_a_difference_allows_for_streaks(rho):
+    """Pointwise differences that follow an AR(1) along the table, of lag-1 correlation rho:
+    the variance of their sum is n var (1 + rho) / (1 - rho) for large n, so the block se
+    should be the naive se times sqrt((1 + rho) / (1 - rho)); the lag-1 estimate near rho."""
+    from analysis.fit.compare import paired_structure
+    rng = np.random.default_rng(1)
+    n, reps = 3000, 60
+    ratios, lags = [], []
+    for _ in range(reps):
+        e = rng.normal(size=n)
+        d = np.empty(n)
+        d[0] = e[0] / np.sqrt(1 - rho ** 2)
+        for i in range(1, n):
+            d[i] = rho * d[i - 1] + e[i]
+        block, lag1 = paired_structure(_loo_of(d), _loo_of(np.zeros(n)))
+        ratios.append(block / np.sqrt(n * np.var(d)))
+        lags.append(lag1)
+    assert np.mean(lags) == pytest.approx(rho, abs=0.02)
+    want = np.sqrt((1 + rho) / (1 - rho))
+    # batch means with blocks of sqrt(n) = 55 values: a small bias (b / (b + 2 rho/(1-rho)))
+    assert np.mean(ratios) == pytest.approx(want, rel=0.08)

@@ -2,6 +2,7 @@
 made it and by a wrong preset, ranked by PSIS-LOO; fits of another table refused."""
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -48,7 +49,13 @@ def test_compare_ranks_the_generating_fabric_first_by_more_than_4_se(fits, tmp_p
     assert r.returncode == 0, r.stderr
     rows = json.loads(r.stdout)
     assert [row["fit"] for row in rows] == [str(fits["right"]), str(fits["wrong"])]
-    assert all(set(row) == {"fit", "model", "elpd", "se", "d_elpd", "d_se"} for row in rows)
+    assert all(set(row) == {"fit", "model", "elpd", "se", "d_elpd", "d_se", "d_se_block",
+                            "d_lag1", "adequate", "n_high_k", "k_threshold"} for row in rows)
+    # each fit's adequacy is its results.json's; the threshold arviz's for 400 draws
+    for row, key in zip(rows, ("right", "wrong")):
+        doc = json.loads((fits[key] / "results.json").read_text())
+        assert row["adequate"] == doc["adequate"]
+        assert row["k_threshold"] == pytest.approx(1 - 1 / math.log10(400))
     assert all(row["model"] == "microcylinder" for row in rows)
     best, wrong = rows
     assert best["d_elpd"] == 0 and best["d_se"] == 0
@@ -66,8 +73,9 @@ def test_compare_ranks_the_generating_fabric_first_by_more_than_4_se(fits, tmp_p
     lines = text.stdout.splitlines()
     assert lines[0].split()[:4] == ["rank", "fit", "model", "elpd"]
     assert lines[1].split()[:3] == ["1", str(fits["right"]), "microcylinder"]
-    assert (f"{fits['wrong']} (microcylinder): behind {fits['right']} (microcylinder) by"
-            in text.stdout)
+    assert lines[0].split()[-1] == "adequate"
+    assert (f"{fits['right']} (microcylinder) is preferred over {fits['wrong']} "
+            f"(microcylinder) by" in text.stdout)
 
 
 def test_compare_refuses_fits_of_different_tables_in_one_line(fits):

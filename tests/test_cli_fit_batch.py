@@ -57,8 +57,15 @@ def test_fit_batch_with_progress_a_corrupt_table_and_the_page(tables, tmp_path):
     assert rows["silk0"]["status"] == rows["silk1"]["status"] == "converged"
     page = (out / "index.html").read_text()
     for name in ("silk0", "silk1"):
-        for plot in json.loads((out / name / "results.json").read_text())["plots"].values():
+        doc = json.loads((out / name / "results.json").read_text())
+        for plot in doc["plots"].values():
             assert f'{name}/{plot}' in page and (out / name / plot).exists()
+        # each fit's verdict: its adequacy, and a line as it ended that says it
+        head = {True: "adequate", False: "NOT adequate"}.get(doc["adequate"],
+                                                              "adequacy unknown")
+        assert f"<p><b>{head}</b>: " in page
+        line = next(x for x in r.stdout.splitlines() if x.startswith(f"{name}: converged"))
+        assert ("NOT ADEQUATE" in line) == (doc["adequate"] is False)
     again = microcyl("fit-batch", src, *FIT, "--workers", "1", "--no-progress", "-o", out)
     assert again.returncode == 1 and "silk0:" not in again.stdout   # converged: not redone
     assert "to fit" not in again.stderr         # only the corrupt table left: no estimate

@@ -132,7 +132,8 @@ def test_fit_measured_ranks_the_models_of_a_dataset(tmp_path, shared_data):
     body, summary = measured_page(tmp_path / "page", read_measured(tmp_path))
     text = str(body)
     assert "<h3>Models</h3>" in text and "best − this" in text
-    assert ("is preferred over" in text) or ("cannot separate" in text)
+    assert ("is preferred over" in text) or ("cannot separate" in text) or (
+        "a close call" in text)
     assert summary["curet_07_velvet"]["models"]["lambert"]["rank"] in (1, 2)
 
 

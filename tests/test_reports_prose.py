@@ -134,3 +134,39 @@ def test_energy_summary_names_the_largest_reflectance_and_the_verdict():
     assert "furnace albedo rho(wo) 0.400 - 0.850" in lines[2]
     assert lines[3] == "linen (default): ok: both albedos at or below 1"
     assert lines[-1] == "other variants: 1 of 1 curves exceed 1 (linen/masking_off/reflectance)."
+
+
+def test_a_close_call_is_worded_as_one_and_alike_in_compare_and_the_measured_page():
+    """Gaps of elpd in the words of reports.fitwords, used by `compare` and the measured
+    page alike: within 2 se not separated; 2-2.7 se (naive or block) a close call that says
+    why; past both, preferred."""
+    from reports.cli.compare import format_table
+    from reports.fitwords import gap_sentence
+    from reports.report_measured import models_verdict
+    cases = {  # d_elpd, d_se, block_se, lag1 -> words expected
+        "apart": (1.2, 1.0, 1.1, 0.0, "The data cannot separate"),
+        "close": (2.4, 1.0, 1.1, 0.05, "a close call"),
+        "streaky": (5.0, 1.0, 3.0, 0.7, "a close call"),
+        "firm": (8.0, 1.0, 1.2, 0.1, "is preferred over"),
+    }
+    for key, (d, se, block, lag, words) in cases.items():
+        text = gap_sentence("A", "B", d, se, block_se=block, lag1=lag)
+        assert words in text, (key, text)
+        z, zb = d / se, d / block
+        if words == "a close call":
+            assert f"({z:.1f} se)" in text and f"the gap is {zb:.1f} se" in text
+            assert f"lag-1 autocorrelation {lag:.2f}" in text
+        rows = [dict(fit="A", model="m", elpd=10.0, se=2.0, d_elpd=0.0, d_se=0.0,
+                     d_se_block=0.0, d_lag1=None, p_loo=1.0, n_high_k=0, k_threshold=0.62,
+                     converged=True, adequate=True, values=50, table="t"),
+                dict(fit="B", model="m", elpd=10.0 - d, se=2.0, d_elpd=d, d_se=se,
+                     d_se_block=block, d_lag1=lag, p_loo=1.0, n_high_k=0, k_threshold=0.62,
+                     converged=True, adequate=False, values=50, table="t")]
+        assert gap_sentence("A (m)", "B (m)", d, se, block_se=block, lag1=lag) \
+            in format_table(rows)
+        page = models_verdict({"A": {"rank": 1, "d_elpd": 0.0, "d_se": 0.0},
+                               "B": {"rank": 2, "d_elpd": d, "d_se": se,
+                                     "d_se_block": block, "d_lag1": lag}})
+        assert page == text + "."
+    # a file without the block se (written before it was kept) still words a close call
+    assert "treats the values as independent" in gap_sentence("A", "B", 2.4, 1.0)

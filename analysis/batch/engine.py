@@ -108,11 +108,15 @@ def _ignore_sigint():
 
 
 def describe_row(row: dict) -> str:
-    """One line for a finished table, through :func:`gonio.terminal.shown` (its error may
-    quote the table's file: a column name, a metadata value).
+    """One line for a finished table: converged or not, at which step, in what time, and
+    whether the model is adequate and how many warnings the fit has, through
+    :func:`gonio.terminal.shown` (its name and error may quote the table's file).
 
     Examples
     --------
+    >>> describe_row({"name": "velvet", "status": "not_converged", "steps": 60,
+    ...               "wall_s": 4.2, "adequate": False, "warnings": "at_bound gamma_v1; misfit"})
+    'velvet: NOT converged at step 60 (4 s); NOT ADEQUATE, 2 warnings'
     >>> print(describe_row({"name": "x", "status": "error", "error": "bad \\x1b[2J"}))
     x: error: bad \\x1b[2J
     """
@@ -121,8 +125,11 @@ def describe_row(row: dict) -> str:
     verdict = "converged" if row["status"] == "converged" else "NOT converged"
     resumed = (f"; resumed from step {row['resumed_from']}" if row.get("resumed_from")
                else "")
+    kinds = [w for w in str(row.get("warnings") or "").split("; ") if w]
+    adequacy = {True: "; adequate", False: "; NOT ADEQUATE"}.get(row.get("adequate"), "")
+    warned = f", {len(kinds)} warning{'s' * (len(kinds) != 1)}" if kinds else ""
     return shown(f"{row['name']}: {verdict} at step {row['steps']} ({row['wall_s']:.0f} s)"
-                 f"{resumed}")
+                 f"{adequacy}{warned}{resumed}")
 
 
 def estimate_batch(todo: list[BatchJob], workers: int | None = None,

@@ -25,8 +25,9 @@ and the LOO-PIT,
 the leave-one-out predictive CDF at the measured value (uniform on [0, 1] when the model's
 predictive distribution is right; a U shape: the noise is underestimated; a hump:
 overestimated; a slope: a bias). Its
-uniformity is tested by Kolmogorov-Smirnov. A value whose Pareto k exceeds :data:`HIGH_K` has an
-unreliable elpd_i (the fit leans on it heavily); they are counted and warned of.
+uniformity is tested by Kolmogorov-Smirnov. A value whose Pareto k exceeds the threshold of
+its sample size, :func:`k_threshold` (min(1 - 1 / log10 S, 0.7), as ``arviz.loo`` judges k),
+has an unreliable elpd_i (the fit leans on it heavily); they are counted and warned of.
 
 ``arviz`` is imported on use (it loads matplotlib: a second the command line need not pay),
 and its once-a-day FutureWarning on import is silenced here.
@@ -46,7 +47,8 @@ from analysis.budget import memory_limit
 from gonio import atomic_write
 
 __all__ = ["Loo", "psis_loo", "psis_pointwise", "thin_draws", "draws_for", "load_loo",
-           "import_arviz", "LOO_FILE", "MAX_DRAWS", "MIN_DRAWS", "CELL_BUDGET", "HIGH_K"]
+           "import_arviz", "k_threshold", "LOO_FILE", "MAX_DRAWS", "MIN_DRAWS", "CELL_BUDGET",
+           "HIGH_K"]
 
 # ArviZ announces its refactor with a FutureWarning on import, once a day: not ours to show
 warnings.filterwarnings("ignore", message=r"\s*ArviZ is undergoing a major refactor",
@@ -63,8 +65,8 @@ MIN_DRAWS = 200
 CELL_BUDGET = 24_000_000
 #: Draws at the least, whatever the memory.
 _FLOOR_DRAWS = 50
-#: Pareto k above which a value's elpd is unreliable (Vehtari et al. 2017); arviz.loo's own,
-#: sample-size dependent threshold min(1 - 1 / log10 S, 0.7) is 0.62 at S = 400.
+#: The largest Pareto k threshold, whatever the draws (Vehtari et al. 2017); the threshold of
+#: S draws is :func:`k_threshold` (0.62 at S = 400).
 HIGH_K = 0.7
 #: Values per block of the PSIS (arviz.psislw's temporaries) and of the model evaluation.
 _BLOCK_VALUES = 20_000
@@ -76,6 +78,29 @@ def import_arviz():
     second), its import-time FutureWarning silenced (see above)."""
     import arviz
     return arviz
+
+
+def k_threshold(draws: int) -> float:
+    """The Pareto k above which a value's elpd is unreliable, given the ``draws`` (S) the
+    PSIS smoothed: min(1 - 1 / log10 S, :data:`HIGH_K`).
+
+    Notes
+    -----
+    The formula of ``arviz.loo`` (arviz 0.23.4, ``arviz/stats/stats.py``: ``good_k =
+    min(1 - 1 / np.log10(n_samples), 0.7)``), after Vehtari et al. 2024, "Pareto smoothed
+    importance sampling", JMLR 25(72), section 3.2.4: with S draws a tail of fewer values
+    estimates k less well, and the PSIS estimate is reliable only below 1 - 1 / log10 S.
+    Fewer than 11 draws give a threshold of 0 or less (no k is trusted).
+
+    Examples
+    --------
+    >>> round(k_threshold(400), 3), k_threshold(10**5)
+    (0.616, 0.7)
+    """
+    s = int(draws)
+    if s <= 1:
+        return 0.0
+    return float(min(1.0 - 1.0 / math.log10(s), HIGH_K))
 
 
 @dataclasses.dataclass
@@ -119,14 +144,21 @@ class Loo:
         return float(math.sqrt(self.elpd_i.size * np.var(self.elpd_i)))
 
     @property
+    def k_threshold(self) -> float:
+        """The Pareto k threshold of :attr:`draws` (:func:`k_threshold`)."""
+        return k_threshold(self.draws)
+
+    @property
     def n_high_k(self) -> int:
-        """Values whose Pareto k exceeds :data:`HIGH_K`."""
-        return int(np.sum(self.pareto_k > HIGH_K))
+        """Values whose Pareto k exceeds :attr:`k_threshold`."""
+        return int(np.sum(self.pareto_k > self.k_threshold))
 
     def summary(self) -> dict:
-        """``results.json``'s ``loo``: elpd, se, p_loo, pareto_k_max, n_high_k."""
+        """``results.json``'s ``loo``: elpd, se, p_loo, pareto_k_max, n_high_k and the
+        k_threshold it counts above (with the draws)."""
         return {"elpd": self.elpd, "se": self.se, "p_loo": float(self.p_loo),
-                "pareto_k_max": float(np.max(self.pareto_k)), "n_high_k": self.n_high_k}
+                "pareto_k_max": float(np.max(self.pareto_k)), "n_high_k": self.n_high_k,
+                "k_threshold": self.k_threshold, "draws": int(self.draws)}
 
     def pit_test(self) -> dict:
         """``quality["loo_pit"]``: the Kolmogorov-Smirnov test of the LOO-PIT against the
@@ -144,7 +176,8 @@ class Loo:
             return []
         return [{"kind": "pareto_k", "parameters": [],
                  "message": f"PSIS-LOO: {n} of {self.pareto_k.size} values have Pareto k > "
-                            f"{HIGH_K} (largest {np.max(self.pareto_k):.2f}); the fit leans "
+                            f"{self.k_threshold:.2f} (the threshold of {self.draws} draws; "
+                            f"largest {np.max(self.pareto_k):.2f}); the fit leans "
                             f"on them so heavily that their leave-one-out densities, and so "
                             f"the elpd, are unreliable (outliers, or a model that misses "
                             f"them)"}]

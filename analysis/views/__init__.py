@@ -4,8 +4,9 @@ numbers read. Nothing here imports matplotlib.
 
 One module a kind of view: lobes (planes of incidence, masking on and off), masking (the
 terms M, P and u), slices (the BRDF Explorer's), hemisphere (the equal-area disc and the 3-D
-lobe), reciprocity (error maps), table (a measured table against models in a plane) and
-posterior (a fit's posterior-predictive lobes).
+lobe), reciprocity (error maps), table (a measured table against models in a plane),
+tablescatter (a table of scattered pairs against models at every point, and what a view of
+a table left out) and posterior (a fit's posterior-predictive lobes).
 """
 
 from analysis.views.common import (QUANTITIES, check_angle, check_quantity, check_resolution,
@@ -24,6 +25,8 @@ from analysis.views.table import (FitOverlayView, TablePanelView, compute_fit_ov
                                   compute_table_panel, plane_data, plane_incidences,
                                   plane_lights, plane_points, reduce_sigma, table_panels,
                                   table_points)
+from analysis.views.tablescatter import (TableCoverage, TableScatterView,
+                                         compute_table_scatter, is_scattered, table_coverage)
 
 __all__ = ["QUANTITIES", "check_angle", "check_quantity", "check_resolution", "eval_brdf",
            "finite_max", "reduce_quantity",
@@ -35,5 +38,6 @@ __all__ = ["QUANTITIES", "check_angle", "check_quantity", "check_resolution", "e
            "Lobe3DView", "compute_lobe_3d", "ReciprocityView", "compute_reciprocity",
            "TablePanelView", "compute_table_panel", "FitOverlayView", "compute_fit_overlay",
            "plane_data", "plane_incidences", "plane_lights", "plane_points", "reduce_sigma",
-           "table_panels", "table_points",
+           "table_panels", "table_points", "TableCoverage", "TableScatterView",
+           "compute_table_scatter", "is_scattered", "table_coverage",
            "PosteriorLobe", "compute_posterior_lobes", "posterior_draws"]

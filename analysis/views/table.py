@@ -99,11 +99,11 @@ def plane_incidences(table, phi_deg=0.0, tol_deg=2.0) -> np.ndarray:
 def table_panels(table, theta_i_deg=None, phi_deg=0.0, tol_deg=2.0) -> list:
     """The panels of a table against models in the plane ``phi_deg``: a ``(theta_i, light)``
     pair (degrees; ``light`` the light's azimuth, ``phi_deg`` or ``phi_deg + 180``) for each
-    incidence of ``theta_i_deg`` (default the first three in the plane) and each side the
+    incidence of ``theta_i_deg`` (default every incidence in the plane) and each side the
     light was measured from; a ValueError names an incidence the plane does not hold."""
     ti, _, _, _, light, _ = plane_data(table, phi_deg, tol_deg)
     have = np.unique(np.round(ti * 2.0) / 2.0)
-    wanted = have[:3] if theta_i_deg is None else np.atleast_1d(theta_i_deg)
+    wanted = have if theta_i_deg is None else np.atleast_1d(theta_i_deg)
     out = []
     for t in wanted:
         sel = np.abs(ti - float(t)) <= 0.5

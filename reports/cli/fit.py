@@ -25,6 +25,7 @@ from analysis.fit.outputs import check_fit_folder
 from gonio.terminal import shown
 from reports.cli import lazy
 from reports.cli import options as cliutil
+from reports.fitwords import verdict_lines
 
 __all__ = ["register", "run", "read_table", "format_summary", "format_information",
            "format_loo", "format_warnings"]
@@ -166,11 +167,12 @@ def format_loo(loo: dict, pit: dict | None = None) -> str:
     --------
     >>> print(format_loo({"elpd": 812.34, "se": 20.1, "p_loo": 3.2, "pareto_k_max": 0.41,
     ...                   "n_high_k": 0}, {"ks_pvalue": 0.31, "values": 450}))
-    PSIS-LOO: elpd 812.3 ± 20.1 (p_loo 3.2; Pareto k max 0.41, 0 values above 0.7);
+    PSIS-LOO: elpd 812.3 ± 20.1 (p_loo 3.2; Pareto k max 0.41, 0 values above 0.70);
     LOO-PIT uniformity over 450 values: KS p = 0.31
     """
+    k = loo.get("k_threshold", HIGH_K)          # a file written before it was recorded: 0.7
     line = (f"PSIS-LOO: elpd {loo['elpd']:.1f} ± {loo['se']:.1f} (p_loo {loo['p_loo']:.1f}; "
-            f"Pareto k max {loo['pareto_k_max']:.2f}, {loo['n_high_k']} values above {HIGH_K})")
+            f"Pareto k max {loo['pareto_k_max']:.2f}, {loo['n_high_k']} values above {k:.2f})")
     if pit:
         line += (f"; LOO-PIT uniformity over {pit['values']} values: KS p = "
                  f"{pit['ks_pvalue']:.2g}")
@@ -199,9 +201,7 @@ def format_summary(result) -> str:
 
 
 def format_warnings(result) -> str:
-    """The adequacy verdict, then each warning, one line each (:mod:`analysis.fit.trust`)."""
+    """The adequacy verdict, then each warning, one line each (:mod:`analysis.fit.trust`;
+    the words of :func:`reports.fitwords.verdict_lines`, which fit-measured prints too)."""
     a = result.adequacy or {}
-    verdict = {True: "ADEQUATE", False: "NOT ADEQUATE", None: "adequacy not checked"}
-    lines = [f"{verdict[a.get('adequate')]}: {a.get('reason', 'not checked')}"]
-    lines += [f"warning ({w['kind']}): {w['message']}" for w in result.warnings]
-    return "\n".join(lines)
+    return "\n".join(verdict_lines(a.get("adequate"), a.get("reason"), result.warnings))

@@ -21,6 +21,7 @@ from analysis.measured import MEASURED, SUMMARY_FILE, fit_measured
 from analysis.measuredmodels import fit_folder, parse_models
 from reports.cli import lazy
 from reports.cli import options as cliutil
+from reports.fitwords import verdict_lines
 
 __all__ = ["register", "run"]
 
@@ -68,6 +69,15 @@ def run(args) -> int:
                        echo=print, workers=args.workers, scheduler=args.scheduler,
                        models=args.models)
     names = args.names or list(doc["datasets"])
+    for n in names:
+        entry = doc["datasets"][n]
+        fits = ([(n, entry)] if args.models is None else
+                [(fit_folder(n, m), entry["models"][m]) for m in models])
+        for folder, e in fits:
+            print(f"{folder}: " + ("converged" if e.get("converged") else "NOT converged")
+                  + "; " + "\n  ".join(verdict_lines(e.get("adequate"),
+                                                      e.get("adequate_reason"),
+                                                      e.get("warnings"))))
     if args.models is None:
         bad = [n for n in names if not doc["datasets"][n]["converged"]]
         print(f"{len(names) - len(bad)} of {len(names)} fits converged; summary: "

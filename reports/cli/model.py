@@ -144,6 +144,9 @@ def run_report(args):
             raise ValueError(f"--fit {item!r}: no such file {path!r}")
         read_results(path)          # a damaged file: one line naming it and the field
         fits[name] = path
+    for s in chosen:                # a fit folder given as --fabric: its own fit section
+        if s.kind == "fit" and s.label not in fits:
+            fits[s.label] = str(s.path / "results.json")
     fabrics = [s.label if s.kind == "preset" else (s.label, s.brdf) for s in chosen]
     index = build_report(fabrics, args.output, progress=cliutil.progress(args),
                          quality=args.quality,

@@ -2,7 +2,9 @@
 
 ``microcyl plot VIEW SOURCE... -o FILE``: the views are those of the report (lobes, slices,
 hemisphere, masking, albedo, reciprocity) and ``table`` (a measured table against presets and
-a fit). Several presets overlay (or sit in one row each where a view is an image). The figure
+a fit: every incidence in the plane, a panel each, and a line saying what was left out; a
+table of scattered pairs, such as a ``microcyl plan`` design, gets a view of every point
+instead). Several presets overlay (or sit in one row each where a view is an image). The figure
 is drawn by the plot functions of :mod:`reports.plots`; the format comes from the suffix of
 FILE (PNG at ``--dpi``, PDF and SVG as vector graphics).
 """
@@ -19,15 +21,19 @@ import brdf
 import gonio
 from analysis import sources
 from analysis.fit.medians import median_fabric
+from analysis.fit.results import read_results
+from gonio.jsonplain import meta_text
+from analysis.views import compute_table_scatter, is_scattered, table_coverage
 from analysis.views.table import write_table_data
 from reports.cli import lazy
 from reports.cli import options as cliutil
 
-__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes"]
+__all__ = ["register", "run_plot", "VIEWS", "fitted_fabric", "fitted_model", "parse_planes",
+           "fit_note"]
 
 #: The views of ``microcyl plot``.
 VIEWS = ("lobes", "slices", "hemisphere", "masking", "albedo", "reciprocity", "table")
-#: Default incidences per view, degrees (``table``: the table's first three in the plane).
+#: Default incidences per view, degrees (``table``: every incidence in the plane).
 _THETA_I = {"lobes": (0.0, 30.0, 60.0), "slices": (30.0,), "hemisphere": (45.0,),
             "masking": (60.0,), "albedo": (), "reciprocity": (), "table": ()}
 _FORMATS = (".png", ".pdf", ".svg")
@@ -55,7 +61,8 @@ def register(sub):
     p.add_argument("--channel", choices=("luminance", "r", "g", "b", "rgb"), default=None,
                    help="what of f_r is drawn (default luminance; rgb for one fabric's slices)")
     p.add_argument("--theta-i", type=_angles, default=None, metavar="DEG[,DEG...]",
-                   help="incidence angles in degrees, e.g. 30,60")
+                   help="incidence angles in degrees, e.g. 30,60 (table: those of the "
+                        "table's incidences to draw; default all)")
     p.add_argument("--plane", type=parse_planes, default=None, metavar="warp|weft|45|DEG",
                    help="planes of incidence: warp, weft, diagonal or azimuths in degrees, "
                         "comma-separated (default warp,45,weft for lobes, else warp)")
@@ -211,6 +218,62 @@ def _models(args) -> dict:
         texts, options=cliutil.fabric_options(args))}
 
 
+def fit_note(fit, label: str) -> str | None:
+    """A line for the figure when the fit drawn (``--fit``: its folder or results.json) is
+    not adequate or did not converge, from its results.json; None when neither."""
+    path = Path(fit)
+    doc = read_results(path if path.is_file() else path / "results.json")
+    kinds = sorted({str(w.get("kind")) for w in doc.get("warnings") or []
+                    if isinstance(w, dict)})
+    said = []
+    if doc.get("adequate") is False:
+        said.append("NOT ADEQUATE (the model does not describe the table to within its noise)")
+    if doc.get("converged") is False:
+        said.append("NOT converged")
+    if not said:
+        return None
+    warned = (f"; {len(kinds)} kinds of warning: {', '.join(map(meta_text, kinds))}" if kinds
+              else "")
+    return f"{label}: " + ", ".join(said) + warned
+
+
+def _table_figure(args, models, plot_views, opts):
+    """The figure of ``plot table`` (a plane's panels, or every point of a scattered table),
+    its ``--data`` CSV, and the line of what was left out (None when nothing was)."""
+    notes = []
+    if args.fit:
+        model, label = fitted_model(args.fit, (args.preset or [None])[0])
+        models[label] = model
+        notes.append(fit_note(args.fit, label))
+    table = gonio.read(args.sources[0])
+    phi = (args.plane or (0.0,))[0]
+    source = Path(args.sources[0]).name
+    if is_scattered(table, phi):
+        if args.theta_i:
+            raise ValueError("--theta-i: the table's pairs are scattered (no incidence in the "
+                             f"plane {phi:g} degrees holds a lobe of 3 points); its view shows "
+                             "every point")
+        view = compute_table_scatter(table, models, quantity=args.channel or "luminance")
+        note = plot_views.coverage_note(table_coverage(table, view.rows))
+        fig = plot_views.table_scatter_view(table, models, channel=args.channel,
+                                            scale=args.scale, source=source, view=view,
+                                            notes=[note, *notes])
+        rows = view.data_rows()
+    else:
+        _check_incidences(table, args)
+        panels = plot_views.table_view_panels(table, models, channel=args.channel,
+                                              theta_i=args.theta_i, planes=args.plane,
+                                              resolution=args.resolution)
+        drawn = np.concatenate([p.points["rows"] for p in panels])
+        note = plot_views.coverage_note(table_coverage(table, drawn, phi))
+        fig = plot_views.table_view(table, models, source=source, panels=panels,
+                                    notes=[note, *notes], **opts)
+        rows = plot_views.table_view_data(table, models, panels=panels)
+    if args.data is not None:      # the numbers the figure drew at the measured points
+        write_table_data(args.data, rows)
+    return fig, "; ".join(n for n in (note, *notes) if n) or None
+
+
 def run_plot(args):
     _check(args)
     models = _models(args)
@@ -223,19 +286,9 @@ def run_plot(args):
     opts = dict(channel=args.channel, theta_i=args.theta_i, planes=args.plane,
                 scale=args.scale, resolution=args.resolution)
     if args.view == "table":
-        if args.fit:
-            model, label = fitted_model(args.fit, (args.preset or [None])[0])
-            models[label] = model
-        table = gonio.read(args.sources[0])
-        _check_incidences(table, args)
-        panels = plot_views.table_view_panels(table, models, channel=args.channel,
-                                              theta_i=args.theta_i, planes=args.plane,
-                                              resolution=args.resolution)
-        fig = plot_views.table_view(table, models, source=Path(args.sources[0]).name,
-                                    panels=panels, **opts)
-        if args.data is not None:      # the numbers the figure drew at the measured points
-            write_table_data(args.data, plot_views.table_view_data(table, models,
-                                                                   panels=panels))
+        fig, note = _table_figure(args, models, plot_views, opts)
+        if note:
+            print(note)
     else:
         fig = plot_views.VIEW_FUNCTIONS[args.view](models, **opts)
     if args.size is not None:

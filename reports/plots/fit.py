@@ -1,11 +1,13 @@
 """Model curves over measured table points in a plane of incidence, with error bars: one
-model at several incidences, or several models (presets, fits) at one."""
+model at several incidences, or several models (presets, fits) at one; and a table of
+scattered pairs against models at every point (:func:`draw_table_scatter`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from analysis.views import (FitOverlayView, TablePanelView, compute_fit_overlay,
+from analysis.views import (FitOverlayView, TablePanelView, TableScatterView,
+                            compute_fit_overlay,
                             compute_table_panel, plane_incidences, plane_lights, plane_points,
                             table_panels, table_points)
 from reports.plots.common import (FONT, finish, legend_outside, log_range, new_axes,
@@ -13,7 +15,7 @@ from reports.plots.common import (FONT, finish, legend_outside, log_range, new_a
 
 __all__ = ["plane_points", "plane_lights", "plot_fit_overlay", "plot_table_models",
            "draw_table_models", "draw_fit_overlay", "plane_incidences", "table_panels",
-           "table_points"]
+           "table_points", "draw_table_scatter", "draw_scatter_residuals"]
 
 
 def plot_fit_overlay(table, brdf, phi_deg=0.0, theta_i_deg=None, *, quantity="rgb",
@@ -180,3 +182,70 @@ def _draw_incidence(ax, n, t, quantity, x_model, model, to, meas, err, where="")
                            marker=markers[n % len(markers)], ms=3.5, mfc="none",
                            capsize=1.5, label=f"data θi = {t:g}°{where}{suffix}")
         cont.lines[0].set_gid(f"data theta_i={t:g} {channel}")
+
+
+def draw_table_scatter(view: TableScatterView, *, log=True, legend=True, ax=None,
+                       filename=None, title=None):
+    """Measured f_r (x, with its sigma as error bars) against every model's at the same
+    pair (y) for every valid point of a :class:`analysis.views.TableScatterView`, and the
+    line model = measured; log axes by default (points not positive are left out of a log
+    axis and counted in the title). Returns ``(fig, ax)``."""
+    fig, ax = new_axes(ax, figsize=(5.0, 4.6))
+    x, err = view.measured, view.sigma
+    styles = series_styles(view.models)
+    shown = np.ones(x.size, bool)
+    for name, y in view.models.items():
+        ok = (x > 0) & (y > 0) if log else np.isfinite(y)
+        shown &= ok
+        cont = ax.errorbar(x[ok], y[ok], xerr=None if err is None else err[ok], ls="",
+                           marker="o", ms=3.5, mfc="none", color=styles[name]["color"],
+                           elinewidth=0.6, capsize=0, label=name)
+        cont.lines[0].set_gid(f"points {name}")
+    values = np.concatenate([x, *view.models.values()])
+    values = values[np.isfinite(values) & ((values > 0) if log else True)]
+    lo, hi = (float(values.min()), float(values.max())) if values.size else (1e-3, 1.0)
+    if log:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        lo, hi = lo / 1.5, hi * 1.5
+    ax.plot([lo, hi], [lo, hi], color="0.5", lw=0.8, ls="--", label="model = measured")
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(lo, hi)
+    what = "luminance" if view.quantity == "luminance" else f"{view.quantity.upper()} channel"
+    ax.set_xlabel(f"measured f_r, {what} (1/sr)", fontsize=FONT["label"])
+    ax.set_ylabel("model f_r at the same pair (1/sr)", fontsize=FONT["label"])
+    hidden = int(x.size - shown.sum())
+    ax.set_title(title or (f"{x.size} points" + (f" ({hidden} not positive: not on the log "
+                                                  f"axes)" if hidden else "")),
+                 fontsize=FONT["title"])
+    if legend:
+        legend_outside(ax, "right")
+    return finish(fig, ax, filename)
+
+
+def draw_scatter_residuals(view: TableScatterView, name: str, *, ax=None, filename=None,
+                           title=None):
+    """Model ``name``'s residuals at every point of a :class:`analysis.views.TableScatterView`
+    on the half-vector disk (h_x, h_y), a diverging colour scale symmetric about 0 (to the
+    98th percentile of |residual|, at least 3 for normalized residuals). Returns
+    ``(fig, ax)``."""
+    fig, ax = new_axes(ax, figsize=(5.0, 4.4))
+    r, what = view.residuals(name)
+    ok = np.isfinite(r)
+    normalized = what.startswith("normalized")
+    lim = float(np.percentile(np.abs(r[ok]), 98)) if ok.any() else 1.0
+    lim = max(lim, 3.0) if normalized else max(lim, 1e-3)
+    sc = ax.scatter(view.half[ok, 0], view.half[ok, 1], c=r[ok], cmap="RdBu_r", vmin=-lim,
+                    vmax=lim, s=14, edgecolors="0.3", linewidths=0.3)
+    fig.colorbar(sc, ax=ax, label=what)
+    t = np.linspace(0.0, 2.0 * np.pi, 181)
+    ax.plot(np.cos(t), np.sin(t), color="k", lw=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlim(-1.05, 1.05)
+    ax.set_ylim(-1.05, 1.05)
+    ax.set_xlabel("h_x (warp; unit half vector)", fontsize=FONT["label"])
+    ax.set_ylabel("h_y (weft)", fontsize=FONT["label"])
+    rms = float(np.sqrt(np.mean(r[ok] ** 2))) if ok.any() else float("nan")
+    ax.set_title(title or f"{name}: rms {rms:.2g} over {int(ok.sum())} points",
+                 fontsize=FONT["title"])
+    return finish(fig, ax, filename)

@@ -18,10 +18,12 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from analysis import albedo_curve
-from analysis.views import compute_lobes, compute_masking_lobes, compute_table_panel
+from analysis.views import (compute_lobes, compute_masking_lobes, compute_table_panel,
+                            compute_table_scatter)
 from reports.plots.common import FONT, series_styles
 from reports.plots.albedo import plot_albedo
-from reports.plots.fit import draw_table_models, table_panels
+from reports.plots.fit import (draw_scatter_residuals, draw_table_models, draw_table_scatter,
+                               table_panels)
 from reports.plots.hemisphere import plot_hemisphere
 from reports.plots.lobes import draw_lobe_comparison, plane_name, plot_lobe_planes
 from reports.plots.masking import draw_masking_lobes
@@ -31,7 +33,7 @@ from reports.plots.slices import (plot_slice_image, plot_slice_theta_d, plot_sli
 
 __all__ = ["VIEW_FUNCTIONS", "lobes_view", "slices_view", "hemisphere_view", "masking_view",
            "albedo_view", "reciprocity_view", "table_view", "table_view_data", "table_view_panels",
-           "MAX_WIDTH_IN"]
+           "table_scatter_view", "coverage_note", "MAX_WIDTH_IN"]
 
 
 def _grid(nrows, ncols, panel, polar=False):
@@ -200,18 +202,21 @@ def reciprocity_view(fabrics, *, channel=None, theta_i=None, planes=None, scale=
 #: inches (3,000 pixels at the default 200 dpi, room left for the margins).
 MAX_WIDTH_IN = 14.0
 _TABLE_PANEL = (4.4, 3.4)
+_SCATTER_PANEL = (4.6, 4.2)
 
 
 def table_view(table, models, *, channel=None, theta_i=None, planes=None, scale="log",
-               resolution=None, source=None, panels=None):
+               resolution=None, source=None, panels=None, notes=()):
     """A measured table against models in the first plane: a panel per incidence (default:
-    the table's first three in the plane) and per side the light was measured from, each
+    every incidence in the plane) and per side the light was measured from, each
     model evaluated with the light there (:func:`reports.plots.fit.table_points`); points
     with error bars and a curve per model. Panels wrap into rows so that the figure is at
     most :data:`MAX_WIDTH_IN` wide. ``source`` names the table in the title (default its
     ``meta["source"]`` when that is a short text). ``panels`` are the panels'
     :class:`analysis.views.TablePanelView` when computed already (:func:`table_view_panels`,
-    whose numbers :func:`table_view_data` writes), else they are computed here."""
+    whose numbers :func:`table_view_data` writes), else they are computed here. ``notes``
+    are lines put under the title (what was left out: :func:`coverage_note`; a fit's
+    verdict)."""
     phi = (planes or (0.0,))[0]
     quantity = channel or "luminance"
     if panels is None:
@@ -230,11 +235,67 @@ def table_view(table, models, *, channel=None, theta_i=None, planes=None, scale=
             ax.set_xlabel("")
     _figure_legend(fig, axes[0])
     what = "luminance" if quantity == "luminance" else f"{quantity.upper()} channel"
-    fig.suptitle("\n".join(textwrap.wrap(
-        f"{_table_name(table, source)}: measured f_r ({what}) and models in the plane "
-        f"φ = {phi:g}° ({plane_name(phi)})", width=int(13 * _TABLE_PANEL[0] * ncols))),
-        fontsize=FONT["title"])
+    _title(fig, f"{_table_name(table, source)}: measured f_r ({what}) and models in the plane "
+                f"φ = {phi:g}° ({plane_name(phi)})", notes, _TABLE_PANEL[0] * ncols)
     return fig
+
+
+def _title(fig, title: str, notes, width_in: float) -> None:
+    """The figure's title, then each note, wrapped to the figure's width."""
+    lines = [ln for text in (title, *[n for n in notes if n])
+             for ln in textwrap.wrap(text, width=int(13 * width_in))]
+    fig.suptitle("\n".join(lines), fontsize=FONT["title"])
+
+
+def table_scatter_view(table, models, *, channel=None, scale="log", source=None, view=None,
+                       notes=()):
+    """A table of scattered pairs against models at every valid point: measured against
+    each model's f_r at the same pair (:func:`reports.plots.fit.draw_table_scatter`), then
+    each model's residuals on the half-vector disk
+    (:func:`reports.plots.fit.draw_scatter_residuals`); panels wrap into rows within
+    :data:`MAX_WIDTH_IN`. ``view`` is the :class:`analysis.views.TableScatterView` when
+    computed already, ``notes`` lines under the title."""
+    if view is None:
+        view = compute_table_scatter(table, models, quantity=channel or "luminance")
+    n = 1 + len(view.models)
+    ncols = max(1, min(n, int(MAX_WIDTH_IN // _SCATTER_PANEL[0])))
+    nrows = -(-n // ncols)
+    fig = Figure(figsize=(_SCATTER_PANEL[0] * ncols, _SCATTER_PANEL[1] * nrows),
+                 layout="constrained")
+    axes = [fig.add_subplot(nrows, ncols, k + 1) for k in range(n)]
+    draw_table_scatter(view, log=scale == "log", legend=False, ax=axes[0])
+    for ax, name in zip(axes[1:], view.models):
+        draw_scatter_residuals(view, name, ax=ax)
+    _figure_legend(fig, axes[0], ncol=3)
+    what = "luminance" if view.quantity == "luminance" else f"{view.quantity.upper()} channel"
+    _title(fig, f"{_table_name(table, source)}: measured f_r ({what}) and models at every "
+                f"measured pair (scattered pairs: no plane of incidence holds a lobe)",
+           notes, _SCATTER_PANEL[0] * ncols)
+    return fig
+
+
+def coverage_note(cov) -> str | None:
+    """What a view of a table left out, in one line (None when it drew every point), from
+    an :class:`analysis.views.TableCoverage`.
+
+    Examples
+    --------
+    >>> from analysis.views import TableCoverage
+    >>> print(coverage_note(TableCoverage(rows=10, valid=9, drawn=5, off_plane=3,
+    ...                                   phi_deg=0.0, tol_deg=2.0)))
+    drew 5 of 10 points; left out: 3 off the plane φ = 0° (±2°), 1 invalid (NaN or negative)
+    """
+    if cov.complete:
+        return None
+    parts = []
+    if cov.off_plane:
+        parts.append(f"{cov.off_plane} off the plane φ = {cov.phi_deg:g}° (±{cov.tol_deg:g}°)")
+    if cov.at_other_incidences:
+        parts.append(f"{cov.at_other_incidences} at the incidences not asked for (θi = "
+                     + ", ".join(f"{t:g}" for t in cov.other_incidences) + "°)")
+    if cov.invalid:
+        parts.append(f"{cov.invalid} invalid (NaN or negative)")
+    return f"drew {cov.drawn} of {cov.rows} points; left out: " + ", ".join(parts)
 
 
 def table_view_panels(table, models, *, channel=None, theta_i=None, planes=None,

@@ -22,6 +22,7 @@ from reports.report.markup import (CSS_NAME, Markup, html, join, nav, now, page,
 from reports.report.overview import overview
 from reports.report.page import Page
 from reports.report.sec_energy import EnergyData
+from reports.report.sec_fit import FitData
 from reports.report.sec_renders import ENGINES, RendersData, check_engine
 from reports.report.sections import FabricReport, run_section
 from reports.prose import overview_sentence
@@ -133,7 +134,12 @@ def _fabric_header(rep: FabricReport, colour, run: dict) -> Markup:
         what = f"A fit of the baseline model {brdf.model_name(rep.fabric)} (not the microcylinder)"
     else:
         what = "A BRDF that is no microcylinder fabric"
-    lede = html("{}; energy: {}.", what,
+    f = rep.data(FitData)
+    fitted = "" if f is None else {
+        True: "; its fit is adequate (the model describes the data to within its noise)",
+        False: "; its fit is NOT adequate (the model does not describe the data to within "
+               "its noise: see the fit section)"}.get(f.results.get("adequate"), "")
+    lede = html("{}{}; energy: {}.", what, fitted,
                 e.verdict() if e is not None else "not computed (no energy section)")
     return run_header(rep.name, lede, run, swatch(colour))
 

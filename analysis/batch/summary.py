@@ -10,11 +10,12 @@ import csv
 import io
 import json
 import math
+import os
 from pathlib import Path
 
 import gonio
 from gonio.safenames import check_component
-from gonio.statefields import FileFields
+from gonio.statefields import FileFields, load_json
 
 __all__ = ["BatchSummary", "SUMMARY_CSV", "SUMMARY_JSON", "SCHEMA", "FIRST_COLUMNS",
            "STATUSES", "check_row"]
@@ -105,13 +106,10 @@ class BatchSummary:
         self.dir = Path(out_dir)
         self.rows: dict[str, dict] = {}
         path = self.dir / SUMMARY_JSON
-        if path.exists():
-            try:
-                doc = json.loads(path.read_text(encoding="utf-8"))
-                ok = (isinstance(doc, dict) and doc.get("schema") == SCHEMA[0]
-                      and isinstance(doc.get("tables"), list))
-            except (OSError, ValueError, RecursionError) as exc:
-                raise ValueError(f"{path}: cannot read the batch summary ({exc})") from None
+        if os.path.lexists(path):       # a link, FIFO, huge or deep file: one line naming it
+            doc = load_json(path, "batch summary")
+            ok = (isinstance(doc, dict) and doc.get("schema") == SCHEMA[0]
+                  and isinstance(doc.get("tables"), list))
             if not ok:
                 raise ValueError(f"{path}: not a microcyl batch summary")
             for i, r in enumerate(doc["tables"]):

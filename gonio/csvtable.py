@@ -15,6 +15,7 @@ from gonio.atomic import atomic_write
 from gonio.errors import FormatError, TableWarning
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
+from gonio.safeopen import open_regular
 from gonio.numtext import (column_digits, float32_column, format_numbers, is_number,
                            parse_number)
 from gonio.table import Table
@@ -180,8 +181,10 @@ def read_rows(path) -> CsvRows:
     ({'source': 'doc'}, ['theta_i', 'phi_i'], [(3, ['30', '0'])])
     """
     path = Path(path)
+    with open_regular(path, what="a CSV table") as fh:     # no link, FIFO or device
+        data = fh.read()
     try:
-        text = path.read_text(encoding="utf-8-sig")   # a spreadsheet's byte-order mark
+        text = data.decode("utf-8-sig")     # a spreadsheet's byte-order mark
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}

@@ -12,6 +12,7 @@ import numpy as np
 from brdf.frames import flat_pairs
 from brdf.shading import DENOM_MIN
 from gonio.errors import FormatError
+from gonio.safeopen import open_regular
 
 __all__ = ["read_tensor_file", "read_tensor_field", "load_rgl", "RGLBRDF", "HEADER_LIMIT"]
 
@@ -78,7 +79,8 @@ def read_tensor_file(path) -> dict[str, np.ndarray]:
         Wrong magic, unknown version or dtype, or a field reaching past the end of the file.
     """
     path = Path(path)
-    data = path.read_bytes()
+    with open_regular(path, what="an RGL tensor file") as fh:   # no link, FIFO or device
+        data = fh.read()
     return {name: np.frombuffer(data, dtype, math.prod(shape), offset).reshape(shape)
             for name, (dtype, shape, offset) in _field_table(path, data, len(data)).items()}
 
@@ -99,7 +101,7 @@ def read_tensor_field(path, name: str) -> np.ndarray | None:
         :data:`HEADER_LIMIT` bytes is called corrupt).
     """
     path = Path(path)
-    with open(path, "rb") as fh:
+    with open_regular(path, what="an RGL tensor file") as fh:
         size = os.fstat(fh.fileno()).st_size
         table = _field_table(path, fh.read(HEADER_LIMIT), size)
         if name not in table:

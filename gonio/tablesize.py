@@ -29,6 +29,7 @@ from gonio.memory import check_memory
 from gonio.merl import FILE_SIZE as MERL_FILE_SIZE
 from gonio.merl import SHAPE as MERL_SHAPE
 from gonio.rgl import read_tensor_field
+from gonio.safeopen import open_regular
 
 __all__ = ["Estimate", "estimate_table", "check_table", "text_estimate", "rgl_pairs",
            "TEXT_BYTES_PER_ROW", "TEXT_BYTES_PER_FIELD", "TEXT_BYTES_PER_BYTE",
@@ -60,7 +61,7 @@ class Estimate:
 def _lines_and_fields(path: Path, sep: str | None) -> tuple[int, int]:
     """(lines, fields of the first line that is neither blank nor a ``#`` comment)."""
     lines, fields, pending, last = 0, 0, b"", b""
-    with open(path, "rb") as fh:
+    with open_regular(path, what="a table") as fh:     # no link, FIFO or device
         while chunk := fh.read(_CHUNK):
             lines += chunk.count(b"\n")
             last = chunk[-1:]
@@ -111,7 +112,8 @@ def text_estimate(path, sep: str | tuple | None = ",") -> Estimate:
 def _exr_estimate(path: Path) -> Estimate | None:
     """Pixels and channels of every part, from the headers alone."""
     try:
-        with OpenEXR.File(str(path), header_only=True) as exr:
+        with open_regular(path, what="an OpenEXR table") as fh, \
+                OpenEXR.File(fh, header_only=True) as exr:
             headers = [dict(part.header) for part in exr.parts]
     except (RuntimeError, OSError, ValueError, TypeError):
         return None                             # the reader says what is wrong

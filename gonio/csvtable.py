@@ -181,10 +181,9 @@ def read_rows(path) -> CsvRows:
     ({'source': 'doc'}, ['theta_i', 'phi_i'], [(3, ['30', '0'])])
     """
     path = Path(path)
-    with open_regular(path, what="a CSV table") as fh:     # no link, FIFO or device
-        data = fh.read()
     try:
-        text = data.decode("utf-8-sig")     # a spreadsheet's byte-order mark
+        with open_regular(path, what="a CSV table") as fh:   # no link, FIFO or device
+            text = fh.read().decode("utf-8-sig")    # a spreadsheet's byte-order mark
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}

@@ -47,7 +47,9 @@ def measure_estimate(spec: str, instrument: gonio.Instrument, brdf) -> tuple[int
     check_memory(f"--geometry {spec} ({n:.3g} pairs)", nbytes, "use a coarser step")
     points = instrument.n_source * instrument.n_detector      # no quadrature built
     options = getattr(brdf, "options", None)
-    samples = options["tangent_samples"] if options is not None else 32
+    samples = 32 if options is None else options["tangent_samples"]
+    if options is not None and options.get("tangent_sampling") == "control_points":
+        samples = max(len(t.offsets) for t in brdf.threads)    # each control point a sample
     return int(n), int(nbytes), n * points * SECONDS_PER_EVALUATION * samples / 32
 
 

@@ -20,7 +20,9 @@ class TangentCurve:
     Parameters
     ----------
     offsets : sequence of float
-        K + 1 tangent offsets alpha_0..alpha_K, degrees, each in [-90, 90].
+        K + 1 tangent offsets alpha_0..alpha_K (the control points), degrees, each in
+        [-90, 90]; at most :data:`brdf.options.MAX_TANGENT_SAMPLES` of them (with
+        ``tangent_sampling="control_points"`` each is a tangent sample).
     lengths : sequence of float
         K segment lengths l_1..l_K (>= 0, summing to > 0); arbitrary units. A zero-length
         segment is a jump.
@@ -28,7 +30,8 @@ class TangentCurve:
     Raises
     ------
     ValueError
-        Offsets outside [-90, 90], negative lengths, lengths summing to 0, or
+        Offsets outside [-90, 90], more than :data:`brdf.options.MAX_TANGENT_SAMPLES`
+        offsets, negative lengths, lengths summing to 0, or
         ``len(offsets) != len(lengths) + 1``.
 
     Examples
@@ -47,6 +50,10 @@ class TangentCurve:
         lengths = _floats("lengths", self.lengths)
         if len(offsets) < 1:
             raise ValueError("offsets must list at least one tangent offset (degrees); got ()")
+        if len(offsets) > MAX_TANGENT_SAMPLES:
+            raise ValueError(f"offsets must list at most {MAX_TANGENT_SAMPLES} tangent offsets "
+                             f"(control points) per curve, the most tangent samples a curve "
+                             f"takes (brdf.MAX_TANGENT_SAMPLES); got {len(offsets):,}")
         if len(offsets) != len(lengths) + 1:
             raise ValueError(f"offsets must have exactly one more entry than lengths; got "
                              f"{len(offsets)} offsets and {len(lengths)} lengths")

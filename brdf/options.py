@@ -45,9 +45,10 @@ class TangentSampling(enum.StrEnum):
 TRANSMISSION_METHODS = tuple(m.value for m in Transmission)
 GAP_METHODS = tuple(m.value for m in Gap)
 SAMPLING_METHODS = tuple(m.value for m in TangentSampling)
-#: The most tangent samples a curve takes (the default is 32): a fixed cap on the work and
-#: memory of each direction pair, whoever asks (a preset's options, a fabric JSON or TOML,
-#: the command line's --tangent-samples, the API).
+#: The most tangent samples a curve takes (the default is 32), and the most control points
+#: (offsets) a tangent curve lists: a fixed cap on the work and memory of each direction
+#: pair, whoever asks (a preset's options, a fabric JSON or TOML, the command line's
+#: --tangent-samples, the API).
 MAX_TANGENT_SAMPLES = 4096
 
 

@@ -15,10 +15,9 @@ from gonio.atomic import atomic_write
 from gonio.errors import FormatError, TableWarning
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
-from gonio.safeopen import open_regular
-from gonio.numtext import (column_digits, float32_column, format_numbers, is_number,
-                           parse_number)
-from gonio.table import Table
+from gonio.numtext import column_digits, float32_column, format_numbers, is_number, parse_number
+from gonio.safeopen import read_bytes
+from gonio.table import Table, check_meta_size
 
 __all__ = ["read_csv", "write_csv", "read_rows", "parse_columns", "delimiter", "CsvRows",
            "looks_like_radians", "ANGLES", "ANGLE_RANGES", "DELIMITERS"]
@@ -168,8 +167,8 @@ def read_rows(path) -> CsvRows:
     OSError
         The file cannot be read.
     FormatError
-        Not UTF-8 text, a header without a known delimiter, or a data row with another
-        number of fields than the header (its line number is given).
+        Not UTF-8 text, a header without a known delimiter, a data row with another number
+        of fields than the header (its line number is given), or metadata over 1 MiB.
 
     Examples
     --------
@@ -181,13 +180,12 @@ def read_rows(path) -> CsvRows:
     ({'source': 'doc'}, ['theta_i', 'phi_i'], [(3, ['30', '0'])])
     """
     path = Path(path)
-    try:
-        with open_regular(path, what="a CSV table") as fh:   # no link, FIFO or device
-            text = fh.read().decode("utf-8-sig")    # a spreadsheet's byte-order mark
+    try:        # opened once: no link, FIFO or device; a spreadsheet's byte-order mark dropped
+        text = read_bytes(path, max_bytes=None, what="a CSV table").decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}
-    header, header_line, rows, sep = None, 0, [], ","
+    header, header_line, rows, sep, meta_bytes = None, 0, [], ",", 0
     for lineno, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped:
@@ -196,6 +194,8 @@ def read_rows(path) -> CsvRows:
             m = _KEY.match(stripped[1:].strip())
             if m:
                 key, raw = m.group(1), m.group(2).strip()
+                meta_bytes += len(raw)
+                check_meta_size(path, meta_bytes, f"line {lineno}: the metadata so far")
                 try:
                     meta[key] = json.loads(raw)
                 except json.JSONDecodeError:

@@ -29,9 +29,10 @@ from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.jsonplain import plain
 from gonio.safeopen import open_regular
-from gonio.table import Table
+from gonio.table import Table, check_meta_size
 
-__all__ = ["read_exr", "write_exr", "image_layout", "from_angles", "meta_to_json"]
+__all__ = ["read_exr", "write_exr", "image_layout", "from_angles", "meta_to_json",
+           "check_headers"]
 
 FORMAT = "microcyl-table/1"
 _MAGIC = b"\x76\x2f\x31\x01"
@@ -176,8 +177,11 @@ def _read_channels(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
         if head != _MAGIC:
             raise FormatError(path, f"wrong magic {head!r}, expected {_MAGIC!r} (not an "
                                     f"OpenEXR file)")
-        fh.seek(0)
         try:            # read from this descriptor, never by name again
+            fh.seek(0)
+            with OpenEXR.File(fh, header_only=True) as exr:
+                check_headers(path, [dict(part.header) for part in exr.parts])
+            fh.seek(0)
             with OpenEXR.File(fh, separate_channels=True) as exr:
                 header = dict(exr.header())
                 chans = {k: np.array(v.pixels) for k, v in exr.channels().items()}
@@ -185,6 +189,36 @@ def _read_channels(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
             raise FormatError(path, f"unreadable OpenEXR (truncated or corrupt): {exc}") \
                 from None
     return header, chans
+
+
+def check_headers(path, headers: list[dict]) -> None:
+    """Refuse, from the headers of its parts alone (before a pixel is read), an OpenEXR file
+    that is no microcyl table: several parts, a deep image (its pixels hold any number of
+    samples each, which the image size does not tell), or a ``microcyl_meta`` attribute of
+    more than :data:`gonio.table.MAX_META_BYTES` (:func:`gonio.table.check_meta_size`).
+
+    Raises
+    ------
+    FormatError
+        Naming the file and what it holds.
+
+    Examples
+    --------
+    >>> check_headers("t.exr", [{"type": OpenEXR.deepscanline}])
+    Traceback (most recent call last):
+    ...
+    gonio.errors.FormatError: t.exr: a deep OpenEXR image (deepscanline); a microcyl table is \
+one flat scanline or tiled image
+    """
+    if len(headers) != 1:
+        raise FormatError(path, f"a multi-part OpenEXR file ({len(headers)} parts); a microcyl "
+                                "table is one flat scanline or tiled image")
+    kind = headers[0].get("type", OpenEXR.scanlineimage)
+    if kind not in (OpenEXR.scanlineimage, OpenEXR.tiledimage):
+        raise FormatError(path, f"a deep OpenEXR image ({getattr(kind, 'name', kind)}); a "
+                                "microcyl table is one flat scanline or tiled image")
+    meta = str(headers[0].get("microcyl_meta", ""))
+    check_meta_size(path, len(meta.encode("utf-8", "replace")), "the microcyl_meta attribute")
 
 
 def _check_channels(path: Path, chans: dict) -> bool:

@@ -12,18 +12,33 @@ import numpy as np
 from brdf.frames import flat_pairs
 from brdf.shading import DENOM_MIN
 from gonio.errors import FormatError
+from gonio.memory import check_memory
+from gonio.rglwarp import Conditional, elevation, mulsign_neg, phi2u, theta2u
 from gonio.safeopen import open_regular
 
-__all__ = ["read_tensor_file", "read_tensor_field", "load_rgl", "RGLBRDF", "HEADER_LIMIT"]
+__all__ = ["read_tensor_file", "read_tensor_field", "tensor_fields", "load_bytes", "check_rgl",
+           "load_rgl", "RGLBRDF", "HEADER_LIMIT", "MAX_FIELDS", "RGL_BYTES_PER_ELEMENT"]
 
 _MAGIC = b"tensor_file\0"
 _DTYPES = {1: "u1", 2: "i1", 3: "<u2", 4: "<i2", 5: "<u4", 6: "<i4", 7: "<u8", 8: "<i8",
            9: "<f2", 10: "<f4", 11: "<f8"}
 
 
+#: The most header bytes a tensor file's field table may take (read before any field).
+HEADER_LIMIT = 1 << 20
+#: The most fields a tensor file may declare (an RGL file has 11).
+MAX_FIELDS = 4096
+#: Peak memory of loading an RGL file (:class:`RGLBRDF`) per element of its fields, bytes,
+#: besides the file's own bytes: the vndf warp's float64 copies, CDFs and their normalized
+#: copies (about 50 bytes an element, measured: 7.4 times a real float32 file in all).
+RGL_BYTES_PER_ELEMENT = 64
+
+
 def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
-    """The field table of a tensor file's header: name -> (dtype, shape, offset), each
-    field checked to end within ``file_size`` bytes. ``data`` holds at least the header."""
+    """The field table of a tensor file's header: name -> (dtype, shape, offset), checked by
+    :func:`_check_layout` against ``file_size`` bytes. ``data`` holds at least the header;
+    only its first :data:`HEADER_LIMIT` bytes are read."""
+    data = data[:HEADER_LIMIT]
     if len(data) < 18 or data[:12] != _MAGIC:
         raise FormatError(path, f"wrong magic {data[:12]!r}, expected {_MAGIC!r} "
                                 "(not an RGL tensor file)")
@@ -31,8 +46,11 @@ def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
     if (major, minor) != (1, 0):
         raise FormatError(path, f"unsupported tensor file version {major}.{minor}, expected 1.0")
     (count,) = struct.unpack_from("<I", data, 14)
+    if count > MAX_FIELDS:
+        raise FormatError(path, f"the header declares {count:,} fields; a tensor file may "
+                                f"have at most {MAX_FIELDS:,} (an RGL file has 11)")
     pos = 18
-    table = {}
+    entries = []
     try:
         for _ in range(count):
             (name_len,) = struct.unpack_from("<H", data, pos)
@@ -47,17 +65,88 @@ def _field_table(path: Path, data: bytes, file_size: int) -> dict[str, tuple]:
             pos += 8 * ndim
             if code not in _DTYPES:
                 raise FormatError(path, f"field {name!r} has unknown dtype code {code}")
-            dtype = np.dtype(_DTYPES[code])
-            size = math.prod(shape) * dtype.itemsize
-            if offset + size > file_size:
-                raise FormatError(path, f"wrong size: field {name!r} needs bytes "
-                                        f"{offset}..{offset + size}, file has {file_size} "
-                                        "(truncated?)")
-            table[name] = (dtype, shape, offset)
+            entries.append((name, np.dtype(_DTYPES[code]), shape, offset))
     except (struct.error, UnicodeDecodeError):
         raise FormatError(path, f"truncated or corrupt header (field table of {count} fields "
                                 f"ends past byte {pos} of {len(data)})") from None
-    return table
+    _check_layout(path, entries, pos, file_size)
+    return {name: (dtype, shape, offset) for name, dtype, shape, offset in entries}
+
+
+def _check_layout(path: Path, entries, header_end: int, file_size: int) -> None:
+    """Refuse a field table whose fields do not each lie within the file, after the header,
+    apart from one another (one name once): what is declared is then at most what the file
+    holds, and the memory of loading it follows from the file's size."""
+    spans, seen = [], set()
+    for name, dtype, shape, offset in entries:
+        if name in seen:
+            raise FormatError(path, f"field {name!r} is declared twice")
+        seen.add(name)
+        size = math.prod(shape) * dtype.itemsize
+        if offset + size > file_size:
+            raise FormatError(path, f"wrong size: field {name!r} needs bytes "
+                                    f"{offset}..{offset + size}, file has {file_size} "
+                                    "(truncated?)")
+        if size and offset < header_end:
+            raise FormatError(path, f"field {name!r} starts at byte {offset}, inside the "
+                                    f"header (which ends at byte {header_end})")
+        if size:
+            spans.append((offset, offset + size, name))
+    spans.sort()
+    for (_, end, a), (start, _, b) in zip(spans, spans[1:]):
+        if start < end:
+            raise FormatError(path, f"fields {a!r} and {b!r} overlap (bytes {start}..{end}); "
+                                    "each field of a tensor file has bytes of its own")
+
+
+def tensor_fields(path) -> tuple[dict[str, tuple], int]:
+    """The field table of a tensor file (name -> (dtype, shape, offset)) and the file's
+    size, from its header alone; the fields checked to lie within the file without
+    overlapping (:func:`read_tensor_file` checks the same).
+
+    Raises
+    ------
+    FormatError
+        As :func:`read_tensor_file`, before any field is read.
+    """
+    path = Path(path)
+    with open_regular(path, what="an RGL tensor file") as fh:   # no link, FIFO or device
+        size = os.fstat(fh.fileno()).st_size
+        return _field_table(path, fh.read(HEADER_LIMIT), size), size
+
+
+def load_bytes(fields: dict[str, tuple], file_size: int) -> int:
+    """Peak memory of loading a tensor file as an :class:`RGLBRDF`, bytes: the file and
+    :data:`RGL_BYTES_PER_ELEMENT` for each element of its fields (:func:`tensor_fields`).
+
+    Examples
+    --------
+    >>> load_bytes({"rgb": (np.dtype("<f4"), (1, 2, 3, 4, 4), 64)}, 448)
+    6592
+    """
+    elements = sum(math.prod(shape) for _, shape, _ in fields.values())
+    return file_size + RGL_BYTES_PER_ELEMENT * elements
+
+
+def check_rgl(path) -> int:
+    """Refuse, from its header alone, an RGL file whose fields do not fit the file
+    (:func:`tensor_fields`) or whose loading would exceed the memory limit
+    (:func:`gonio.memory.check_memory`); returns the bytes of loading it
+    (:func:`load_bytes`). Every load of a tensor file goes through it.
+
+    Raises
+    ------
+    FormatError
+        A damaged or aliasing field table (one line naming the file and the field).
+    MemoryLimitError
+        A file too large for the memory.
+    """
+    path = Path(path)
+    fields, size = tensor_fields(path)
+    nbytes = load_bytes(fields, size)
+    check_memory(f"loading {path.name} ({len(fields)} fields, {size:,} bytes)", nbytes,
+                 "load it on a machine with more memory")
+    return nbytes
 
 
 def read_tensor_file(path) -> dict[str, np.ndarray]:
@@ -76,17 +165,18 @@ def read_tensor_file(path) -> dict[str, np.ndarray]:
     Raises
     ------
     FormatError
-        Wrong magic, unknown version or dtype, or a field reaching past the end of the file.
+        Wrong magic, unknown version or dtype, a field reaching past the end of the file,
+        into the header or into another field (:func:`check_rgl`, before the fields are
+        read).
+    MemoryLimitError
+        Loading the file would exceed the memory limit (:func:`check_rgl`).
     """
     path = Path(path)
+    check_rgl(path)
     with open_regular(path, what="an RGL tensor file") as fh:   # no link, FIFO or device
         data = fh.read()
     return {name: np.frombuffer(data, dtype, math.prod(shape), offset).reshape(shape)
             for name, (dtype, shape, offset) in _field_table(path, data, len(data)).items()}
-
-
-#: The most header bytes :func:`read_tensor_field` reads to find its field.
-HEADER_LIMIT = 1 << 20
 
 
 def read_tensor_field(path, name: str) -> np.ndarray | None:
@@ -112,111 +202,35 @@ def read_tensor_field(path, name: str) -> np.ndarray | None:
     return np.frombuffer(raw, dtype).reshape(shape)
 
 
-def _elevation(d):
-    """Polar angle of unit vectors, computed as Mitsuba does (stable near the pole)."""
-    dist = np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + (d[..., 2] - 1.0) ** 2)
-    return 2.0 * np.arcsin(np.clip(0.5 * dist, -1.0, 1.0))
+def _check_angles(path, theta_i, phi_i) -> None:
+    """Refuse, naming the field, incident angles that the evaluation cannot interpolate
+    between: ``theta_i`` and ``phi_i`` non-empty lists, finite and strictly increasing,
+    ``theta_i`` in [0, pi/2] and ``phi_i`` in [-pi, pi] radians."""
+    for name, values, hi in (("theta_i", theta_i, np.pi / 2), ("phi_i", phi_i, np.pi)):
+        lo = 0.0 if name == "theta_i" else -np.pi
+        if values.ndim != 1 or values.size == 0:
+            raise FormatError(path, f"field {name!r} must be a non-empty list of angles; "
+                                    f"got shape {values.shape}")
+        if not np.all(np.isfinite(values)) or np.any(np.diff(values) <= 0):
+            raise FormatError(path, f"field {name!r} must increase strictly (finite angles, "
+                                    f"radians); got " + ", ".join(f"{v:.4g}" for v in values[:8])
+                              + (", ..." if values.size > 8 else ""))
+        if values[0] < lo - 1e-6 or values[-1] > hi + 1e-6:
+            raise FormatError(path, f"field {name!r} must lie in [{lo:.4g}, {hi:.4g}] "
+                                    f"radians; got {values[0]:.4g}..{values[-1]:.4g}")
 
 
-def _theta2u(theta):
-    return np.sqrt(np.maximum(theta, 0.0) * (2.0 / np.pi))
-
-
-def _phi2u(phi):
-    return (phi + np.pi) / (2.0 * np.pi)
-
-
-def _mulsign_neg(x, s):
-    """x * -sign(s), with the sign taken from the sign bit (as drjit.mulsign_neg)."""
-    return np.where(np.signbit(s), x, -x)
-
-
-def _param_weights(values: np.ndarray, param: np.ndarray):
-    """Slice index and linear weight along one parameter axis (Mitsuba's Distribution2D)."""
-    n = values.shape[0]
-    if n == 1:
-        return np.zeros(param.shape, np.intp), np.zeros(param.shape)
-    idx = np.clip(np.searchsorted(values, param, side="left") - 1, 0, n - 2)
-    p0, p1 = values[idx], values[idx + 1]
-    return idx, np.clip((param - p0) / (p1 - p0), 0.0, 1.0)
-
-
-class _Conditional:
-    """Slices of a 2-D function over the unit square indexed by parameters (phi_i, theta_i[, c]).
-
-    ``data`` has shape (P..., ny, nx); parameters are interpolated linearly between slices,
-    exactly as Mitsuba's ``Marginal2D`` does (the interpolated quantity is the slice data,
-    and, for the continuous warp, its CDFs).
-    """
-
-    def __init__(self, data: np.ndarray, params: list[np.ndarray], warp: bool):
-        self.params = [np.asarray(p, np.float64) for p in params]
-        data = np.asarray(data, np.float64)
-        self.ny, self.nx = data.shape[-2:]
-        self.pshape = data.shape[:-2]
-        flat = data.reshape(-1, self.ny, self.nx)
-        if warp:
-            cond = np.zeros_like(flat)
-            cond[:, :, 1:] = np.cumsum(0.5 * (flat[:, :, :-1] + flat[:, :, 1:]), axis=2)
-            marg = np.zeros((flat.shape[0], self.ny))
-            marg[:, 1:] = np.cumsum(0.5 * (cond[:, :-1, -1] + cond[:, 1:, -1]), axis=1)
-            norm = 1.0 / marg[:, -1]
-            self.cond = cond * norm[:, None, None]
-            self.marg = marg * norm[:, None]
-            flat = flat * norm[:, None, None]
-        self.data = flat
-        self.strides = []
-        s = 1
-        for n in reversed(self.pshape):
-            self.strides.insert(0, s)
-            s *= n
-
-    def _corners(self, param):
-        """List of (slice index, weight) pairs for the multilinear parameter interpolation."""
-        corners = [(0, 1.0)]
-        for values, stride, p in zip(self.params, self.strides, param):
-            idx, w1 = _param_weights(values, p)
-            if values.shape[0] == 1:
-                continue
-            corners = [(base + stride * (idx + j), w * (w1 if j else 1.0 - w1))
-                       for base, w in corners for j in (0, 1)]
-        return corners
-
-    @staticmethod
-    def _gather(arr, corners, *index):
-        return sum(w * arr[(s,) + index] for s, w in corners)
-
-    def eval(self, pos, param):
-        """Bilinear interpolation of the (un-normalized) data at ``pos`` (..., 2) in [0, 1]^2."""
-        corners = self._corners(param)
-        px = np.clip(pos[..., 0], 0.0, 1.0) * (self.nx - 1)
-        py = np.clip(pos[..., 1], 0.0, 1.0) * (self.ny - 1)
-        ix = np.minimum(px.astype(np.intp), self.nx - 2)
-        iy = np.minimum(py.astype(np.intp), self.ny - 2)
-        wx, wy = px - ix, py - iy
-        g = lambda y, x: self._gather(self.data, corners, y, x)  # noqa: E731
-        return ((1 - wy) * ((1 - wx) * g(iy, ix) + wx * g(iy, ix + 1))
-                + wy * ((1 - wx) * g(iy + 1, ix) + wx * g(iy + 1, ix + 1)))
-
-    def invert(self, sample, param):
-        """Inverse of the continuous marginal-conditional warp (Mitsuba's invert_continuous)."""
-        corners = self._corners(param)
-        sx = np.clip(sample[..., 0], 0.0, 1.0) * (self.nx - 1)
-        sy = np.clip(sample[..., 1], 0.0, 1.0) * (self.ny - 1)
-        ix = np.minimum(sx.astype(np.intp), self.nx - 2)
-        iy = np.minimum(sy.astype(np.intp), self.ny - 2)
-        sx, sy = sx - ix, sy - iy
-        d = lambda y, x: self._gather(self.data, corners, y, x)  # noqa: E731
-        c = lambda y, x: self._gather(self.cond, corners, y, x)  # noqa: E731
-        v00, v10, v01, v11 = d(iy, ix), d(iy, ix + 1), d(iy + 1, ix), d(iy + 1, ix + 1)
-        c0 = (1 - sy) * v00 + sy * v01
-        c1 = (1 - sy) * v10 + sy * v11
-        ux = sx * (c0 + 0.5 * sx * (c1 - c0))
-        ux = ux + (1 - sy) * c(iy, ix) + sy * c(iy + 1, ix)
-        r0, r1 = c(iy, self.nx - 1), c(iy + 1, self.nx - 1)
-        ux = ux / ((1 - sy) * r0 + sy * r1)
-        uy = sy * (r0 + 0.5 * sy * (r1 - r0)) + self._gather(self.marg, corners, iy)
-        return np.stack([ux, uy], axis=-1)
+def _check_grids(path, fields) -> None:
+    """Refuse, naming the field, a grid the evaluation cannot interpolate in: every 2-D grid
+    (``ndf``, ``sigma``, the last two axes of ``vndf`` and ``rgb``) at least 2 x 2;
+    ``jacobian`` non-empty."""
+    for name in ("ndf", "sigma", "vndf", "rgb"):
+        grid = fields[name].shape[-2:]
+        if min(grid) < 2:
+            raise FormatError(path, f"field {name!r} is a {grid[0]} x {grid[1]} grid; the "
+                                    "interpolation needs at least 2 x 2")
+    if np.asarray(fields["jacobian"]).size == 0:
+        raise FormatError(path, "field 'jacobian' is empty; expected one flag")
 
 
 class RGLBRDF:
@@ -254,6 +268,7 @@ class RGLBRDF:
                                     "RGL tensor file")
         theta_i = np.asarray(fields["theta_i"], np.float64)
         phi_i = np.asarray(fields["phi_i"], np.float64)
+        _check_angles(path, theta_i, phi_i)
         ndf, sigma, vndf, rgb = (fields[k] for k in ("ndf", "sigma", "vndf", "rgb"))
         nphi, nth = phi_i.shape[0], theta_i.shape[0]
         if (ndf.ndim != 2 or sigma.ndim != 2 or vndf.shape[:2] != (nphi, nth) or vndf.ndim != 4
@@ -261,6 +276,7 @@ class RGLBRDF:
             raise FormatError(path, "field shapes do not match an RGB RGL tensor file: "
                               f"phi_i {phi_i.shape}, theta_i {theta_i.shape}, ndf {ndf.shape}, "
                               f"sigma {sigma.shape}, vndf {vndf.shape}, rgb {rgb.shape}")
+        _check_grids(path, fields)
         self.isotropic = nphi <= 2
         self.jacobian = bool(np.asarray(fields["jacobian"]).ravel()[0])
         self.reduction = 0
@@ -269,10 +285,10 @@ class RGLBRDF:
         desc = fields.get("description")
         self.description = bytes(np.asarray(desc, np.uint8)).decode("utf-8", "replace") \
             if desc is not None else ""
-        self._ndf = _Conditional(ndf, [], warp=False)
-        self._sigma = _Conditional(sigma, [], warp=False)
-        self._vndf = _Conditional(vndf, [phi_i, theta_i], warp=True)
-        self._rgb = _Conditional(rgb, [phi_i, theta_i, np.arange(3.0)], warp=False)
+        self._ndf = Conditional(ndf, [], warp=False)
+        self._sigma = Conditional(sigma, [], warp=False)
+        self._vndf = Conditional(vndf, [phi_i, theta_i], warp=True)
+        self._rgb = Conditional(rgb, [phi_i, theta_i, np.arange(3.0)], warp=False)
 
     def __repr__(self):
         return f"RGLBRDF({self.description!r}, file={self.path!r})"
@@ -311,16 +327,16 @@ class RGLBRDF:
             sy = wi[..., 1].copy()
             sx = wi[..., 0].copy() if self.reduction == 4 else sy
             for w in (wi, wo):
-                w[..., 0] = _mulsign_neg(w[..., 0], sx)
-                w[..., 1] = _mulsign_neg(w[..., 1], sy)
+                w[..., 0] = mulsign_neg(w[..., 0], sx)
+                w[..., 1] = mulsign_neg(w[..., 1], sy)
         m = wi + wo
         norm = np.linalg.norm(m, axis=-1, keepdims=True)
         m = m / np.where(norm > 0, norm, 1.0)
-        theta_i, phi_i = _elevation(wi), np.arctan2(wi[..., 1], wi[..., 0])
-        theta_m, phi_m = _elevation(m), np.arctan2(m[..., 1], m[..., 0])
-        u_wi = np.stack([_theta2u(theta_i), _phi2u(phi_i)], axis=-1)
-        um1 = _phi2u(phi_m - phi_i if self.isotropic else phi_m)
-        u_m = np.stack([_theta2u(theta_m), um1 - np.floor(um1)], axis=-1)
+        theta_i, phi_i = elevation(wi), np.arctan2(wi[..., 1], wi[..., 0])
+        theta_m, phi_m = elevation(m), np.arctan2(m[..., 1], m[..., 0])
+        u_wi = np.stack([theta2u(theta_i), phi2u(phi_i)], axis=-1)
+        um1 = phi2u(phi_m - phi_i if self.isotropic else phi_m)
+        u_m = np.stack([theta2u(theta_m), um1 - np.floor(um1)], axis=-1)
         params = [phi_i, theta_i]
         sample = self._vndf.invert(u_m, params)
         spec = np.stack([self._rgb.eval(sample, params + [np.full(phi_i.shape, float(c))])

@@ -10,8 +10,36 @@ from typing import Any
 import numpy as np
 
 from brdf.frames import normalize, to_angles
+from gonio.errors import FormatError
 
-__all__ = ["Table"]
+__all__ = ["Table", "MAX_META_BYTES", "check_meta_size"]
+
+#: The most bytes a table file's metadata may take (a CSV file's ``# key: value`` comment
+#: lines, an OpenEXR file's ``microcyl_meta`` attribute): the metadata microcyl writes is a
+#: few kilobytes, and parsed JSON takes tens of times its bytes.
+MAX_META_BYTES = 1 << 20
+
+
+def check_meta_size(path, nbytes: int, what: str) -> None:
+    """Refuse, before it is parsed, a table file's metadata of more than
+    :data:`MAX_META_BYTES`.
+
+    Raises
+    ------
+    FormatError
+        ``t.csv: the # comment lines: 25,000,000 bytes, more than ...``, naming the file.
+
+    Examples
+    --------
+    >>> check_meta_size("t.exr", 2 << 20, "the microcyl_meta attribute")
+    Traceback (most recent call last):
+    ...
+    gonio.errors.FormatError: t.exr: the microcyl_meta attribute: 2,097,152 bytes, more than \
+the 1,048,576 a table's metadata may hold (microcyl writes a few KB)
+    """
+    if nbytes > MAX_META_BYTES:
+        raise FormatError(path, f"{what}: {nbytes:,} bytes, more than the {MAX_META_BYTES:,} "
+                                "a table's metadata may hold (microcyl writes a few KB)")
 
 
 def _as_n3(name: str, value, n: int | None) -> np.ndarray:

@@ -14,21 +14,30 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 from pathlib import Path
 
 import h5py
 import numpy as np
 
+from analysis.fit.proposal import MIXTURE_COMPONENTS
 from gonio import atomic_write
 from gonio.jsonplain import plain
+from gonio.memory import memory_limit
+from gonio.safeh5 import H5Data, H5Group, read_h5
 from gonio.statefields import FileFields, load_json, loads_json
 
-__all__ = ["FitFolder", "table_digest", "read_config", "CONFIG_FILE", "CHECKPOINT_FILE"]
+__all__ = ["FitFolder", "table_digest", "read_config", "checkpoint_layout", "check_checkpoint",
+           "CONFIG_FILE", "CHECKPOINT_FILE"]
 
 CONFIG_FILE = "fit_config.json"
 CHECKPOINT_FILE = "checkpoint.h5"
 #: Most ensembles a checkpoint may hold (``--ensembles`` is at most 64).
 MAX_ENSEMBLES = 1024
+#: Most walkers a checkpoint's configuration may name, and most importance draws
+#: (``draw_lw``) a proposal may keep (the fit keeps analysis.fit.moves.DRAWS = 256).
+MAX_WALKERS = 1 << 16
+MAX_DRAWS = 1 << 16
 
 
 def table_digest(table) -> str:
@@ -104,26 +113,46 @@ class FitFolder:
         with atomic_write(self.config_path, "w") as fh:
             fh.write(json.dumps(plain(doc), indent=1) + "\n")
 
-    def read_checkpoint(self) -> dict | None:
+    def read_checkpoint(self, config: dict | None = None) -> dict | None:
         """The checkpoint: ``{"progress": dict, "ensembles": [dict of arrays, ...]}``, or None.
+
+        The file is read as data by :func:`gonio.safeh5.read_h5`, the one reader of
+        ``checkpoint.h5`` (the resume, ``plan FITDIR``): opened once (no link, no FIFO, no
+        larger than :func:`gonio.memory.memory_limit`), its structure checked against what
+        the fit of ``config`` writes (:func:`checkpoint_layout`: its ensembles, walkers and
+        free parameters; no link but hard links to nodes of its own, no external, virtual or
+        chunked storage) and the values it declares against the memory limit, before any
+        value is read; then the values are checked (:func:`check_checkpoint`).
+
+        Parameters
+        ----------
+        config : dict, optional
+            The fit's configuration (``fit_config.json``'s ``config``, checked equal by
+            :meth:`read_start`); None: read from ``fit_config.json``.
 
         Raises
         ------
         ValueError
-            When the file cannot be read.
+            One line naming the file: not a regular file, a structure or value that is not
+            what the fit writes, more than memory allows, or not readable.
         """
-        if not self.checkpoint_path.exists():
-            return None
         path = self.checkpoint_path
+        if not os.path.lexists(path):          # a link is refused by the reader, not skipped
+            return None
+        if config is None:
+            try:
+                config = read_config(self.config_path)["config"]
+            except ValueError as exc:
+                raise self._corrupt(exc) from None
+        layout, bounds = checkpoint_layout(*_shape_of(self.config_path, config))
         try:
-            with h5py.File(path, "r") as f:
-                progress = f.attrs["progress"]
-                n = FileFields(path).integer(f.attrs, "ensembles", lo=1, hi=MAX_ENSEMBLES)
-                ens = []
-                for k in range(n):
-                    g = f[f"ensemble_{k}"]
-                    ens.append({name: _read_node(g[name]) for name in g})
-                    ens[-1].update({f"attr:{a}": v for a, v in g.attrs.items()})
+            doc = read_h5(path, layout, what="a fit's checkpoint", max_bytes=memory_limit()[0],
+                          bounds=bounds, change="chains this long need more memory than this "
+                          "machine allows")
+            progress = doc["attr:progress"]
+            n = FileFields(path).integer(doc, "attr:ensembles", lo=len(layout.entries),
+                                         hi=len(layout.entries))
+            ens = [doc[f"ensemble_{k}"] for k in range(n)]
             if not isinstance(progress, str):
                 raise ValueError(f"progress must be JSON text; got {type(progress).__name__}")
             progress = loads_json(progress, path, "checkpoint's progress")
@@ -144,6 +173,48 @@ class FitFolder:
                 f.attrs["ensembles"] = len(ensembles)
                 for k, doc in enumerate(ensembles):
                     _write_node(f.create_group(f"ensemble_{k}"), doc)
+
+
+def _shape_of(path, config: dict) -> tuple[int, int, int]:
+    """(ensembles, walkers, free parameters) of a fit configuration, checked."""
+    f = FileFields(path)
+    cfg = f.mapping({"config": config}, "config")
+    free = f.mapping(cfg, "spec", "config").get("free")
+    if not isinstance(free, list) or not free:
+        raise f.error("config.spec.free", "a list of parameter names", free)
+    return (f.integer(cfg, "ensembles", "config", lo=1, hi=MAX_ENSEMBLES),
+            f.integer(cfg, "walkers", "config", lo=2, hi=MAX_WALKERS), len(free))
+
+
+def checkpoint_layout(ensembles: int, walkers: int, ndim: int) -> tuple[H5Group, dict]:
+    """What :meth:`FitFolder.write_checkpoint` writes for a fit of ``ensembles`` ensembles of
+    ``walkers`` walkers in ``ndim`` free parameters, as :func:`gonio.safeh5.read_h5`'s layout,
+    and the bounds of its free lengths (mixture components, importance draws; the steps are
+    bounded by the memory limit).
+
+    Examples
+    --------
+    >>> layout, bounds = checkpoint_layout(2, 6, 2)
+    >>> sorted(layout.entries), layout.entries["ensemble_0"].entries["chain"].shape
+    (['ensemble_0', 'ensemble_1'], ('steps@0', 6, 2))
+    >>> layout.nodes(), bounds["components"]
+    (27, 8)
+    """
+    def one(k):
+        steps, comps = f"steps@{k}", f"components@{k}"
+        rng = H5Group({"keys": H5Data((624,), "int")},
+                      attrs={"pos": "int", "has_gauss": "int", "cached": "number"})
+        proposal = H5Group({"means": H5Data((comps, ndim)), "chols": H5Data((comps, ndim, ndim)),
+                            "weights": H5Data((comps,)), "warps": H5Data((ndim,), "int"),
+                            "df": H5Data(()), "draw_lw": H5Data((f"draws@{k}",))},
+                           attrs={"share": "number", "last_kept": "int"},
+                           optional=frozenset({"draw_lw"}))
+        return H5Group({"chain": H5Data((steps, walkers, ndim)),
+                        "log_prob": H5Data((steps, walkers)), "accepted": H5Data((walkers,)),
+                        "rng": rng, "proposal": proposal})
+    root = H5Group({f"ensemble_{k}": one(k) for k in range(ensembles)},
+                   attrs={"progress": "text", "ensembles": "int"})
+    return root, {"components": max(MIXTURE_COMPONENTS), "draws": MAX_DRAWS}
 
 
 def read_config(path) -> dict:
@@ -255,11 +326,3 @@ def _write_node(group, doc: dict):
             _write_node(group.create_group(key), value)
         elif value is not None:
             group[key] = np.asarray(value)
-
-
-def _read_node(node):
-    if isinstance(node, h5py.Group):
-        out = {name: _read_node(node[name]) for name in node}
-        out.update({f"attr:{a}": v for a, v in node.attrs.items()})
-        return out
-    return node[()]

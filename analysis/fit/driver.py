@@ -353,7 +353,7 @@ def _run(table, spec, model, opts: FitOptions, out_dir, progress, config_extra,
     config = opts.config(spec, table, lik, config_extra)
     folder = None if out_dir is None else FitFolder(out_dir)
     start = None if folder is None else folder.read_start(config)
-    ckpt = None if start is None else folder.read_checkpoint()
+    ckpt = None if start is None else folder.read_checkpoint(config)
     if start is not None and ckpt is None and not np.isfinite(start["best_logp"]):
         start = None                   # a failed start of an older version: estimate again
     rng_opt, *rngs = [np.random.default_rng(s)

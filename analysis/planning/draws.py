@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.fit.checkpoint import CONFIG_FILE, FitFolder, read_config
+from analysis.fit.checkpoint import CHECKPOINT_FILE, CONFIG_FILE, FitFolder, read_config
 from analysis.params import ParamSpec
 
 __all__ = ["prior_draws", "posterior_draws", "fit_folder_spec", "LOCAL_SD", "MAX_DRAWS"]
@@ -107,10 +107,9 @@ def posterior_draws(folder, spec: ParamSpec, draws: int,
         fit_spec = fit_folder_spec(folder)[0]
     except ValueError as exc:
         raise ValueError(f"{folder}: cannot read the fit's parameters: {exc}") from None
-    ckpt = FitFolder(folder).read_checkpoint() if (folder / "checkpoint.h5").is_file() \
-        else None
+    ckpt = FitFolder(folder).read_checkpoint()    # the one reader of checkpoint.h5
     if ckpt is None:
-        raise ValueError(f"{folder}: no checkpoint.h5 (the fit's posterior samples): plan "
+        raise ValueError(f"{folder}: no {CHECKPOINT_FILE} (the fit's posterior samples): plan "
                          f"from a finished `microcyl fit` folder, or from a preset")
     chains = [e["chain"] for e in ckpt["ensembles"]]
     samples = np.concatenate([c[c.shape[0] // 2:].reshape(-1, c.shape[-1]) for c in chains])

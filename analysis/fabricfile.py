@@ -16,8 +16,6 @@ from __future__ import annotations
 import json
 import math
 import numbers
-import os
-import stat
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Mapping
 from pathlib import Path
@@ -27,6 +25,7 @@ import brdf
 from brdf.fabric import OPTIONS
 from gonio.atomic import atomic_write
 from gonio.jsonplain import plain
+from gonio.safeopen import read_bytes
 from gonio.statefields import MAX_MAGNITUDE, loads_json
 
 __all__ = ["plugin_dict", "plugin_xml", "fabric_from_dict", "fabric_from_xml",
@@ -300,19 +299,12 @@ def fabric_from_xml(text: str) -> brdf.Fabric:
 
 
 def _read_text(path: Path) -> str:
-    """The text of a regular file of at most :data:`MAX_FILE_BYTES`, never through a link."""
-    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0)
+    """The text of a regular file of at most :data:`MAX_FILE_BYTES`, opened once
+    (:func:`gonio.safeopen.read_bytes`: never through a link, never a FIFO or device)."""
     try:
-        fd = os.open(path, flags)
-    except OSError as exc:
-        raise ValueError(f"cannot open ({exc.strerror or exc})") from None
-    with os.fdopen(fd, "rb") as fh:
-        info = os.fstat(fh.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise ValueError("not a regular file")
-        data = fh.read(MAX_FILE_BYTES + 1)
-    if len(data) > MAX_FILE_BYTES:
-        raise ValueError(f"larger than {MAX_FILE_BYTES} bytes: not a fabric file")
+        data = read_bytes(path, max_bytes=MAX_FILE_BYTES, what="a fabric file")
+    except ValueError as exc:               # named again by read_fabric_file
+        raise ValueError(str(exc).removeprefix(f"{path}: ")) from None
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

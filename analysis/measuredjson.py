@@ -32,12 +32,12 @@ has no ``results`` of its own (:func:`has_microcylinder`).
 
 from __future__ import annotations
 
-import json
 import math
+import os
 from pathlib import Path, PurePosixPath
 
 from gonio.safenames import check_component, check_inside
-from gonio.statefields import FileFields
+from gonio.statefields import FileFields, load_json
 
 __all__ = ["load_measured_json", "check_measured_doc", "results_path", "has_microcylinder"]
 
@@ -200,11 +200,7 @@ def load_measured_json(folder) -> dict:
         one line naming the file.
     """
     path = Path(folder) / "measured.json"
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ValueError(f"{path}: not found; run `microcyl fit-measured -o {folder}` first") \
-            from None
-    except (OSError, ValueError, RecursionError) as exc:
-        raise ValueError(f"{path}: unreadable ({exc})") from None
+    if not os.path.lexists(path):
+        raise ValueError(f"{path}: not found; run `microcyl fit-measured -o {folder}` first")
+    doc = load_json(path, "fit-measured summary")   # a link, FIFO, huge or deep file: one line
     return check_measured_doc(doc, path)

@@ -23,6 +23,7 @@ fit's posterior medians (a :class:`brdf.Model`: ``eval``, ``sample``,
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 
 import brdf
@@ -120,7 +121,7 @@ def _label(path: Path) -> str:
 
 
 def _fit(text: str, path: Path, what: str, preset: str | None) -> Source:
-    folder = path.parent if path.is_file() else path
+    folder = path if path.is_dir() else path.parent
     try:
         med = median_fabric(folder, preset=preset)
     except ValueError as exc:
@@ -179,16 +180,18 @@ def _resolve_path(text: str, what: str, tables: bool, preset: str | None) -> Sou
     """:func:`resolve` of a name that is no preset: a folder or a file."""
     path = Path(text)
     suffix = path.suffix.lower()
-    if path.is_dir() or (path.name == "results.json" and path.is_file()):
+    # a file here may be a link or a FIFO: its reader (safeopen) refuses it by name, at once
+    is_file = os.path.lexists(path) and not path.is_dir()
+    if path.is_dir() or (path.name == "results.json" and is_file):
         return _fit(text, path, what, preset)
-    if path.is_file() and suffix in FABRIC_SUFFIXES:
+    if is_file and suffix in FABRIC_SUFFIXES:
         try:
             fab = read_fabric_file(path)
         except ValueError as exc:
             raise ValueError(f"{what} {text!r}: {str(exc).removeprefix(f'{path}: ')}") \
                 from None
         return Source(suffix[1:], _label(path), fab, path, fab.name)
-    if tables and path.is_file() and suffix in TABLE_SUFFIXES:
+    if tables and is_file and suffix in TABLE_SUFFIXES:
         load = gonio.load_rgl if suffix == ".bsdf" else gonio.load_merl
         try:
             table = load(path)

@@ -24,6 +24,7 @@ from gonio.errors import FormatError
 from gonio.exr import count_missing
 from gonio.jsonplain import json_line
 from gonio.numtext import parse_number
+from gonio.safeopen import open_regular
 from gonio.table import Table
 
 __all__ = ["read_alta", "write_alta"]
@@ -50,7 +51,8 @@ COORDINATE_RANGES = {
 
 def _split(path: Path):
     """Header dict, comments and (line number, text) data lines of an ALTA text file."""
-    raw = path.read_bytes()
+    with open_regular(path, what="an ALTA table") as fh:   # no link, FIFO or device
+        raw = fh.read()
     if raw.startswith(b"\xef\xbb\xbf"):     # a UTF-8 byte-order mark (spreadsheets, editors)
         raw = raw[3:]
     head, comments, data = {}, [], []

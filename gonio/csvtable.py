@@ -16,8 +16,8 @@ from gonio.csvcells import comment_json
 from gonio.errors import FormatError, TableWarning
 from gonio.exr import count_missing, from_angles
 from gonio.jsonplain import plain
-from gonio.numtext import (column_digits, float32_column, format_numbers, is_number,
-                           parse_number)
+from gonio.numtext import column_digits, float32_column, format_numbers, is_number, parse_number
+from gonio.safeopen import read_bytes
 from gonio.table import Table, check_meta_size
 
 __all__ = ["read_csv", "write_csv", "read_rows", "parse_columns", "delimiter", "CsvRows",
@@ -181,8 +181,8 @@ def read_rows(path) -> CsvRows:
     ({'source': 'doc'}, ['theta_i', 'phi_i'], [(3, ['30', '0'])])
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")   # a spreadsheet's byte-order mark
+    try:        # opened once: no link, FIFO or device; a spreadsheet's byte-order mark dropped
+        text = read_bytes(path, max_bytes=None, what="a CSV table").decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise FormatError(path, f"not UTF-8 text (byte {exc.start}); not a CSV table") from None
     meta: dict = {}

@@ -9,6 +9,7 @@ import numpy as np
 
 from gonio.errors import FormatError
 from gonio.exr import count_missing, from_angles
+from gonio.safeopen import open_regular
 from gonio.table import Table
 
 __all__ = ["read_curet", "load_curet", "N_SAMPLES", "N_CONFIGS"]
@@ -18,8 +19,10 @@ N_CONFIGS = 205
 
 
 def _read_numbers(path: Path, ncols: int, nrows: int, what: str) -> np.ndarray:
+    with open_regular(path, what="a CUReT file") as fh:    # no link, FIFO or device
+        data = fh.read()
     try:
-        lines = [ln for ln in path.read_text(encoding="ascii").splitlines() if ln.strip()]
+        lines = [ln for ln in data.decode("ascii").splitlines() if ln.strip()]
     except UnicodeDecodeError:
         raise FormatError(path, f"not ASCII text; expected {what}") from None
     if len(lines) != nrows:

@@ -28,6 +28,7 @@ from brdf.frames import from_angles
 from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.jsonplain import plain
+from gonio.safeopen import open_regular
 from gonio.table import Table, check_meta_size
 
 __all__ = ["read_exr", "write_exr", "image_layout", "from_angles", "meta_to_json",
@@ -171,18 +172,22 @@ def read_exr(path) -> Table:
 
 def _read_channels(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
     """The header attributes and the channels (name -> pixel array) of an OpenEXR file."""
-    with open(path, "rb") as fh:
+    with open_regular(path, what="an OpenEXR table") as fh:    # no link, FIFO or device
         head = fh.read(4)
-    if head != _MAGIC:
-        raise FormatError(path, f"wrong magic {head!r}, expected {_MAGIC!r} (not an OpenEXR file)")
-    try:
-        with OpenEXR.File(str(path), header_only=True) as exr:
-            check_headers(path, [dict(part.header) for part in exr.parts])
-        with OpenEXR.File(str(path), separate_channels=True) as exr:
-            header = dict(exr.header())
-            chans = {k: np.array(v.pixels) for k, v in exr.channels().items()}
-    except (RuntimeError, OSError, ValueError) as exc:
-        raise FormatError(path, f"unreadable OpenEXR (truncated or corrupt): {exc}") from None
+        if head != _MAGIC:
+            raise FormatError(path, f"wrong magic {head!r}, expected {_MAGIC!r} (not an "
+                                    f"OpenEXR file)")
+        try:            # read from this descriptor, never by name again
+            fh.seek(0)
+            with OpenEXR.File(fh, header_only=True) as exr:
+                check_headers(path, [dict(part.header) for part in exr.parts])
+            fh.seek(0)
+            with OpenEXR.File(fh, separate_channels=True) as exr:
+                header = dict(exr.header())
+                chans = {k: np.array(v.pixels) for k, v in exr.channels().items()}
+        except (RuntimeError, OSError, ValueError) as exc:
+            raise FormatError(path, f"unreadable OpenEXR (truncated or corrupt): {exc}") \
+                from None
     return header, chans
 
 

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import errno
+import os
 import re
 from pathlib import Path
 
@@ -31,14 +33,18 @@ def read_pairs_csv(path) -> Geometry:
     Raises
     ------
     OSError
-        The file cannot be read.
+        The file does not exist or cannot be read.
     ValueError
-        A file too large for the memory; no header, a header without the four angle
+        A link, FIFO or device in place of the file (opened through
+        :func:`gonio.safeopen.open_regular`); a file too large for the memory; no header, a header without the four angle
         columns, or a bad row (with its line number and column: not a decimal number, or an
         angle outside :data:`gonio.csvtable.ANGLE_RANGES`): a :class:`gonio.FormatError`
         naming the file.
     """
     path = Path(path)
+    if not os.path.lexists(path):       # a link or FIFO: read_rows refuses it by name
+        raise FileNotFoundError(errno.ENOENT, "cannot read pairs file: No such file",
+                                str(path))
     try:
         check_table(path, "csv")
         text = read_rows(path)

@@ -136,7 +136,9 @@ def read(path, **options) -> Table:
     ------
     ValueError
         Unknown suffix (the message lists the known ones), an option the format does not
-        take, a missing option, or a table too large for the memory.
+        take, a missing option, a table too large for the memory, or a link, FIFO or device
+        in place of the file (every reader, and the size estimate, opens the file through
+        :func:`gonio.safeopen.open_regular`: one line naming it, at once, never a hang).
     FormatError
         The file is not what its name says, truncated or corrupt.
     """

@@ -30,6 +30,7 @@ from gonio.atomic import atomic_write
 from gonio.errors import FormatError
 from gonio.exr import count_missing
 from gonio.progress import progress_bar
+from gonio.safeopen import open_regular
 from gonio.table import Table
 
 __all__ = ["MerlBRDF", "load_merl", "read_merl", "write_merl", "merl_table", "half_diff",
@@ -108,8 +109,8 @@ def merl_directions(i, j, k, phi_h=0.0):
 def _read_raw(path) -> np.ndarray:
     """The (3, N) scaled-to-1/sr array (negative entries left as they are)."""
     path = Path(path)
-    size = path.stat().st_size
-    with open(path, "rb") as fh:
+    with open_regular(path, what="a MERL table") as fh:    # no link, FIFO or device
+        size = os.fstat(fh.fileno()).st_size
         head = fh.read(12)
         if len(head) < 12:
             raise FormatError(path, f"wrong size: {size} bytes, too short for the MERL header")

@@ -35,6 +35,7 @@ from gonio.errors import FormatError
 from gonio.geometry import HORIZON_EPS
 from gonio.csvcells import comment_text, text_cells
 from gonio.terminal import shown
+from gonio.safeopen import open_regular
 from gonio.travel import check_angles, order_for_travel, travel
 
 __all__ = ["write_pairs_csv", "read_pairs_header", "order_for_travel", "travel",
@@ -188,13 +189,12 @@ def read_pairs_header(path) -> dict[str, str]:
     {'free': 'gamma1,kd1'}
     """
     path = Path(path)
-    try:
-        if path.exists() and not path.is_file():
-            raise OSError(errno.EINVAL, "not a regular file", str(path))
-        with open(path, "rb") as f:
+    try:                    # opened once: no link, FIFO or device (one line, at once)
+        with open_regular(path, what="a plan file") as f:
             data = f.read(MAX_HEADER_BYTES + 1)
-    except OSError as exc:
-        raise OSError(exc.errno, f"cannot read plan file: {exc.strerror}", str(path)) from None
+    except ValueError as exc:
+        raise OSError(errno.EINVAL, "cannot read plan file: "
+                      + str(exc).removeprefix(f"{path}: "), str(path)) from None
     out: dict[str, str] = {}
     lines = data.split(b"\n")
     for lineno, raw in enumerate(lines, start=1):

@@ -14,6 +14,7 @@ from brdf.shading import DENOM_MIN
 from gonio.errors import FormatError
 from gonio.memory import check_memory
 from gonio.rglwarp import Conditional, elevation, mulsign_neg, phi2u, theta2u
+from gonio.safeopen import open_regular
 
 __all__ = ["read_tensor_file", "read_tensor_field", "tensor_fields", "load_bytes", "check_rgl",
            "load_rgl", "RGLBRDF", "HEADER_LIMIT", "MAX_FIELDS", "RGL_BYTES_PER_ELEMENT"]
@@ -109,7 +110,7 @@ def tensor_fields(path) -> tuple[dict[str, tuple], int]:
         As :func:`read_tensor_file`, before any field is read.
     """
     path = Path(path)
-    with open(path, "rb") as fh:
+    with open_regular(path, what="an RGL tensor file") as fh:   # no link, FIFO or device
         size = os.fstat(fh.fileno()).st_size
         return _field_table(path, fh.read(HEADER_LIMIT), size), size
 
@@ -172,7 +173,8 @@ def read_tensor_file(path) -> dict[str, np.ndarray]:
     """
     path = Path(path)
     check_rgl(path)
-    data = path.read_bytes()
+    with open_regular(path, what="an RGL tensor file") as fh:   # no link, FIFO or device
+        data = fh.read()
     return {name: np.frombuffer(data, dtype, math.prod(shape), offset).reshape(shape)
             for name, (dtype, shape, offset) in _field_table(path, data, len(data)).items()}
 
@@ -189,7 +191,7 @@ def read_tensor_field(path, name: str) -> np.ndarray | None:
         :data:`HEADER_LIMIT` bytes is called corrupt).
     """
     path = Path(path)
-    with open(path, "rb") as fh:
+    with open_regular(path, what="an RGL tensor file") as fh:
         size = os.fstat(fh.fileno()).st_size
         table = _field_table(path, fh.read(HEADER_LIMIT), size)
         if name not in table:

@@ -111,14 +111,15 @@ def open_regular(path, *, max_bytes: int | None = None, what: str = "file") -> B
         raise
 
 
-def read_bytes(path, *, max_bytes: int = MAX_STATE_BYTES, what: str = "file") -> bytes:
+def read_bytes(path, *, max_bytes: int | None = MAX_STATE_BYTES, what: str = "file") -> bytes:
     """The bytes of ``path`` (opened by :func:`open_regular`), at most ``max_bytes``.
 
-    A file that grows past the cap while it is read is refused too.
+    A file that grows past the cap while it is read is refused too. ``max_bytes=None``: no
+    cap (a table, whose size :func:`gonio.tablesize.check_table` checks against the memory).
     """
     with open_regular(path, max_bytes=max_bytes, what=what) as fh:
-        data = fh.read(max_bytes + 1)
-    if len(data) > max_bytes:
+        data = fh.read(-1 if max_bytes is None else max_bytes + 1)
+    if max_bytes is not None and len(data) > max_bytes:
         raise ValueError(f"{path}: more than the {_size(max_bytes)} {what} may have")
     return data
 

@@ -47,6 +47,7 @@ from gonio.memory import check_memory
 from gonio.merl import FILE_SIZE as MERL_FILE_SIZE
 from gonio.merl import SHAPE as MERL_SHAPE
 from gonio.rgl import load_bytes, read_tensor_field, tensor_fields
+from gonio.safeopen import open_regular
 from gonio.table import check_meta_size
 
 __all__ = ["Estimate", "estimate_table", "check_table", "text_estimate", "rgl_pairs",
@@ -162,7 +163,7 @@ class _TextScan:
 
 def _scan(path: Path, sep) -> _TextScan:
     scan = _TextScan(sep)
-    with open(path, "rb") as fh:
+    with open_regular(path, what="a table") as fh:     # no link, FIFO or device
         step = min(_CHUNK, max(os.fstat(fh.fileno()).st_size, 1))   # no 4 MiB for a small file
         while chunk := fh.read(step):
             scan.feed(chunk)
@@ -221,7 +222,8 @@ def _exr_estimate(path: Path) -> Estimate | None:
     header alone; a file that is no microcyl table (several parts, a deep image, metadata
     over the cap) refused first (:func:`gonio.exr.check_headers`)."""
     try:
-        with OpenEXR.File(str(path), header_only=True) as exr:
+        with open_regular(path, what="an OpenEXR table") as fh, \
+                OpenEXR.File(fh, header_only=True) as exr:
             headers = [dict(part.header) for part in exr.parts]
     except (RuntimeError, OSError, ValueError, TypeError):
         return None                             # the reader says what is wrong

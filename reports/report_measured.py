@@ -13,14 +13,16 @@ sentence of verdict drawn from those numbers (:func:`models_verdict`).
 
 from __future__ import annotations
 
-import shutil
+import os
 from pathlib import Path
 
 from analysis.fit.results import read_results
 from analysis.measuredjson import has_microcylinder, load_measured_json, results_path
+from gonio import atomic_write
 from gonio.safenames import check_component, check_inside
 from analysis.fit.loo import HIGH_K
 from reports.fitwords import SEPARATION_SE, gap_sentence
+from gonio.safeopen import MAX_FIGURE_BYTES, MAX_STATE_BYTES, copy_capped
 from reports.safehtml import Markup, html, join, table, url
 
 __all__ = ["read_measured", "measured_page", "PLOTS", "models_table", "models_verdict",
@@ -79,7 +81,7 @@ def read_measured(folder) -> dict:
         e["data_files"] = [check_inside(rpath.parent / f, rpath.parent, source=source,
                                         entry=f"datasets.{name}")
                            for f in ("results.json", "results.csv")
-                           if (rpath.parent / f).is_file()]
+                           if os.path.lexists(rpath.parent / f)]
         out[name] = e
     return out
 
@@ -177,6 +179,13 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         The report's (temporary) root folder.
     measured : dict
         From :func:`read_measured`.
+
+    Raises
+    ------
+    ValueError
+        A figure or data file that is now a link, not a regular file, or larger than it may
+        be (:data:`gonio.safeopen.MAX_FIGURE_BYTES`): each is copied from one descriptor
+        (:func:`gonio.safeopen.copy_capped`), never by name after an earlier check.
     """
     body = [Markup(
         '<p>The model fitted to measured fabrics with <code>microcyl fit-measured</code> '
@@ -210,14 +219,14 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         figs = []
         for key, caption in PLOTS.items():
             src = e["plot_files"].get(key)
-            if src is None or not src.is_file():
+            if src is None or not os.path.lexists(src):     # a link or FIFO: _copy names it
                 continue
-            shutil.copyfile(src, check_inside(dest / src.name, root))
+            _copy(src, check_inside(dest / src.name, root), MAX_FIGURE_BYTES, "a fit's figure")
             rel = f"{folder}/{name}/{src.name}"
             figs.append(html('<figure><img src="{}" alt="{}"><figcaption>{}</figcaption>'
                              "</figure>", url(rel), key, caption))
         for src in e["data_files"]:
-            shutil.copyfile(src, check_inside(dest / src.name, root))
+            _copy(src, check_inside(dest / src.name, root), MAX_STATE_BYTES, "a fit's results")
         verdict = "converged" if e.get("converged") else "NOT converged"
         q = e.get("quality", {})
         body.append(_section(folder, name, e, verdict, rows, figs,
@@ -233,6 +242,14 @@ def measured_page(root: Path, measured: dict, folder: str = "measured") -> tuple
         if "models" in e:
             summary[name]["models"] = e["models"]
     return join(body), summary
+
+
+def _copy(src: Path, dest: Path, max_bytes: int, what: str) -> None:
+    """Copy ``src`` to ``dest`` from one descriptor (:func:`gonio.safeopen.copy_capped`):
+    a link, a FIFO or a file larger than ``max_bytes`` (a sparse one included) is refused by
+    name, whatever it was when the report started, and nothing is left at ``dest``."""
+    with atomic_write(dest, "wb") as fh:
+        copy_capped(src, fh, max_bytes=max_bytes, what=what)
 
 
 def _ranked(models: dict) -> list[tuple[str, dict]]:

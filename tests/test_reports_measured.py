@@ -204,6 +204,50 @@ def test_a_planted_link_is_not_followed_out_of_the_folder(tmp_path):
         _report(tmp_path, mdir2)
 
 
+def test_a_plot_swapped_for_a_link_after_the_checks_is_refused_not_copied(tmp_path):
+    """The checks of read_measured pass; then, before the copy, the plot becomes a link to a
+    secret (what a colleague with write access to the shared folder can do while a report
+    runs): the copy refuses it by name and nothing of the secret reaches the report."""
+    from reports.report_measured import measured_page, read_measured
+    secret = tmp_path / "secret.txt"
+    secret.write_text("private key material")
+    mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json"}})
+    _fake_fit(mdir / "felt", plots={"lobes": "lobes.png"})
+    measured = read_measured(mdir)                      # every check passes here
+    plot = mdir / "felt" / "lobes.png"
+    plot.unlink()
+    plot.symlink_to(secret)
+    root = tmp_path / "rep"
+    root.mkdir()
+    with pytest.raises(ValueError) as err:
+        measured_page(root, measured)
+    msg = str(err.value)
+    assert str(plot) in msg and "symbolic link" in msg and "\n" not in msg, msg
+    copied = [p for p in root.rglob("*") if p.is_file()]
+    assert all(b"private" not in p.read_bytes() for p in copied), copied
+    assert not any(p.name.startswith(".microcyl-") for p in root.rglob("*"))
+
+
+def test_a_sparse_2gb_plot_is_refused_fast_and_nothing_large_is_written(tmp_path):
+    """A "PNG" of 2 GB that takes no disk (a sparse file) is refused by its size before a
+    byte is copied: the report stops in one line naming it and writes nothing large."""
+    import os
+    import time
+    mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json"}})
+    _fake_fit(mdir / "felt", plots={"lobes": "lobes.png"})
+    plot = mdir / "felt" / "lobes.png"
+    os.truncate(plot, 2 << 30)
+    t0 = time.monotonic()
+    with pytest.raises(ValueError) as err:
+        _report(tmp_path, mdir)
+    assert time.monotonic() - t0 < 60
+    msg = str(err.value)
+    assert str(plot) in msg and "2048 MiB" in msg and "\n" not in msg, msg
+    site = tmp_path / "site"
+    sizes = [p.stat().st_size for p in site.rglob("*") if p.is_file()] if site.exists() else []
+    assert sum(sizes) < 16 << 20, sizes
+
+
 @pytest.mark.parametrize("plot", ["../../x.png", "/tmp/x.png", ".x.png", "a/b.png"])
 def test_a_hostile_plot_name_in_results_json_is_refused(tmp_path, plot):
     mdir = _measured_dir(tmp_path / "m", {"felt": {"results": "felt/results.json"}})

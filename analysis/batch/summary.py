@@ -10,13 +10,14 @@ import csv
 import io
 import json
 import math
+import os
 from pathlib import Path
 
 import gonio
 from gonio.csvcells import text_cells
 from gonio.safenames import check_component
 from gonio.terminal import shown
-from gonio.statefields import FileFields
+from gonio.statefields import FileFields, load_json
 
 __all__ = ["BatchSummary", "SUMMARY_CSV", "SUMMARY_JSON", "SCHEMA", "FIRST_COLUMNS",
            "STATUSES", "BATCH_FILES", "check_row", "check_not_batch_file"]
@@ -148,13 +149,10 @@ class BatchSummary:
             raise ValueError(f"{path} is a folder, not the batch summary (the folder of a "
                              f"table named {SUMMARY_JSON}.*, from a microcyl that did not "
                              f"avoid the batch's file names?); move it away")
-        if path.exists():
-            try:
-                doc = json.loads(path.read_text(encoding="utf-8"))
-                ok = (isinstance(doc, dict) and doc.get("schema") == SCHEMA[0]
-                      and isinstance(doc.get("tables"), list))
-            except (OSError, ValueError, RecursionError) as exc:
-                raise ValueError(f"{path}: cannot read the batch summary ({exc})") from None
+        if os.path.lexists(path):       # a link, FIFO, huge or deep file: one line naming it
+            doc = load_json(path, "batch summary")
+            ok = (isinstance(doc, dict) and doc.get("schema") == SCHEMA[0]
+                  and isinstance(doc.get("tables"), list))
             if not ok:
                 raise ValueError(f"{path}: not a microcyl batch summary")
             for i, r in enumerate(doc["tables"]):

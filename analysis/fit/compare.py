@@ -24,8 +24,8 @@ values, which allows for correlation within a run; both are reported beside ``d_
 
 from __future__ import annotations
 
-import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +35,7 @@ from analysis.fit.checkpoint import CONFIG_FILE
 from analysis.fit.loo import LOO_FILE, import_arviz, load_loo
 from analysis.fit.results import read_results
 from gonio.terminal import shown
+from gonio.statefields import load_json
 
 __all__ = ["compare_fits", "read_fit", "difference_in_se", "paired_structure", "FIT_KEYS"]
 
@@ -57,25 +58,30 @@ def read_fit(folder) -> dict:
     Raises
     ------
     ValueError
-        Not a folder, no ``results.json``, no ``loo.npz``, or files that disagree on the
-        table (each message names the file).
+        Not a folder, no ``results.json``, no ``loo.npz``, a file that is a link, not a
+        regular file, too large or out of its schema (``fit_config.json`` through
+        :func:`gonio.statefields.load_json`, ``loo.npz`` through
+        :func:`gonio.safenpz.load_npz`), or files that disagree on the table (each message
+        names the file).
     """
     folder = Path(folder)
     if folder.is_symlink() or not folder.is_dir():
         raise ValueError(f"{folder}: not a fit's folder (not a directory, or a link)")
     rpath = folder / "results.json"
-    if not rpath.is_file():
+    if not os.path.lexists(rpath):          # a link or a FIFO: read_results names it
         raise ValueError(f"{rpath}: not found; is {folder} the output folder of "
                          f"`microcyl fit`?")
     results = read_results(rpath)
     loo = load_loo(folder)
     table = loo.table
     cpath = folder / CONFIG_FILE
-    if cpath.is_file() and not cpath.is_symlink():
+    if os.path.lexists(cpath):
+        doc = load_json(cpath, "fit configuration")     # a link, FIFO, deep or huge: one line
         try:
-            recorded = json.loads(cpath.read_text(encoding="utf-8"))["config"]["table"]
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise ValueError(f"{cpath}: unreadable fit configuration ({exc})") from None
+            recorded = doc["config"]["table"]
+        except (KeyError, TypeError):
+            raise ValueError(f"{cpath}: config.table is missing; a fit configuration records "
+                             f"its table's digest there") from None
         if str(recorded) != table:
             raise ValueError(f"{folder / LOO_FILE} was computed for another table "
                              f"({shown(table)}) than {cpath} records ({shown(recorded)}); run "

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import warnings
 from pathlib import Path
 
@@ -45,6 +46,7 @@ from scipy import stats
 
 from analysis.budget import memory_limit
 from gonio import atomic_write
+from gonio.safenpz import load_npz
 
 __all__ = ["Loo", "psis_loo", "psis_pointwise", "thin_draws", "draws_for", "load_loo",
            "import_arviz", "k_threshold", "LOO_FILE", "MAX_DRAWS", "MIN_DRAWS", "CELL_BUDGET",
@@ -56,6 +58,8 @@ warnings.filterwarnings("ignore", message=r"\s*ArviZ is undergoing a major refac
 
 #: The file of a fit's pointwise LOO values (beside ``results.json``).
 LOO_FILE = "loo.npz"
+_LOO_ARRAYS = ("elpd_i", "pareto_k", "pit", "point", "channel", "p_loo", "draws", "reff",
+               "table")
 #: Posterior draws the log-likelihood is evaluated at, at most.
 MAX_DRAWS = 400
 #: ... and at least (unless the chains or the memory hold fewer): with fewer, the Pareto k
@@ -198,18 +202,16 @@ def load_loo(folder) -> Loo:
     Raises
     ------
     ValueError
-        Missing, a link, or not a fit's LOO file (the message names the file).
+        Missing, a link or not a regular file, or not a fit's LOO file: a member missing, of
+        the wrong shape or type, or larger than it may be (declared sizes are checked before
+        anything is inflated, :func:`gonio.safenpz.load_npz`); the message names the file.
     """
     path = Path(folder) / LOO_FILE
-    if path.is_symlink():
-        raise ValueError(f"{path}: is a symbolic link; refusing to read it")
-    if not path.is_file():
+    if not os.path.lexists(path):
         raise ValueError(f"{path}: not found (a fit made before PSIS-LOO was added? run the "
                          f"same `microcyl fit` again: it resumes and writes it)")
+    d = load_npz(path, _LOO_ARRAYS, what="a fit's LOO file")   # sizes checked, then read
     try:
-        with np.load(path, allow_pickle=False) as z:
-            d = {k: z[k] for k in ("elpd_i", "pareto_k", "pit", "point", "channel", "p_loo",
-                                   "draws", "reff", "table")}
         n = d["elpd_i"].shape
         ok = (len(n) == 1 and n[0] > 0 and all(d[k].shape == n for k in
                                                  ("pareto_k", "pit", "point", "channel"))

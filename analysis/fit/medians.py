@@ -16,6 +16,7 @@ relative), as :class:`analysis.fit.LogPosterior` predicts it.
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 
 import numpy as np
@@ -100,7 +101,7 @@ class MedianFabric:
 
 def _config(folder: Path) -> dict:
     path = folder / CONFIG_FILE
-    if not path.is_file():
+    if not os.path.lexists(path):           # a link or a FIFO: read_config names it
         raise ValueError(f"{path}: cannot read the fit's configuration (no such file); is "
                          f"{folder} a `microcyl fit` output folder?")
     cfg = read_config(path)["config"]      # every field used here checked, errors named

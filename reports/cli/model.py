@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -140,7 +141,7 @@ def run_report(args):
         if not sep or name not in names:
             raise ValueError(f"--fit must be FABRIC=PATH/results.json with FABRIC one of "
                              f"{', '.join(names)}; got {item!r}")
-        if not Path(path).is_file():
+        if not os.path.lexists(path):   # a link or a FIFO: read_results names it
             raise ValueError(f"--fit {item!r}: no such file {path!r}")
         read_results(path)          # a damaged file: one line naming it and the field
         fits[name] = path

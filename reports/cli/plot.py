@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -151,7 +152,7 @@ def _check(args) -> None:
         raise ValueError("table: give the table file first (plot table TABLE [FABRIC...])")
     if args.view != "table" and not names:
         raise ValueError(f"{args.view}: give at least one FABRIC (positional or --fabric)")
-    if args.view == "table" and not Path(args.sources[0]).is_file():
+    if args.view == "table" and not os.path.lexists(args.sources[0]):  # a FIFO: gonio.read
         raise ValueError(f"table: no such file {args.sources[0]!r}")
     if args.view != "table" and (args.fit or args.preset):
         raise ValueError("--fit and --preset apply to the 'table' view only")

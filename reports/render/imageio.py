@@ -14,6 +14,7 @@ import OpenEXR
 from PIL import Image
 
 from gonio.atomic import atomic_write
+from gonio.safeopen import open_regular
 
 # colour-science's first import sets NumPy's print options to legacy="1.13", which would
 # change every later array repr (doctests included): keep the options as they were
@@ -109,8 +110,8 @@ def read_exr(path):
     ValueError
         If the file is not a readable OpenEXR image with R, G and B channels.
     """
-    try:
-        with OpenEXR.File(str(path)) as f:
+    try:            # opened once: no link, FIFO or device (one line naming it)
+        with open_regular(path, what="an OpenEXR image") as fh, OpenEXR.File(fh) as f:
             ch = f.channels()
             if "RGB" in ch:
                 return np.asarray(ch["RGB"].pixels, dtype=np.float32)
@@ -131,7 +132,8 @@ def read_exr_attributes(path) -> dict:
     1.5
     """
     try:
-        with OpenEXR.File(str(path)) as f:   # the header is emptied when the file closes
+        with open_regular(path, what="an OpenEXR image") as fh, \
+                OpenEXR.File(fh) as f:   # the header is emptied when the file closes
             return {k: v for k, v in f.header().items() if isinstance(v, (float, str))}
     except (KeyError, RuntimeError) as exc:
         raise ValueError(f"{path}: not a readable OpenEXR file ({exc})") from None

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from analysis.folderlock import LOCK_NAME, REPORT_MARKER
 from gonio.atomic import atomic_write, make_temporary_folder
+from gonio.safeopen import read_bytes
 
 __all__ = ["MARKER", "check_output_dir", "check_report_folder", "swap_into_place",
            "write_file", "write_marker"]
@@ -79,14 +80,8 @@ def _entries(folder: Path) -> tuple[set, set]:
 def _listed(folder: Path) -> set | None:
     """The files the marker of ``folder`` lists; None when it lists none (a marker of an
     older microcyl, or damaged)."""
-    try:
-        fd = os.open(folder / MARKER, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError:
-        return None
-    try:
-        with os.fdopen(fd, "rb") as fh:
-            data = fh.read(_MARKER_MAX + 1)
-        doc = json.loads(data) if len(data) <= _MARKER_MAX else None
+    try:            # opened once: no link, FIFO or device; at most _MARKER_MAX bytes
+        doc = json.loads(read_bytes(folder / MARKER, max_bytes=_MARKER_MAX, what="a marker"))
     except (OSError, ValueError, RecursionError):
         return None
     files = doc.get("files") if isinstance(doc, dict) and doc.get("kind") == _KIND else None

@@ -8,7 +8,8 @@ from gonio.alta import read_alta, write_alta
 from gonio.atomic import atomic_write
 from gonio.progress import progress_bar
 from gonio.jsonplain import json_line, meta_text, plain
-from gonio.csvtable import read_csv, write_csv
+from gonio.csvtable import read_csv
+from gonio.csvwrite import write_csv
 from gonio.curet import load_curet, read_curet
 from gonio.errors import FormatError, TableWarning
 from gonio.exr import read_exr, write_exr

@@ -7,7 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from gonio.alta import read_alta, write_alta
-from gonio.csvtable import read_csv, write_csv
+from gonio.csvtable import read_csv
+from gonio.csvwrite import write_csv
 from gonio.curet import read_curet
 from gonio.exr import count_missing, from_angles, read_exr, write_exr
 from gonio.merl import read_merl, write_merl

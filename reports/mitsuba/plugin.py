@@ -10,8 +10,8 @@ also take a Mitsuba texture (``bitmap``, ``checkerboard``, ...): f_r uses its va
 hit, the sampler its mean (:data:`reports.mitsuba.bsdf.TEXTURED_KEYS`). ``mi.traverse`` exposes each
 thread's ``eta``, ``albedo``, ``kd``, ``gamma_s``, ``gamma_v`` and ``area`` (1 or 2 appended) and
 ``rotation`` for editing (:data:`reports.mitsuba.bsdf.TRAVERSED_THREAD_KEYS`); a JIT variant
-then reuses its compiled kernel. The kernel is written in
-Dr.Jit (:mod:`reports.mitsuba.kernel`) and runs in ``scalar_rgb``, ``llvm_ad_rgb`` and
+then reuses its compiled kernel. The kernel is brdf's Dr.Jit kernel (:mod:`brdf.jit.kernel`,
+:mod:`brdf.jit.sampler`, in the variant's float type) and runs in ``scalar_rgb``, ``llvm_ad_rgb`` and
 ``cuda_ad_rgb``.
 
 Conventions. Mitsuba's ``si.wi`` points toward the viewer and a BSDF's ``wo`` toward the light:

@@ -516,7 +516,7 @@ def test_kernel_on_its_consts_matches_fabric_without_the_plugin(scalar):
     from brdf.jit import consts as mconsts, sampler as mkernel
     from reports.mitsuba import bsdf as mbsdf
     fab = brdf.fabric("silk_shot", masking=False, gap="outgoing")
-    k = mconsts.consts(fab, mbsdf.variant_types())
+    k = mconsts.consts(fab.plan, mbsdf.variant_types(), brdf.sampling.lobe_probabilities(fab))
     assert k.masking is False and k.reweighting is True and str(k.gap) == "outgoing"
     assert k.gap_area == pytest.approx(1 - fab.threads[0].area - fab.threads[1].area)
     assert k.comp_cdf[-1] == 1.0 and len(k.comp_cdf) == k.comp_size

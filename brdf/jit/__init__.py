@@ -1,0 +1,128 @@
+"""brdf's compiled backend: the microcylinder kernel in Dr.Jit (:mod:`brdf.jit.kernel`),
+written once for every Dr.Jit float type, behind the same :class:`brdf.FabricPlan` as the
+NumPy kernel (:mod:`brdf.kernel`, :mod:`brdf.shading`), which stays the reference.
+
+``Fabric.eval``, ``Fabric.eval_threads`` and ``Prepared.eval`` (float64) run on Dr.Jit's LLVM
+backend in float64 (:mod:`brdf.jit.llvm`) when :func:`backend` says ``"drjit"``; the Mitsuba
+plugin (:mod:`reports.mitsuba.bsdf`) runs the same kernel in its variant's float32.
+``MICROCYL_BACKEND=numpy|drjit`` chooses; unset, the default is ``drjit`` where it runs
+(Dr.Jit importable, its LLVM backend initialised with an LLVM of version 16 or later: LLVM 14
+and 15 abort the process on Dr.Jit's ``fmaximum``), else ``numpy`` with the reason written
+once per process (a :class:`RuntimeWarning`).
+
+Dr.Jit's LLVM kernels flush subnormal numbers to zero: pairs with a subnormal component
+(:func:`subnormal_pairs`, |w_k| < 2.2e-308, rare) are left to the NumPy kernel, which keeps
+them, so that both backends give the same f_r everywhere.
+
+This package imports no Dr.Jit: :func:`compiled` loads it on first use (about a second).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import warnings
+
+import numpy as np
+
+__all__ = ["backend", "available", "compiled", "subnormal_pairs", "BACKENDS", "BACKEND_ENV",
+           "MIN_LLVM"]
+
+#: The kernels ``MICROCYL_BACKEND`` chooses between.
+BACKENDS = ("numpy", "drjit")
+#: The environment variable that chooses.
+BACKEND_ENV = "MICROCYL_BACKEND"
+#: The least LLVM major version Dr.Jit's LLVM backend runs the kernel with.
+MIN_LLVM = 16
+
+
+def compiled():
+    """:mod:`brdf.jit.llvm` (the LLVM float64 driver), imported on first use: the one place
+    brdf loads Dr.Jit.
+
+    Raises
+    ------
+    ImportError
+        Dr.Jit is not installed.
+    """
+    # optional dependency, loaded on use (drjit, about a second): llvm imports it at its top
+    from brdf.jit import llvm
+    return llvm
+
+
+@functools.cache
+def available() -> tuple[bool, str]:
+    """Whether the Dr.Jit backend runs in this process, and why not (asked once).
+
+    Returns
+    -------
+    (bool, str)
+        True and "" where Dr.Jit imports, its LLVM backend initialised with LLVM >=
+        :data:`MIN_LLVM`, and a small kernel gives the right answer; else False and the
+        reason.
+    """
+    try:
+        llvm = compiled()
+    except ImportError as exc:
+        return False, f"Dr.Jit is not importable ({exc})"
+    return llvm.probe(MIN_LLVM)
+
+
+def backend() -> str:
+    """The kernel that ``Fabric.eval`` and ``Prepared.eval`` run: ``"numpy"`` or
+    ``"drjit"`` (read from ``MICROCYL_BACKEND`` at each call; the probe of Dr.Jit is made
+    once).
+
+    Raises
+    ------
+    ValueError
+        ``MICROCYL_BACKEND`` is set to something else than ``numpy`` or ``drjit``.
+    RuntimeError
+        ``MICROCYL_BACKEND=drjit`` where Dr.Jit does not run (the reason given).
+
+    Examples
+    --------
+    >>> import os
+    >>> os.environ[BACKEND_ENV] = "numpy"
+    >>> backend()
+    'numpy'
+    >>> del os.environ[BACKEND_ENV]
+    >>> backend() == ("drjit" if available()[0] else "numpy")
+    True
+    """
+    choice = os.environ.get(BACKEND_ENV, "").strip()
+    if choice == "numpy":
+        return "numpy"
+    if choice not in ("", "drjit"):
+        raise ValueError(f"{BACKEND_ENV} must be one of {', '.join(BACKENDS)} (or unset); "
+                         f"got {choice!r}")
+    ok, why = available()
+    if ok:
+        return "drjit"
+    if choice == "drjit":
+        raise RuntimeError(f"{BACKEND_ENV}=drjit, but Dr.Jit does not run here: {why}")
+    _fallback(why)
+    return "numpy"
+
+
+@functools.cache
+def _fallback(why: str) -> None:
+    """Say once per process why the NumPy kernel runs."""
+    warnings.warn(f"microcyl: the Dr.Jit backend does not run here ({why}); using the "
+                  f"NumPy kernel (set {BACKEND_ENV}=numpy to silence this)", RuntimeWarning,
+                  stacklevel=3)
+
+
+def subnormal_pairs(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+    """The pairs of unit (n, 3) ``wi``, ``wo`` with a subnormal component, which Dr.Jit's
+    kernels would take as 0 (the NumPy kernel evaluates them): a bool array (n,).
+
+    >>> w = np.array([[0.6, 0.0, 0.8], [1.0, 0.0, 1e-310]])
+    >>> subnormal_pairs(w, w[::-1]).tolist()
+    [True, True]
+    >>> subnormal_pairs(w[:1], w[:1]).tolist()
+    [False]
+    """
+    tiny = np.finfo(np.float64).tiny
+    sub = lambda w: ((w != 0.0) & (np.abs(w) < tiny)).any(axis=-1)  # noqa: E731
+    return sub(wi) | sub(wo)

@@ -21,9 +21,10 @@ import itertools
 # optional dependency: this module is imported only through brdf.jit.llvm() and the plugin
 import drjit as dr
 
-from brdf import sampling, shading
+import numpy as np
+
+from brdf import shading
 from brdf.options import Gap, Transmission
-from brdf.plan import FabricPlan, ThreadPlan, plan_of
 
 __all__ = ["Types", "Consts", "ThreadConsts", "consts", "opaque", "MIN_COMPONENTS",
            "GAUSS_NORM"]
@@ -99,7 +100,7 @@ class Consts:
     hemisphere, then per thread, tangent offset and lobe; :func:`brdf.sampling.sample`'s
     mixture), padded to :data:`MIN_COMPONENTS` or the next power of two with components
     that are never drawn; ``comp_cdf`` is its cumulative distribution (exactly 1 from the
-    last real component on). Without the sampler (``consts(..., sampler=False)``) they are
+    last real component on). Without the sampler (``consts(..., lobes=None)``) they are
     None and ``sampled`` is false for both threads.
     """
 
@@ -139,7 +140,7 @@ def _clamped(x: float) -> float:
     return min(max(float(x), lo), hi)
 
 
-def _thread_consts(c: ThreadPlan, lobe_p, t: Types) -> ThreadConsts:
+def _thread_consts(c, lobe_p, t: Types) -> ThreadConsts:
     """:class:`ThreadConsts` of the thread whose plan is ``c``."""
     kd, gs, gv = float(c.kd), _clamped(c.gamma_s), _clamped(c.gamma_v)
     eta2 = _clamped(c.eta) ** 2
@@ -157,7 +158,7 @@ def _thread_consts(c: ThreadPlan, lobe_p, t: Types) -> ThreadConsts:
         (f(0.5 / gs), f(0.5 / gv)), tuple(f(p) for p in lobe_p))
 
 
-def _components(plan: FabricPlan, thread_p, lobe_p) -> list:
+def _components(plan, thread_p, lobe_p) -> list:
     """The sampler's components: (probability, thread, cos, sin, kind, sigma) each."""
     rows = [(1.0 - float(thread_p.sum()), 0, 1.0, 0.0, -1, 1.0)]
     for j, c in enumerate(plan.threads):
@@ -170,7 +171,7 @@ def _components(plan: FabricPlan, thread_p, lobe_p) -> list:
     return rows
 
 
-def _sampler_table(plan: FabricPlan, thread_p, lobe_p, t: Types) -> dict:
+def _sampler_table(plan, thread_p, lobe_p, t: Types) -> dict:
     """The ``comp_*`` fields of :class:`Consts`."""
     rows = _components(plan, thread_p, lobe_p)
     size = max(MIN_COMPONENTS, 1 << (len(rows) - 1).bit_length())
@@ -185,19 +186,24 @@ def _sampler_table(plan: FabricPlan, thread_p, lobe_p, t: Types) -> dict:
                 comp_sigma=opaque(list(cols[5]), t.Float))
 
 
-def consts(fabric, types: Types, sampler: bool = True) -> Consts:
-    """The kernel's constants of ``fabric`` (a :class:`brdf.Fabric` or its
-    :class:`brdf.FabricPlan`) in ``types``; with ``sampler`` the sampler's tables too (the
-    Mitsuba plugin's ``sample`` and density)."""
-    plan = plan_of(fabric)
-    thread_p, lobe_p = sampling.lobe_probabilities(plan)
+def consts(plan, types: Types, lobes=None) -> Consts:
+    """The kernel's constants of ``plan`` (a :class:`brdf.FabricPlan`) in ``types``.
+
+    ``lobes``: the sampler's ``(thread_p, lobe_p)`` (:func:`brdf.sampling.lobe_probabilities`
+    of the plan), for its tables and density (the Mitsuba plugin's ``sample`` and ``pdf``);
+    None for f_r alone.
+    """
     t = types
+    if lobes is None:
+        thread_p, lobe_p = np.zeros(2), np.zeros((2, 3))
+    else:
+        thread_p, lobe_p = (np.asarray(x, dtype=np.float64) for x in lobes)
     threads = tuple(_thread_consts(c, lobe_p[j], t) for j, c in enumerate(plan.threads))
     opts = plan.options
     area = 1.0 - float(plan.threads[0].area) - float(plan.threads[1].area)
-    table = _sampler_table(plan, thread_p, lobe_p, t) if sampler else {}
+    table = {} if lobes is None else _sampler_table(plan, thread_p, lobe_p, t)
     return Consts(t, threads, opts.masking, opts.reweighting, opts.transmission,
                   opts.gap, float(opts.rotation), opaque(area, t.Float),
-                  tuple(sampler and bool(p > 0.0) for p in thread_p),
+                  tuple(lobes is not None and bool(p > 0.0) for p in thread_p),
                   opaque(1.0 - float(thread_p.sum()), t.Float),
                   tuple(opaque(float(p), t.Float) for p in thread_p), **table)

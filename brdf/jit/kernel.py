@@ -78,10 +78,12 @@ def narrow(x, k: Consts):
 
 
 def _norm(x, y):
-    """sqrt(x^2 + y^2) (double precision), without underflow below 2^-500 (as hypot)."""
-    r = dr.sqrt(x * x + y * y)
-    rs = dr.sqrt(dr.square(x * _BIG) + dr.square(y * _BIG)) * _SMALL
-    return dr.select(r < _TINY, rs, r)
+    """sqrt(x^2 + y^2) (double precision), without underflow below 2^-500 (as hypot):
+    tiny components are scaled by 2^600 first (exact)."""
+    tiny = (dr.abs(x) < _TINY) & (dr.abs(y) < _TINY)
+    kind = type(x)          # (dr.select of two Python floats would make them float32)
+    up, down = dr.select(tiny, kind(_BIG), 1.0), dr.select(tiny, kind(_SMALL), 1.0)
+    return dr.sqrt(dr.square(x * up) + dr.square(y * up)) * down
 
 
 def thread_axes(w, c, s):
@@ -160,14 +162,20 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
                           geo / dr.select(csum > 0.0, csum, 1.0), p, ci, cr, si, sr, xi)
 
 
-def _fresnel(eta2, eta2m1, c):
+def _fresnel(eta2, eta2m1, c, wide_float: bool):
     """Unpolarized Fresnel reflectance F_r and transmission 1 - F_r at incidence cosine c
-    (``eta2`` = eta^2, ``eta2m1`` = eta^2 - 1)."""
+    (``eta2`` = eta^2, ``eta2m1`` = eta^2 - 1), with one division. In double precision
+    (``wide_float``) 1 - F_r is taken as such, as the NumPy kernel takes it; in float32 in
+    the form without cancellation (module notes)."""
     g = dr.sqrt(eta2m1 + c * c)
     e2c = eta2 * c
     a, b = c + g, e2c + g
-    rs, rp = (c - g) / a, (e2c - g) / b
-    return 0.5 * (rs * rs + rp * rp), 2.0 * c * g * (1.0 / (a * a) + eta2 / (b * b))
+    inv = 1.0 / (a * b)
+    rs, rp = (c - g) * b * inv, (e2c - g) * a * inv
+    f = 0.5 * (rs * rs + rp * rp)
+    if wide_float:
+        return f, 1.0 - f
+    return f, 2.0 * c * g * (dr.square(b * inv) + eta2 * dr.square(a * inv))
 
 
 def sample_shading(th, g: SampleGeometry, transmission: Transmission):
@@ -178,11 +186,13 @@ def sample_shading(th, g: SampleGeometry, transmission: Transmission):
     ``eta2``, ``eta2m1``, ``kd``, ``gs_k``, ``gs_c``, ``gv_k``, ``gv_c``): opaque values,
     or one per lane for a batch of parameter sets.
     """
-    fr, tr = _fresnel(th.eta2, th.eta2m1, g.cg)
+    wide_float = dr.type_v(g.cg) == dr.VarType.Float64 or not dr.is_jit_v(g.cg)
+    fr, tr = _fresnel(th.eta2, th.eta2m1, g.cg, wide_float)
     if transmission is Transmission.HALF_ANGLE:
         ft = tr * tr
     else:
-        ft = _fresnel(th.eta2, th.eta2m1, g.ci)[1] * _fresnel(th.eta2, th.eta2m1, g.cr)[1]
+        ft = (_fresnel(th.eta2, th.eta2m1, g.ci, wide_float)[1]
+              * _fresnel(th.eta2, th.eta2m1, g.cr, wide_float)[1])
     gs = dr.exp(g.th2 * th.gs_k) * th.gs_c
     gv = dr.exp(g.th2 * th.gv_k) * th.gv_c
     return fr * gs * g.ks, ft * (gv + th.kd) * g.kv

@@ -1,0 +1,266 @@
+r"""The Dr.Jit kernel (:mod:`brdf.jit.kernel`) on the LLVM backend in float64: what
+``Fabric.eval`` (:func:`eval_pairs`) and ``Prepared.eval`` (:class:`PreparedJit`) run when
+:func:`brdf.jit.backend` is ``"drjit"``, and the gradients of a fit's batched f_r with
+respect to the optical parameters (:meth:`PreparedJit.eval_and_grad`, Dr.Jit's forward-mode
+AD).
+
+Every number of a fabric or a batch is an evaluated array or an opaque value, never a
+literal of the kernel's code: one compiled kernel per set of options serves every fabric,
+pair count and batch size (Dr.Jit's kernel cache keeps it), and only its Python tracing is
+repeated per call. ``Fabric.eval`` runs one fused kernel, a lane a pair, a symbolic loop over
+each thread's tangent samples. ``Prepared`` runs the samples' geometry once (a lane a pair
+and a sample, :func:`brdf.jit.kernel.sample_geometry`), then each ``eval`` one kernel, a
+lane a parameter set and a pair, whose loop over the samples gathers that geometry and
+shades it (:func:`brdf.jit.kernel.sample_shading`).
+
+Imports Dr.Jit at its top: it is imported only through :func:`brdf.jit.compiled`.
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+
+import numpy as np
+
+# optional dependency: this module is imported only through brdf.jit.compiled()
+import drjit as dr
+from drjit.llvm.ad import Array3f64, Float64, UInt32
+
+from brdf.combine import DENOM_MIN
+from brdf.jit.consts import GAUSS_NORM, Consts, Types, consts, opaque
+from brdf.jit.kernel import (SampleGeometry, at, fabric_q, fabric_sums, inverse_rho, loop,
+                             sample_geometry, sample_shading, thread_axes)
+from brdf.options import Transmission
+from brdf.shading import PARAM_CLAMP
+
+__all__ = ["TYPES", "probe", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS"]
+
+#: The kernel's types here: float64 throughout, on the LLVM backend.
+TYPES = Types(Float64, Float64, UInt32, Array3f64, Array3f64)
+#: The parameters :meth:`PreparedJit.eval_and_grad` differentiates by (``Prepared.eval``'s
+#: keywords).
+GRAD_PARAMS = ("eta", "kd", "gamma_s", "gamma_v", "area", "albedo")
+_CONSTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()   # plan -> plan_consts
+
+
+def probe(min_llvm: int) -> tuple[bool, str]:
+    """Whether the LLVM backend runs here (:func:`brdf.jit.available`)."""
+    if not dr.has_backend(dr.JitBackend.LLVM):
+        return False, "Dr.Jit's LLVM backend did not initialise (no libLLVM found; set " \
+                      "DRJIT_LIBLLVM_PATH)"
+    version = dr.detail.llvm_version()
+    if version[0] < min_llvm:
+        return False, (f"Dr.Jit found LLVM {'.'.join(map(str, version))}, which fails on its "
+                       f"kernels; set DRJIT_LIBLLVM_PATH to a libLLVM {min_llvm} or later")
+    x = dr.maximum(Float64([1.0, 2.0]), Float64([1.5, 0.0]))
+    if float(dr.sum(x)[0]) != 3.5:
+        return False, "a test kernel gave a wrong answer"
+    return True, ""
+
+
+def plan_consts(plan) -> tuple[Consts, Float64, Float64]:
+    """The kernel's constants of ``plan`` and its rotation's (cos, sin), made once a plan."""
+    got = _CONSTS.get(plan)
+    if got is None:
+        rot = plan.options.rotation
+        got = (consts(plan, TYPES), opaque(math.cos(rot), Float64),
+               opaque(math.sin(rot), Float64))
+        _CONSTS[plan] = got
+    return got
+
+
+def _vector(w: np.ndarray) -> Array3f64:
+    """(n, 3) float64 directions as an Array3f64 in memory that Dr.Jit allocated (NumPy's,
+    mapped, can be unaligned, and a kernel's loads say so: another kernel, compiled anew)."""
+    out = Array3f64(*(Float64(np.ascontiguousarray(w[:, c])) + 0.0 for c in range(3)))
+    dr.eval(out)
+    return out
+
+
+def _inverse_denominator(q, zi):
+    """1 / max(Q n.wi, DENOM_MIN), 0 where Q or n . wi is not positive
+    (:func:`brdf.combine.inverse_denominator`)."""
+    ok = (q > 0.0) & (zi > 0.0)
+    return dr.select(ok, 1.0 / dr.maximum(q * zi, DENOM_MIN), 0.0)
+
+
+def _rgb(parts, inv):
+    """sum_j a_j (S_j + A_j V_j) / (Q n.wi) (``parts``: per thread (area, albedo, surf, vol)),
+    in the order of :func:`brdf.combine.combine_rgb`."""
+    (a1, alb1, s1, v1), (a2, alb2, s2, v2) = parts
+    base = (s1 * a1 + s2 * a2) * inv
+    w1, w2 = v1 * inv * a1, v2 * inv * a2
+    return Array3f64(*(w1 * alb1[ch] + base + w2 * alb2[ch] for ch in range(3)))
+
+
+def _numpy(x) -> np.ndarray:
+    """An evaluated Array3f64 as an (n, 3) float64 array."""
+    return np.ascontiguousarray(x.numpy().T, dtype=np.float64)
+
+
+def eval_pairs(plan, wi: np.ndarray, wo: np.ndarray, split: bool = False):
+    """f_r (1/sr) of unit (C, 3) pairs above the horizon: (C, 3) RGB, or per thread (C, 2,
+    3) with ``split`` (:meth:`brdf.FabricPlan.eval`'s kernel)."""
+    k, rc, rs = plan_consts(plan)
+    light, view = _vector(wi), _vector(wo)
+    sums = fabric_sums(k, light, view, rc, rs)
+    inv = _inverse_denominator(fabric_q(k, sums, light.z, view.z), light.z)
+    parts = [(th.area, th.albedo, s[0], s[1]) for th, s in zip(k.threads, sums)]
+    if not split:
+        out = _rgb(parts, inv)
+        dr.eval(out)
+        return _numpy(out)
+    outs = [Array3f64(*(a * (s + alb[ch] * v) * inv for ch in range(3)))
+            for a, alb, s, v in parts]
+    dr.eval(outs)
+    return np.stack([_numpy(o) for o in outs], axis=1)
+
+
+class _RowConsts:
+    """A thread's optical constants per lane (:class:`brdf.jit.consts.ThreadConsts`' names)
+    from its raw parameters per lane (eta, kd, gammas in radians), clamped as the NumPy
+    kernel clamps them (:data:`brdf.shading.PARAM_CLAMP`)."""
+
+    def __init__(self, eta, kd, gamma_s, gamma_v):
+        eta, gs, gv = (dr.clip(x, *PARAM_CLAMP) for x in (eta, gamma_s, gamma_v))
+        self.eta2 = eta * eta
+        self.eta2m1 = self.eta2 - 1.0
+        self.kd = kd
+        self.gs_k, self.gs_c = -0.125 / (gs * gs), GAUSS_NORM / gs
+        self.gv_k, self.gv_c = -0.125 / (gv * gv), (1.0 - kd) * GAUSS_NORM / gv
+
+
+class _ThreadGeom:
+    """One thread's geometry of the prepared pairs, evaluated: arrays of C x S entries
+    (pair-major: entry c S + s is sample s of pair c, so that a lane's loop over the samples
+    reads consecutive entries), and the P mean of each pair."""
+
+    def __init__(self, g: SampleGeometry, keep_cos: bool, pmean):
+        self.th2, self.cg, self.ks, self.kv = g.th2, g.cg, g.ks, g.kv
+        self.ci, self.cr = (g.ci, g.cr) if keep_cos else (None, None)
+        self.pmean = pmean
+
+    def at(self, i) -> SampleGeometry:
+        """The geometry of entries ``i`` (one per lane)."""
+        get = lambda a: None if a is None else dr.gather(Float64, a, i)  # noqa: E731
+        return SampleGeometry(get(self.th2), get(self.cg), get(self.ks), get(self.kv), None,
+                              get(self.ci), get(self.cr), None, None, None)
+
+
+class PreparedJit:
+    """The Dr.Jit half of :class:`brdf.Prepared`: n fixed pairs' geometry, shaded for
+    batches of parameter sets.
+
+    Parameters
+    ----------
+    plan : brdf.FabricPlan
+    wi, wo : ndarray, shape (C, 3)
+        Unit directions above the horizon (``Prepared`` has checked and filtered them).
+    """
+
+    def __init__(self, plan, wi: np.ndarray, wo: np.ndarray):
+        self.plan = plan
+        self.k, rc, rs = plan_consts(plan)
+        self.size = wi.shape[0]
+        self._n = opaque(self.size, UInt32)
+        light, view = _vector(wi), _vector(wo)
+        self._zi, self._zo = light.z, view.z
+        self._geoms = [self._thread_geometry(j, light, view, rc, rs) for j in range(2)]
+
+    def _thread_geometry(self, j, light, view, rc, rs) -> _ThreadGeom:
+        """Thread j's geometry, a lane a (pair, sample)."""
+        k, th, tp = self.k, self.k.threads[j], self.plan.threads[j]
+        ns = tp.ca.size
+        idx = dr.arange(UInt32, ns * self.size)
+        c = idx // th.n
+        s = idx - c * th.n
+        axes = [thread_axes(Array3f64(*(dr.gather(Float64, x, c) for x in w)), rc, rs)[j]
+                for w in (light, view)]
+        g = sample_geometry(k, at(th.ca, s, Float64), at(th.sa, s, Float64), *axes,
+                            tuple(inverse_rho(k, a) for a in axes))
+        keep_cos = k.transmission is Transmission.LONGITUDINAL
+        dr.eval(g.th2, g.cg, g.ks, g.kv, *((g.ci, g.cr) if keep_cos else ()),
+                *((g.p,) if k.reweighting else ()))
+        pmean = None
+        if k.reweighting:
+            p = np.asarray(g.p.numpy(), dtype=np.float64).reshape(self.size, ns)
+            pmean = Float64(p @ np.asarray(tp.weight))
+        return _ThreadGeom(g, keep_cos, pmean)
+
+    @staticmethod
+    def inputs(par) -> dict:
+        """``par``'s arrays as Dr.Jit arrays: per name a list of the two threads' Float64
+        arrays (nb,); ``albedo`` a list of the threads' (R, G, B) triples."""
+        col = lambda a, j: Float64(np.ascontiguousarray(a[:, j], dtype=np.float64))  # noqa: E731
+        out = {name: [col(getattr(par, name), j) for j in range(2)]
+               for name in ("eta", "kd", "gamma_s", "gamma_v", "area")}
+        out["albedo"] = [tuple(col(par.albedo[:, j], ch) for ch in range(3)) for j in range(2)]
+        return out
+
+    def shade(self, x: dict, nb: int) -> Array3f64:
+        """f_r (1/sr) of every (pair, parameter set), a lane each (pair-major: the lanes of
+        a vector share their pair, and so the geometry they read), from the Dr.Jit arrays
+        ``x`` of :meth:`inputs` (unevaluated: AD may flow through it)."""
+        k, nbo = self.k, opaque(nb, UInt32)
+        idx = dr.arange(UInt32, nb * self.size)
+        c = idx // nbo
+        b = idx - c * nbo
+        row = lambda a: dr.gather(Float64, a, b)  # noqa: E731
+        sums, parts = [], []
+        for j, (th, geom) in enumerate(zip(k.threads, self._geoms)):
+            rc = _RowConsts(*(row(x[name][j]) for name in ("eta", "kd", "gamma_s", "gamma_v")))
+
+            def terms(s, th=th, geom=geom, rc=rc):
+                w = at(th.weight, s, Float64)
+                return tuple(w * t for t in sample_shading(rc, geom.at(c * th.n + s),
+                                                           k.transmission))
+
+            surf, vol = loop(th.n, terms, UInt32(0), Float64(0.0), Float64(0.0))
+            pmean = None if geom.pmean is None else dr.gather(Float64, geom.pmean, c)
+            sums.append((surf, vol, pmean))
+            parts.append((row(x["area"][j]), tuple(map(row, x["albedo"][j])), surf, vol))
+        zi, zo = dr.gather(Float64, self._zi, c), dr.gather(Float64, self._zo, c)
+        a1, a2 = parts[0][0], parts[1][0]
+        q = fabric_q(k, sums, zi, zo, (a1, a2, 1.0 - a1 - a2))
+        return _rgb(parts, _inverse_denominator(q, zi))
+
+    def eval(self, par) -> np.ndarray:
+        """f_r (1/sr), shape (nb, C, 3), of the batch ``par`` (checked, gammas in radians)."""
+        nb = par.eta.shape[0]
+        out = self.shade(self.inputs(par), nb)
+        dr.eval(out)
+        return _numpy(out).reshape(self.size, nb, 3).transpose(1, 0, 2)
+
+    def eval_and_grad(self, par) -> tuple[np.ndarray, dict]:
+        """f_r (nb, C, 3) and its derivatives by each of :data:`GRAD_PARAMS`, by Dr.Jit's
+        forward-mode AD (one pass a parameter and thread).
+
+        Returns
+        -------
+        f : ndarray, shape (nb, C, 3)
+        grads : dict of ndarray, shape (nb, C, 3, 2)
+            ``grads[name][b, c, ch, j]`` = d f_r[b, c, ch] / d name_j of set b (per degree
+            for the gammas; for ``albedo`` the derivative by thread j's albedo in the same
+            channel ch, the others' being 0).
+        """
+        nb = par.eta.shape[0]
+        f = self.eval(par)
+        grads = {}
+        for name in GRAD_PARAMS:
+            cols = []
+            for j in range(2):
+                x = self.inputs(par)
+                var = x[name][j] if name == "albedo" else (x[name][j],)
+                for v in var:
+                    dr.enable_grad(v)
+                out = self.shade(x, nb)
+                for v in var:
+                    dr.set_grad(v, 1.0)
+                dr.forward_to(out)
+                g = dr.grad(out)
+                dr.eval(g)
+                cols.append(_numpy(g).reshape(self.size, nb, 3).transpose(1, 0, 2))
+            scale = math.pi / 180.0 if name.startswith("gamma") else 1.0
+            grads[name] = np.stack(cols, axis=-1) * scale
+        return f, grads

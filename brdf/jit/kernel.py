@@ -21,7 +21,8 @@ Edge cases as the NumPy kernel: a direction along a tangent sample (cos theta = 
 azimuth 0; a sample with cos^2(theta_d) = 0 contributes 0; a pair with both directions along
 the tangent has no volume term; in-plane lengths and cosines below 2^-500 are taken without
 underflow (scaled by 2^600); below the horizon and Q <= 0 give 0. Three formulas differ from
-the NumPy kernel in form only, for float32: theta_i + theta_r comes from ``atan2`` of its sine
+the NumPy kernel in form only, for float32 (in double precision the last two are NumPy's, so
+that both backends round alike where these cancel): theta_i + theta_r comes from ``atan2`` of its sine
 and cosine (``arccos`` of a cosine near 1 loses the angle's digits); :math:`\cos^2(\phi_d/2) =
 |\hat u_i + \hat u_r|^2 / 4` from the unit azimuth vectors (no cancellation in :math:`1 +
 \cos\phi_d`); and the transmission :math:`1 - F_r = 2cg\,[(c + g)^{-2} + \eta^2 (\eta^2 c +
@@ -75,6 +76,12 @@ def wide(x, k: Consts):
 def narrow(x, k: Consts):
     """x back in the kernel's shading precision."""
     return k.types.Float(x) if k.types.jit else x
+
+
+def _double(k: Consts) -> bool:
+    """Whether the kernel shades in double precision (the LLVM float64 of brdf, or Python
+    floats): then it rounds as the NumPy kernel, where the float32 forms differ."""
+    return not k.types.jit or dr.type_v(k.types.Float) == dr.VarType.Float64
 
 
 def _norm(x, y):
@@ -140,9 +147,16 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
     ci_s, cr_s = dr.select(zero_i, 1.0, ci), dr.select(zero_r, 1.0, cr)
     ui_x, ui_y = dr.select(zero_i, 1.0, xi / ci_s), dr.select(zero_i, 0.0, bi / ci_s)
     ur_x, ur_y = dr.select(zero_r, 1.0, xr / cr_s), dr.select(zero_r, 0.0, bo / cr_s)
-    hp = narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0, 1.0), k)
     cc, ss = ci * cr, si * sr
-    c2d = narrow(1.0 + cc + ss, k)                        # 2 cos^2(theta_d)
+    if _double(k):              # (1 + cos phi_d) / 2, rounded as the NumPy kernel rounds it
+        tiny = (ci < _TINY) | (cr < _TINY)
+        cphi = dr.select(tiny, ui_x * ur_x + ui_y * ur_y,
+                         (bi * bo + xi * xr) / dr.select(tiny, 1.0, cc))
+        hp = 0.5 * (1.0 + dr.clip(cphi, -1.0, 1.0))
+    else:                       # without its cancellation near phi_d = pi (module notes)
+        hp = narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0,
+                            1.0), k)
+    c2d = narrow(cc + ss + 1.0, k)                        # 2 cos^2(theta_d)
     th2 = dr.square(narrow(dr.atan2(si * cr + ci * sr, cc - ss), k))  # (theta_i + theta_r)^2
     p = 1.0
     if k.reweighting:
@@ -164,18 +178,17 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
 
 def _fresnel(eta2, eta2m1, c, wide_float: bool):
     """Unpolarized Fresnel reflectance F_r and transmission 1 - F_r at incidence cosine c
-    (``eta2`` = eta^2, ``eta2m1`` = eta^2 - 1), with one division. In double precision
-    (``wide_float``) 1 - F_r is taken as such, as the NumPy kernel takes it; in float32 in
-    the form without cancellation (module notes)."""
+    (``eta2`` = eta^2, ``eta2m1`` = eta^2 - 1). In double precision (``wide_float``)
+    1 - F_r is taken as such, rounded as the NumPy kernel rounds it (r_s = -1 exactly at
+    c = 0, so F_r = 1); in float32 in the form without cancellation (module notes)."""
     g = dr.sqrt(eta2m1 + c * c)
     e2c = eta2 * c
     a, b = c + g, e2c + g
-    inv = 1.0 / (a * b)
-    rs, rp = (c - g) * b * inv, (e2c - g) * a * inv
+    rs, rp = (c - g) / a, (e2c - g) / b
     f = 0.5 * (rs * rs + rp * rp)
     if wide_float:
         return f, 1.0 - f
-    return f, 2.0 * c * g * (dr.square(b * inv) + eta2 * dr.square(a * inv))
+    return f, 2.0 * c * g * (1.0 / (a * a) + eta2 / (b * b))
 
 
 def sample_shading(th, g: SampleGeometry, transmission: Transmission):
@@ -186,7 +199,7 @@ def sample_shading(th, g: SampleGeometry, transmission: Transmission):
     ``eta2``, ``eta2m1``, ``kd``, ``gs_k``, ``gs_c``, ``gv_k``, ``gv_c``): opaque values,
     or one per lane for a batch of parameter sets.
     """
-    wide_float = dr.type_v(g.cg) == dr.VarType.Float64 or not dr.is_jit_v(g.cg)
+    wide_float = not dr.is_jit_v(g.cg) or dr.type_v(g.cg) == dr.VarType.Float64
     fr, tr = _fresnel(th.eta2, th.eta2m1, g.cg, wide_float)
     if transmission is Transmission.HALF_ANGLE:
         ft = tr * tr

@@ -41,6 +41,7 @@ TYPES = Types(Float64, Float64, UInt32, Array3f64, Array3f64)
 #: The parameters :meth:`PreparedJit.eval_and_grad` differentiates by (``Prepared.eval``'s
 #: keywords).
 GRAD_PARAMS = ("eta", "kd", "gamma_s", "gamma_v", "area", "albedo")
+_ALIGN = 128                        # bytes: a vector load of 16 float64
 _CONSTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()   # plan -> plan_consts
 
 
@@ -64,18 +65,27 @@ def plan_consts(plan) -> tuple[Consts, Float64, Float64]:
     got = _CONSTS.get(plan)
     if got is None:
         rot = plan.options.rotation
-        got = (consts(plan, TYPES), opaque(math.cos(rot), Float64),
-               opaque(math.sin(rot), Float64))
+        # NumPy's cos and sin, as FabricPlan.frames takes them (math's may differ by an ulp)
+        got = (consts(plan, TYPES), opaque(float(np.cos(rot)), Float64),
+               opaque(float(np.sin(rot)), Float64))
         _CONSTS[plan] = got
     return got
 
 
-def _vector(w: np.ndarray) -> Array3f64:
-    """(n, 3) float64 directions as an Array3f64 in memory that Dr.Jit allocated (NumPy's,
-    mapped, can be unaligned, and a kernel's loads say so: another kernel, compiled anew)."""
-    out = Array3f64(*(Float64(np.ascontiguousarray(w[:, c])) + 0.0 for c in range(3)))
-    dr.eval(out)
+def _aligned(a: np.ndarray) -> np.ndarray:
+    """A float64 copy of ``a`` starting at a 128-byte boundary (Dr.Jit maps NumPy's memory,
+    and a kernel's vector loads state its alignment: another alignment, another kernel,
+    compiled anew, about 0.3 s)."""
+    buf = np.empty(a.size + _ALIGN // 8)
+    off = (-buf.ctypes.data % _ALIGN) // 8
+    out = buf[off:off + a.size]
+    out[...] = a
     return out
+
+
+def _vector(w: np.ndarray) -> Array3f64:
+    """(n, 3) float64 directions as an Array3f64 (aligned: :func:`_aligned`)."""
+    return Array3f64(*(Float64(_aligned(w[:, c])) for c in range(3)))
 
 
 def _inverse_denominator(q, zi):
@@ -95,8 +105,10 @@ def _rgb(parts, inv):
 
 
 def _numpy(x) -> np.ndarray:
-    """An evaluated Array3f64 as an (n, 3) float64 array."""
-    return np.ascontiguousarray(x.numpy().T, dtype=np.float64)
+    """An evaluated Array3f64 as an (n, 3) float64 array (a copy per component: the
+    conversion of the whole would launch a kernel, one per alignment of NumPy's buffer)."""
+    return np.stack([np.asarray(c.numpy(), dtype=np.float64) for c in (x.x, x.y, x.z)],
+                    axis=1)
 
 
 def eval_pairs(plan, wi: np.ndarray, wo: np.ndarray, split: bool = False):

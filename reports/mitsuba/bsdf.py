@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 import brdf
+from brdf import sampling
 
 # optional dependencies: this module is imported only by reports.mitsuba.register()
 import drjit as dr
@@ -142,6 +143,11 @@ def variant_types() -> Types:
                  mi.warp.square_to_cosine_hemisphere)
 
 
+def _consts(fabric):
+    """The kernel's constants of ``fabric`` in the variant's types, the sampler's included."""
+    return consts(fabric.plan, variant_types(), sampling.lobe_probabilities(fabric.plan))
+
+
 def bsdf_class():
     """The ``microcylinder`` BSDF class of the variant that is set."""
     variant = mi.variant()
@@ -160,7 +166,7 @@ def _make_class():
             mi.BSDF.__init__(self, props)
             plain, self.textures = _props_dict(props)
             self.fabric = fabric_from_dict(plain)
-            self.k = consts(self.fabric, variant_types())
+            self.k = _consts(self.fabric)
             self.params = {key: _param(v)
                            for key, v in _values_of(self.fabric, self.textures).items()}
             self.m_components = [flags]
@@ -183,7 +189,7 @@ def _make_class():
             except ValueError:
                 _write(self.params, self.fabric)        # back to the values in use
                 raise
-            self.fabric, self.k = fabric, consts(fabric, variant_types())
+            self.fabric, self.k = fabric, _consts(fabric)
 
         def _frame(self, si):
             return _warp(si, self.k.rotation)

@@ -21,8 +21,8 @@ Edge cases as the NumPy kernel: a direction along a tangent sample (cos theta = 
 azimuth 0; a sample with cos^2(theta_d) = 0 contributes 0; a pair with both directions along
 the tangent has no volume term; in-plane lengths and cosines below 2^-500 are taken without
 underflow (scaled by 2^600); below the horizon and Q <= 0 give 0. Three formulas differ from
-the NumPy kernel in form only, for float32 (in double precision the last two are NumPy's, so
-that both backends round alike where these cancel): theta_i + theta_r comes from ``atan2`` of its sine
+the NumPy kernel in form only, for float32 (in double precision they are NumPy's, so that
+both backends round alike where these cancel): theta_i + theta_r comes from ``atan2`` of its sine
 and cosine (``arccos`` of a cosine near 1 loses the angle's digits); :math:`\cos^2(\phi_d/2) =
 |\hat u_i + \hat u_r|^2 / 4` from the unit azimuth vectors (no cancellation in :math:`1 +
 \cos\phi_d`); and the transmission :math:`1 - F_r = 2cg\,[(c + g)^{-2} + \eta^2 (\eta^2 c +
@@ -144,9 +144,9 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
     sr, xr = to * ca + zo * sa, zo * ca - to * sa
     ci, cr = _norm(xi, bi), _norm(xr, bo)
     zero_i, zero_r = ci == 0.0, cr == 0.0                  # along the tangent: phi := 0
-    ci_s, cr_s = dr.select(zero_i, 1.0, ci), dr.select(zero_r, 1.0, cr)
-    ui_x, ui_y = dr.select(zero_i, 1.0, xi / ci_s), dr.select(zero_i, 0.0, bi / ci_s)
-    ur_x, ur_y = dr.select(zero_r, 1.0, xr / cr_s), dr.select(zero_r, 0.0, bo / cr_s)
+    ici, icr = 1.0 / dr.select(zero_i, 1.0, ci), 1.0 / dr.select(zero_r, 1.0, cr)
+    ui_x, ui_y = dr.select(zero_i, 1.0, xi * ici), dr.select(zero_i, 0.0, bi * ici)
+    ur_x, ur_y = dr.select(zero_r, 1.0, xr * icr), dr.select(zero_r, 0.0, bo * icr)
     cc, ss = ci * cr, si * sr
     if _double(k):              # (1 + cos phi_d) / 2, rounded as the NumPy kernel rounds it
         tiny = (ci < _TINY) | (cr < _TINY)
@@ -157,7 +157,10 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
         hp = narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0,
                             1.0), k)
     c2d = narrow(cc + ss + 1.0, k)                        # 2 cos^2(theta_d)
-    th2 = dr.square(narrow(dr.atan2(si * cr + ci * sr, cc - ss), k))  # (theta_i + theta_r)^2
+    if _double(k):              # (theta_i + theta_r)^2, as the NumPy kernel forms it
+        th2 = dr.square(dr.acos(dr.clip(cc - ss, -1.0, 1.0)))
+    else:
+        th2 = dr.square(narrow(dr.atan2(si * cr + ci * sr, cc - ss), k))
     p = 1.0
     if k.reweighting:
         (ii, ir) = irho

@@ -146,7 +146,8 @@ class _RowConsts:
 class _ThreadGeom:
     """One thread's geometry of the prepared pairs, evaluated: arrays of C x S entries
     (pair-major: entry c S + s is sample s of pair c, so that a lane's loop over the samples
-    reads consecutive entries), and the P mean of each pair."""
+    reads consecutive entries), ``ks`` and ``kv`` multiplied by the sample's weight, and
+    the P mean of each pair."""
 
     def __init__(self, g: SampleGeometry, keep_cos: bool, pmean):
         self.th2, self.cg, self.ks, self.kv = g.th2, g.cg, g.ks, g.kv
@@ -191,6 +192,8 @@ class PreparedJit:
                 for w in (light, view)]
         g = sample_geometry(k, at(th.ca, s, Float64), at(th.sa, s, Float64), *axes,
                             tuple(inverse_rho(k, a) for a in axes))
+        w = at(th.weight, s, Float64)           # the sample's weight, in its two factors
+        g = g._replace(ks=g.ks * w, kv=g.kv * w)
         keep_cos = k.transmission is Transmission.LONGITUDINAL
         dr.eval(g.th2, g.cg, g.ks, g.kv, *((g.ci, g.cr) if keep_cos else ()),
                 *((g.p,) if k.reweighting else ()))
@@ -223,10 +226,8 @@ class PreparedJit:
         for j, (th, geom) in enumerate(zip(k.threads, self._geoms)):
             rc = _RowConsts(*(row(x[name][j]) for name in ("eta", "kd", "gamma_s", "gamma_v")))
 
-            def terms(s, th=th, geom=geom, rc=rc):
-                w = at(th.weight, s, Float64)
-                return tuple(w * t for t in sample_shading(rc, geom.at(c * th.n + s),
-                                                           k.transmission))
+            def terms(s, th=th, geom=geom, rc=rc):      # (weights in ks, kv)
+                return sample_shading(rc, geom.at(c * th.n + s), k.transmission)
 
             surf, vol = loop(th.n, terms, UInt32(0), Float64(0.0), Float64(0.0))
             pmean = None if geom.pmean is None else dr.gather(Float64, geom.pmean, c)

@@ -46,17 +46,18 @@ RGB_VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
 
 
 def mitsuba_modules():
-    """``(mitsuba, drjit, bsdf)``: Mitsuba, Dr.Jit and :mod:`reports.mitsuba.bsdf`, imported on
-    first use (the one place the plugin's modules load them).
+    """``(mitsuba, drjit, bsdf, scene)``: Mitsuba, Dr.Jit, :mod:`reports.mitsuba.bsdf` and
+    :mod:`reports.mitsuba.scene`, imported on first use (the one place the modules of
+    reports.mitsuba load them).
 
     Raises
     ------
     ImportError
         Mitsuba is not installed.
     """
-    # optional dependency, loaded on use: bsdf imports mitsuba and drjit at its top
-    from reports.mitsuba import bsdf
-    return bsdf.mi, bsdf.dr, bsdf
+    # optional dependency, loaded on use: bsdf and scene import mitsuba and drjit at their top
+    from reports.mitsuba import bsdf, scene
+    return bsdf.mi, bsdf.dr, bsdf, scene
 
 
 def register() -> None:
@@ -72,7 +73,7 @@ def register() -> None:
     ValueError
         No variant is set, or it is not one of :data:`RGB_VARIANTS`' kind (``*_rgb``).
     """
-    mi, _, mitsuba_bsdf = mitsuba_modules()
+    mi, _, mitsuba_bsdf, _ = mitsuba_modules()
 
     variant = mi.variant()
     if variant is None or not variant.endswith("_rgb") or "polarized" in variant:

@@ -116,6 +116,8 @@ class Prepared:
         out = (np.empty if self._ok.all() else np.zeros)((nb, self._ok.size, 3))
         if self._jit is not None and dtype == np.float64:
             vals = self._jit_eval(par, dtype)
+            if self._ok.all():
+                out = vals                  # a new array of every pair
         else:
             vals = self._numpy_eval(par, dtype, out)
         if vals is not out:

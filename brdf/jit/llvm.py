@@ -25,7 +25,7 @@ import numpy as np
 
 # optional dependency: this module is imported only through brdf.jit.compiled()
 import drjit as dr
-from drjit.llvm.ad import Array3f64, Float64, UInt32
+from drjit.llvm.ad import Array3f64, Array4f64, Float64, UInt32
 
 from brdf.combine import DENOM_MIN
 from brdf.jit.consts import GAUSS_NORM, Consts, Types, consts, opaque
@@ -150,15 +150,19 @@ class _ThreadGeom:
     the P mean of each pair."""
 
     def __init__(self, g: SampleGeometry, keep_cos: bool, pmean):
-        self.th2, self.cg, self.ks, self.kv = g.th2, g.cg, g.ks, g.kv
-        self.ci, self.cr = (g.ci, g.cr) if keep_cos else (None, None)
+        # packed four (six) to an entry: one packet gather per lane and sample
+        cols = (g.th2, g.cg, g.ks, g.kv) + ((g.ci, g.cr, g.ci, g.cr) if keep_cos else ())
+        self.width = len(cols)
+        self.packed = Float64(np.stack([np.asarray(c.numpy()) for c in cols], axis=1).ravel())
         self.pmean = pmean
 
     def at(self, i) -> SampleGeometry:
         """The geometry of entries ``i`` (one per lane)."""
-        get = lambda a: None if a is None else dr.gather(Float64, a, i)  # noqa: E731
-        return SampleGeometry(get(self.th2), get(self.cg), get(self.ks), get(self.kv), None,
-                              get(self.ci), get(self.cr), None, None, None)
+        v = dr.gather(Array4f64, self.packed, i * (self.width // 4))
+        if self.width == 4:
+            return SampleGeometry(v.x, v.y, v.z, v.w, None, None, None, None, None, None)
+        u = dr.gather(Array4f64, self.packed, i * 2 + 1)
+        return SampleGeometry(v.x, v.y, v.z, v.w, None, u.x, u.y, None, None, None)
 
 
 class PreparedJit:
@@ -243,7 +247,15 @@ class PreparedJit:
         nb = par.eta.shape[0]
         out = self.shade(self.inputs(par), nb)
         dr.eval(out)
-        return _numpy(out).reshape(self.size, nb, 3).transpose(1, 0, 2)
+        return self._to_numpy(out, nb)
+
+    def _to_numpy(self, x, nb) -> np.ndarray:
+        """An evaluated Array3f64 of the lanes (pair-major) as (nb, C, 3), one strided copy
+        a channel."""
+        res = np.empty((nb, self.size, 3))
+        for ch, comp in enumerate((x.x, x.y, x.z)):
+            res[:, :, ch] = np.asarray(comp.numpy()).reshape(self.size, nb).T
+        return res
 
     def eval_and_grad(self, par) -> tuple[np.ndarray, dict]:
         """f_r (nb, C, 3) and its derivatives by each of :data:`GRAD_PARAMS`, by Dr.Jit's
@@ -273,7 +285,7 @@ class PreparedJit:
                 dr.forward_to(out)
                 g = dr.grad(out)
                 dr.eval(g)
-                cols.append(_numpy(g).reshape(self.size, nb, 3).transpose(1, 0, 2))
+                cols.append(self._to_numpy(g, nb))
             scale = math.pi / 180.0 if name.startswith("gamma") else 1.0
             grads[name] = np.stack(cols, axis=-1) * scale
         return f, grads

@@ -153,7 +153,8 @@ class _ThreadGeom:
         # packed four (six) to an entry: one packet gather per lane and sample
         cols = (g.th2, g.cg, g.ks, g.kv) + ((g.ci, g.cr, g.ci, g.cr) if keep_cos else ())
         self.width = len(cols)
-        self.packed = Float64(np.stack([np.asarray(c.numpy()) for c in cols], axis=1).ravel())
+        self.packed = Float64(_aligned(np.stack([np.asarray(c.numpy()) for c in cols], axis=1)
+                                        .ravel()))
         self.pmean = pmean
 
     def at(self, i) -> SampleGeometry:
@@ -204,14 +205,14 @@ class PreparedJit:
         pmean = None
         if k.reweighting:
             p = np.asarray(g.p.numpy(), dtype=np.float64).reshape(self.size, ns)
-            pmean = Float64(p @ np.asarray(tp.weight))
+            pmean = Float64(_aligned(p @ np.asarray(tp.weight)))
         return _ThreadGeom(g, keep_cos, pmean)
 
     @staticmethod
     def inputs(par) -> dict:
         """``par``'s arrays as Dr.Jit arrays: per name a list of the two threads' Float64
         arrays (nb,); ``albedo`` a list of the threads' (R, G, B) triples."""
-        col = lambda a, j: Float64(np.ascontiguousarray(a[:, j], dtype=np.float64))  # noqa: E731
+        col = lambda a, j: Float64(_aligned(a[:, j]))  # noqa: E731
         out = {name: [col(getattr(par, name), j) for j in range(2)]
                for name in ("eta", "kd", "gamma_s", "gamma_v", "area")}
         out["albedo"] = [tuple(col(par.albedo[:, j], ch) for ch in range(3)) for j in range(2)]

@@ -34,13 +34,18 @@ from brdf.jit.kernel import (SampleGeometry, at, fabric_q, fabric_sums, inverse_
 from brdf.options import Transmission
 from brdf.shading import PARAM_CLAMP
 
-__all__ = ["TYPES", "probe", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS"]
+__all__ = ["TYPES", "probe", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS",
+           "CHUNK_PAIRS"]
 
 #: The kernel's types here: float64 throughout, on the LLVM backend.
 TYPES = Types(Float64, Float64, UInt32, Array3f64, Array3f64)
 #: The parameters :meth:`PreparedJit.eval_and_grad` differentiates by (``Prepared.eval``'s
 #: keywords).
 GRAD_PARAMS = ("eta", "kd", "gamma_s", "gamma_v", "area", "albedo")
+#: Pairs per kernel launch of :func:`eval_pairs`: the launch's arrays (about 100 bytes a
+#: pair) stay near 25 MiB however many pairs are asked for, and the Python tracing of a
+#: launch (about 0.5 ms) is a few thousandths of its run.
+CHUNK_PAIRS = 1 << 18
 _ALIGN = 128                        # bytes: a vector load of 16 float64
 _CONSTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()   # plan -> plan_consts
 
@@ -113,7 +118,17 @@ def _numpy(x) -> np.ndarray:
 
 def eval_pairs(plan, wi: np.ndarray, wo: np.ndarray, split: bool = False):
     """f_r (1/sr) of unit (C, 3) pairs above the horizon: (C, 3) RGB, or per thread (C, 2,
-    3) with ``split`` (:meth:`brdf.FabricPlan.eval`'s kernel)."""
+    3) with ``split`` (:meth:`brdf.FabricPlan.eval`'s kernel), in chunks of at most
+    :data:`CHUNK_PAIRS` pairs (one kernel launch each)."""
+    out = np.empty((wi.shape[0], 2, 3) if split else (wi.shape[0], 3))
+    for start in range(0, wi.shape[0], CHUNK_PAIRS):
+        sl = slice(start, start + CHUNK_PAIRS)
+        out[sl] = _eval_chunk(plan, wi[sl], wo[sl], split)
+    return out
+
+
+def _eval_chunk(plan, wi, wo, split):
+    """:func:`eval_pairs` of one chunk."""
     k, rc, rs = plan_consts(plan)
     light, view = _vector(wi), _vector(wo)
     sums = fabric_sums(k, light, view, rc, rs)

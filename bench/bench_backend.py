@@ -42,14 +42,14 @@ def _cpu(fn) -> float:
 
 
 def interleaved(calls: dict, rounds: int) -> dict:
-    """Median CPU seconds of each of ``calls`` (name -> function), run in turn."""
-    times = {name: [] for name in calls}
-    for name, fn in calls.items():        # warm-up: compiles the Dr.Jit kernel
-        with_backend(name, fn)
+    """Median seconds of each of ``calls`` ((backend, label) -> function), run in turn."""
+    times = {key: [] for key in calls}
+    for key, fn in calls.items():         # warm-up: compiles the Dr.Jit kernel
+        with_backend(key[0], fn)
     for _ in range(rounds):
-        for name, fn in calls.items():
-            times[name].append(with_backend(name, lambda: _cpu(fn)))
-    return {name: statistics.median(t) for name, t in times.items()}
+        for key, fn in calls.items():
+            times[key].append(with_backend(key[0], lambda: _cpu(fn)))
+    return {key: statistics.median(t) for key, t in times.items()}
 
 
 def with_backend(name, fn):
@@ -73,8 +73,9 @@ def bench_eval(pairs, rounds):
     out = {}
     for name in brdf.PRESETS:
         fab = brdf.fabric(name)
-        t = interleaved({"numpy": lambda: fab.eval(wi, wo), "drjit": lambda: fab.eval(wi, wo)},
+        t = interleaved({(b, ""): (lambda: fab.eval(wi, wo)) for b in ("numpy", "drjit")},
                         rounds)
+        t = {b: v for (b, _), v in t.items()}
         out[name] = t
         print(f"eval  {name:32s} {pairs} pairs  numpy {t['numpy'] * 1e3:8.1f} ms  drjit "
               f"{t['drjit'] * 1e3:8.1f} ms  ratio {t['numpy'] / t['drjit']:5.1f}x", flush=True)
@@ -104,14 +105,15 @@ def bench_prepared(batch, rounds, fabrics):
         kw = walkers(fab, batch)
         preps = {b: with_backend(b, lambda: fab.prepare(tab.wi, tab.wo))
                  for b in ("numpy", "drjit")}
-        t = interleaved({b: (lambda p=p: p.eval(**kw)) for b, p in preps.items()}, rounds)
-        t32 = interleaved({"numpy": lambda: preps["numpy"].eval(**kw, dtype=np.float32)},
-                          rounds)["numpy"]
-        out[name] = dict(t, numpy32=t32)
-        print(f"batch {name:32s} {len(tab.wi)} pairs x {batch} sets  numpy f64 "
-              f"{t['numpy'] * 1e3:8.1f} ms  (f32 {t32 * 1e3:7.1f} ms)  drjit f64 "
-              f"{t['drjit'] * 1e3:8.1f} ms  ratio {t['numpy'] / t['drjit']:5.1f}x "
-              f"(vs numpy f32 {t32 / t['drjit']:4.1f}x)", flush=True)
+        t = interleaved({(b, dt): (lambda p=p, dt=dt: p.eval(**kw, dtype=dt))
+                         for b, p in preps.items() for dt in ("float64", "float32")}, rounds)
+        out[name] = t
+        n64, d64 = t["numpy", "float64"], t["drjit", "float64"]
+        n32, d32 = t["numpy", "float32"], t["drjit", "float32"]
+        print(f"batch {name:28s} {len(tab.wi)} pairs x {batch} sets  float64 numpy "
+              f"{n64 * 1e3:6.1f} ms drjit {d64 * 1e3:6.1f} ms ratio {n64 / d64:4.1f}x;  "
+              f"float32 numpy {n32 * 1e3:6.1f} ms drjit {d32 * 1e3:6.1f} ms ratio "
+              f"{n32 / d32:4.1f}x", flush=True)
     return out
 
 

@@ -66,7 +66,7 @@ class Prepared:
         self._ok = ~(bad | below)
         wi_ok, wo_ok = wi[self._ok], wo[self._ok]
         self._pairs = (wi_ok, wo_ok)
-        # the Dr.Jit kernel (brdf.jit) shades float64, but for pairs with a subnormal
+        # the Dr.Jit kernel (brdf.jit) shades (float64, float32), but for pairs with a subnormal
         # component (``_exact``, NumPy's); NumPy's geometry is made on first use
         self._jit, self._exact, self._jit_all = None, None, None
         if jit.backend() == "drjit":
@@ -114,7 +114,7 @@ class Prepared:
         par, batch = self._params(eta, albedo, kd, gamma_s, gamma_v, area)
         nb = par.eta.shape[0]
         out = (np.empty if self._ok.all() else np.zeros)((nb, self._ok.size, 3))
-        if self._jit is not None and dtype == np.float64:
+        if self._jit is not None:
             vals = self._jit_eval(par, dtype)
             if self._ok.all():
                 out = vals                  # a new array of every pair
@@ -171,14 +171,16 @@ class Prepared:
         return f.reshape(batch + self.shape + (3,)), grads
 
     def _jit_eval(self, par: ShadeParams, dtype) -> np.ndarray:
-        """The Dr.Jit kernel's f_r (nb, pairs above the horizon, 3), those with a subnormal
-        component from the NumPy kernel."""
+        """The Dr.Jit kernel's f_r (nb, pairs above the horizon, 3), shaded in ``dtype``;
+        those with a subnormal component from the NumPy kernel."""
+        single = dtype == np.float32
         if self._exact is None:
-            return self._jit.eval(par) if self._zi.size else np.zeros((par.eta.shape[0], 0, 3))
+            return (self._jit.eval(par, single) if self._zi.size
+                    else np.zeros((par.eta.shape[0], 0, 3)))
         vals = self._numpy_eval(par, dtype, None).copy()
         keep = ~self._exact
         if keep.any():
-            vals[:, keep] = self._jit.eval(par)
+            vals[:, keep] = self._jit.eval(par, single)
         return vals
 
     def _numpy_eval(self, par: ShadeParams, dtype, out) -> np.ndarray:

@@ -142,6 +142,31 @@ def test_batched_eval_agrees_with_numpy(monkeypatch, pairs, preset, options):
 
 
 @needs_drjit
+@pytest.mark.parametrize("preset, options", CASES, ids=IDS)
+def test_float32_batches_agree_with_numpy_float64(monkeypatch, pairs, preset, options):
+    """Prepared.eval(dtype=float32) on Dr.Jit (samples shaded and summed in float32, the
+    threads combined in float64) keeps f_r of a batch within 5e-6 relative of the NumPy
+    kernel's float64 wherever it is at least 1e-3 of the channel's largest value, and within
+    2e-6 of that largest value everywhere (the NumPy float32 shading's bounds,
+    tests/test_brdf_prepared.py)."""
+    wi, wo = pairs
+    keep = ~ill_conditioned(wi, wo)
+    wi, wo = wi[keep], wo[keep]
+    fab = brdf.fabric(preset, **options)
+    kw = _batch(fab, 4, np.random.default_rng(len(preset) * 7 + len(options)))
+    ref = with_backend(monkeypatch, "numpy", lambda: fab.prepare(wi, wo).eval(**kw))
+    prep = with_backend(monkeypatch, "drjit", lambda: fab.prepare(wi, wo))
+    got = prep.eval(**kw, dtype=np.float32)
+    assert got.dtype == np.float64 and np.array_equal(np.isnan(got), np.isnan(ref))
+    ok = ~np.isnan(ref)
+    top = np.nanmax(ref, axis=1, keepdims=True)
+    big = ok & (ref >= 1e-3 * top)
+    np.testing.assert_allclose(got[big], ref[big], rtol=5e-6, atol=0)
+    assert np.all(np.abs(got - ref)[ok] <= 2e-6 * np.broadcast_to(top, ref.shape)[ok])
+    assert not np.array_equal(got[big], ref[big])        # shaded in float32 indeed
+
+
+@needs_drjit
 def test_subnormal_components_agree(monkeypatch):
     """Pairs with subnormal components (Dr.Jit's kernels flush them to 0) give the NumPy
     kernel's f_r in both eval and the batched eval, beside ordinary pairs."""

@@ -25,14 +25,15 @@ import numpy as np
 
 # optional dependency: this module is imported only through brdf.jit.compiled()
 import drjit as dr
-from drjit.llvm.ad import Array3f64, Array4f64, Float64, UInt32
+from drjit.llvm.ad import Array3f64, Array4f64, Float32, Float64, UInt32
+from drjit.llvm.ad import Array4f as Array4f32
 
 from brdf.combine import DENOM_MIN
 from brdf.jit.consts import GAUSS_NORM, Consts, Types, consts, opaque
 from brdf.jit.kernel import (SampleGeometry, at, fabric_q, fabric_sums, inverse_rho, loop,
                              sample_geometry, sample_shading, thread_axes)
 from brdf.options import Transmission
-from brdf.shading import PARAM_CLAMP
+from brdf.shading import PARAM_CLAMP, PARAM_CLAMP_32
 
 __all__ = ["TYPES", "probe", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS",
            "CHUNK_PAIRS"]
@@ -77,12 +78,13 @@ def plan_consts(plan) -> tuple[Consts, Float64, Float64]:
     return got
 
 
-def _aligned(a: np.ndarray) -> np.ndarray:
-    """A float64 copy of ``a`` starting at a 128-byte boundary (Dr.Jit maps NumPy's memory,
-    and a kernel's vector loads state its alignment: another alignment, another kernel,
-    compiled anew, about 0.3 s)."""
-    buf = np.empty(a.size + _ALIGN // 8)
-    off = (-buf.ctypes.data % _ALIGN) // 8
+def _aligned(a: np.ndarray, dtype=np.float64) -> np.ndarray:
+    """A copy of ``a`` (float64, or ``dtype``) starting at a 128-byte boundary (Dr.Jit maps
+    NumPy's memory, and a kernel's vector loads state its alignment: another alignment,
+    another kernel, compiled anew, about 0.3 s)."""
+    size = np.dtype(dtype).itemsize
+    buf = np.empty(a.size + _ALIGN // size, dtype)
+    off = (-buf.ctypes.data % _ALIGN) // size
     out = buf[off:off + a.size]
     out[...] = a
     return out
@@ -147,15 +149,18 @@ def _eval_chunk(plan, wi, wo, split):
 class _RowConsts:
     """A thread's optical constants per lane (:class:`brdf.jit.consts.ThreadConsts`' names)
     from its raw parameters per lane (eta, kd, gammas in radians), clamped as the NumPy
-    kernel clamps them (:data:`brdf.shading.PARAM_CLAMP`)."""
+    kernel clamps them (:data:`brdf.shading.PARAM_CLAMP`, or ``PARAM_CLAMP_32`` for float32
+    shading: formed in float64, then rounded, as :func:`brdf.shading.thread_shade` does)."""
 
-    def __init__(self, eta, kd, gamma_s, gamma_v):
-        eta, gs, gv = (dr.clip(x, *PARAM_CLAMP) for x in (eta, gamma_s, gamma_v))
-        self.eta2 = eta * eta
-        self.eta2m1 = self.eta2 - 1.0
-        self.kd = kd
-        self.gs_k, self.gs_c = -0.125 / (gs * gs), GAUSS_NORM / gs
-        self.gv_k, self.gv_c = -0.125 / (gv * gv), (1.0 - kd) * GAUSS_NORM / gv
+    def __init__(self, eta, kd, gamma_s, gamma_v, single=False):
+        clamp = PARAM_CLAMP_32 if single else PARAM_CLAMP
+        eta, gs, gv = (dr.clip(x, *clamp) for x in (eta, gamma_s, gamma_v))
+        cast = Float32 if single else (lambda v: v)
+        self.eta2 = cast(eta * eta)
+        self.eta2m1 = cast(eta * eta - 1.0)
+        self.kd = cast(kd)
+        self.gs_k, self.gs_c = cast(-0.125 / (gs * gs)), cast(GAUSS_NORM / gs)
+        self.gv_k, self.gv_c = cast(-0.125 / (gv * gv)), cast((1.0 - kd) * GAUSS_NORM / gv)
 
 
 class _ThreadGeom:
@@ -168,16 +173,22 @@ class _ThreadGeom:
         # packed four (six) to an entry: one packet gather per lane and sample
         cols = (g.th2, g.cg, g.ks, g.kv) + ((g.ci, g.cr, g.ci, g.cr) if keep_cos else ())
         self.width = len(cols)
-        self.packed = Float64(_aligned(np.stack([np.asarray(c.numpy()) for c in cols], axis=1)
-                                        .ravel()))
+        self.host = np.stack([np.asarray(c.numpy()) for c in cols], axis=1).ravel()
+        self.packed = Float64(_aligned(self.host))
+        self.packed32 = None
         self.pmean = pmean
 
-    def at(self, i) -> SampleGeometry:
-        """The geometry of entries ``i`` (one per lane)."""
-        v = dr.gather(Array4f64, self.packed, i * (self.width // 4))
+    def at(self, i, single=False) -> SampleGeometry:
+        """The geometry of entries ``i`` (one per lane), float32 with ``single`` (clipped to
+        its finite range, as ``Prepared``'s NumPy float32 copies, made on first use)."""
+        if single and self.packed32 is None:
+            f32 = np.finfo(np.float32).max
+            self.packed32 = Float32(_aligned(np.clip(self.host, -f32, f32), np.float32))
+        packed, kind = (self.packed32, Array4f32) if single else (self.packed, Array4f64)
+        v = dr.gather(kind, packed, i * (self.width // 4))
         if self.width == 4:
             return SampleGeometry(v.x, v.y, v.z, v.w, None, None, None, None, None, None)
-        u = dr.gather(Array4f64, self.packed, i * 2 + 1)
+        u = dr.gather(kind, packed, i * 2 + 1)
         return SampleGeometry(v.x, v.y, v.z, v.w, None, u.x, u.y, None, None, None)
 
 
@@ -233,23 +244,26 @@ class PreparedJit:
         out["albedo"] = [tuple(col(par.albedo[:, j], ch) for ch in range(3)) for j in range(2)]
         return out
 
-    def shade(self, x: dict, nb: int) -> Array3f64:
+    def shade(self, x: dict, nb: int, single: bool = False) -> Array3f64:
         """f_r (1/sr) of every (pair, parameter set), a lane each (pair-major: the lanes of
         a vector share their pair, and so the geometry they read), from the Dr.Jit arrays
-        ``x`` of :meth:`inputs` (unevaluated: AD may flow through it)."""
+        ``x`` of :meth:`inputs` (unevaluated: AD may flow through it). With ``single`` the
+        samples are shaded and summed in float32, the threads combined in float64."""
         k, nbo = self.k, opaque(nb, UInt32)
         idx = dr.arange(UInt32, nb * self.size)
         c = idx // nbo
         b = idx - c * nbo
         row = lambda a: dr.gather(Float64, a, b)  # noqa: E731
+        zero = (Float32 if single else Float64)(0.0)
         sums, parts = [], []
         for j, (th, geom) in enumerate(zip(k.threads, self._geoms)):
-            rc = _RowConsts(*(row(x[name][j]) for name in ("eta", "kd", "gamma_s", "gamma_v")))
+            rc = _RowConsts(*(row(x[name][j]) for name in ("eta", "kd", "gamma_s", "gamma_v")),
+                            single=single)
 
             def terms(s, th=th, geom=geom, rc=rc):      # (weights in ks, kv)
-                return sample_shading(rc, geom.at(c * th.n + s), k.transmission)
+                return sample_shading(rc, geom.at(c * th.n + s, single), k.transmission)
 
-            surf, vol = loop(th.n, terms, UInt32(0), Float64(0.0), Float64(0.0))
+            surf, vol = (Float64(v) for v in loop(th.n, terms, UInt32(0), zero, zero))
             pmean = None if geom.pmean is None else dr.gather(Float64, geom.pmean, c)
             sums.append((surf, vol, pmean))
             parts.append((row(x["area"][j]), tuple(map(row, x["albedo"][j])), surf, vol))
@@ -258,10 +272,11 @@ class PreparedJit:
         q = fabric_q(k, sums, zi, zo, (a1, a2, 1.0 - a1 - a2))
         return _rgb(parts, _inverse_denominator(q, zi))
 
-    def eval(self, par) -> np.ndarray:
-        """f_r (1/sr), shape (nb, C, 3), of the batch ``par`` (checked, gammas in radians)."""
+    def eval(self, par, single: bool = False) -> np.ndarray:
+        """f_r (1/sr), shape (nb, C, 3), of the batch ``par`` (checked, gammas in radians);
+        shaded in float32 with ``single``."""
         nb = par.eta.shape[0]
-        out = self.shade(self.inputs(par), nb)
+        out = self.shade(self.inputs(par), nb, single)
         dr.eval(out)
         return self._to_numpy(out, nb)
 

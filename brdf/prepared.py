@@ -153,12 +153,14 @@ class Prepared:
         ok, why = jit.available()
         if not ok:
             raise RuntimeError(f"eval_and_grad needs Dr.Jit, which does not run here: {why}")
-        if self._jit_all is None:
-            self._jit_all = jit.compiled().PreparedJit(self.plan, *self._pairs)
+        if self._jit_all is None:       # subnormal components raised to the least normal
+            self._jit_all = jit.compiled().PreparedJit(self.plan, *map(_normal, self._pairs))
         nb = par.eta.shape[0]
         f, grads = np.zeros((nb, self._ok.size, 3)), {}
         if self._zi.size:
             vals, gvals = self._jit_all.eval_and_grad(par)
+            if self._exact is not None:     # f_r as eval gives it
+                vals = self._jit_eval(par, np.float64)
         else:
             vals, gvals = f[:, :0], {k: np.zeros((nb, 0, 3, 2)) for k in GRAD_PARAMS}
         f[:, self._ok] = vals
@@ -175,8 +177,7 @@ class Prepared:
         those with a subnormal component from the NumPy kernel."""
         single = dtype == np.float32
         if self._exact is None:
-            return (self._jit.eval(par, single) if self._zi.size
-                    else np.zeros((par.eta.shape[0], 0, 3)))
+            return self._jit.eval(par, single)
         vals = self._numpy_eval(par, dtype, None).copy()
         keep = ~self._exact
         if keep.any():
@@ -242,6 +243,13 @@ class Prepared:
             self._geoms32 = [ThreadGeometry(*(None if a is None else _to_float32(a) for a in g))
                              for g in self._geoms]
         return self._geoms32
+
+
+def _normal(w: np.ndarray) -> np.ndarray:
+    """``w`` with its subnormal components raised to the least normal number, their sign
+    kept (what Dr.Jit's kernels would flush to 0)."""
+    tiny = np.finfo(np.float64).tiny
+    return np.where((w != 0) & (np.abs(w) < tiny), np.copysign(tiny, w), w)
 
 
 def _to_float32(a: np.ndarray) -> np.ndarray:

@@ -326,3 +326,26 @@ def test_one_compiled_kernel_serves_every_preset(monkeypatch):
     assert len(set(seen)) == 1 and len(seen[0]) >= 3
     assert other - seen[0]
     assert llvm.plan_consts(brdf.fabric("velvet").plan)[0].masking is True
+
+
+@needs_drjit
+def test_no_pair_to_shade(monkeypatch):
+    """Pairs all below the horizon, bad or with subnormal components leave Dr.Jit nothing
+    to shade: eval, the batched eval (both precisions) and eval_and_grad give 0 and NaN
+    where the NumPy kernel does."""
+    monkeypatch.setenv(jit.BACKEND_ENV, "drjit")
+    fab = brdf.fabric("linen_plain")
+    wi = np.array([[0.0, 0.0, 0.0], [0.3, 0.2, -0.9], [1.0, 0.0, 1e-310]])
+    wo = np.array([[0.0, 0.6, 0.8], [0.0, 0.6, 0.8], [0.0, 0.6, 0.8]])
+    ref = with_backend(monkeypatch, "numpy", lambda: fab.eval(wi, wo))
+    assert np.isnan(ref[0]).all() and (ref[1] == 0).all() and (ref[2] > 0).all()
+    for rows in (slice(0, 2), slice(0, 3)):
+        prep = fab.prepare(wi[rows], wo[rows])
+        for got in (fab.eval(wi[rows], wo[rows]), prep.eval(), prep.eval(dtype=np.float32),
+                    prep.eval_and_grad()[0]):
+            assert_agree(got, ref[rows])
+        eta = [[1.3, 1.4], [1.5, 1.6]]
+        assert_agree(prep.eval(eta=eta), with_backend(
+            monkeypatch, "numpy", lambda: fab.prepare(wi[rows], wo[rows]).eval(eta=eta)),
+            axis=1)
+        assert np.isnan(prep.eval_and_grad()[1]["eta"][0]).all()

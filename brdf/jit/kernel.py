@@ -187,11 +187,13 @@ def _fresnel(eta2, eta2m1, c, wide_float: bool):
     g = dr.sqrt(eta2m1 + c * c)
     e2c = eta2 * c
     a, b = c + g, e2c + g
-    rs, rp = (c - g) / a, (e2c - g) / b
-    f = 0.5 * (rs * rs + rp * rp)
     if wide_float:
+        rs, rp = (c - g) / a, (e2c - g) / b
+        f = 0.5 * (rs * rs + rp * rp)
         return f, 1.0 - f
-    return f, 2.0 * c * g * (1.0 / (a * a) + eta2 / (b * b))
+    ia, ib = 1.0 / a, 1.0 / b
+    rs, rp = (c - g) * ia, (e2c - g) * ib
+    return 0.5 * (rs * rs + rp * rp), 2.0 * c * g * (ia * ia + eta2 * (ib * ib))
 
 
 def sample_shading(th, g: SampleGeometry, transmission: Transmission):

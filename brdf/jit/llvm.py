@@ -208,6 +208,8 @@ class PreparedJit:
         self.k, rc, rs = plan_consts(plan)
         self.size = wi.shape[0]
         self._n = opaque(self.size, UInt32)
+        if not self.size:                   # nothing to shade (Dr.Jit has no empty kernels)
+            return
         light, view = _vector(wi), _vector(wo)
         self._zi, self._zo = light.z, view.z
         self._geoms = [self._thread_geometry(j, light, view, rc, rs) for j in range(2)]
@@ -276,6 +278,8 @@ class PreparedJit:
         """f_r (1/sr), shape (nb, C, 3), of the batch ``par`` (checked, gammas in radians);
         shaded in float32 with ``single``."""
         nb = par.eta.shape[0]
+        if not self.size:
+            return np.zeros((nb, 0, 3))
         out = self.shade(self.inputs(par), nb, single)
         dr.eval(out)
         return self._to_numpy(out, nb)

@@ -94,7 +94,8 @@ class Prepared:
             computed, and the threads combined, in float64 either way, and the result is
             float64. float32 shades about twice as fast (the sampling of a fit uses it), at
             a relative error of a few 1e-6 where f_r is not far below its largest value
-            over the pairs; terms below about 1e-38 of their scale round to zero.
+            over the pairs; terms below about 1e-38 of their scale round to zero. Either
+            runs on the kernel :func:`brdf.jit.backend` names (Dr.Jit's or NumPy's).
 
         Returns
         -------

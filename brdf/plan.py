@@ -230,7 +230,7 @@ class FabricPlan:
 
     def _eval_into(self, wi, wo, out, split):
         if jit.backend() == "drjit":     # the Dr.Jit kernel (brdf.jit), float64 on LLVM
-            exact = jit.subnormal_pairs(wi, wo)   # NumPy's (brdf.jit's notes)
+            exact = jit.tiny_pairs(wi, wo)   # NumPy's (brdf.jit's notes)
             if exact.any():
                 part = np.zeros((int(exact.sum()),) + out.shape[1:])
                 self._numpy_into(wi[exact], wo[exact], part, split)

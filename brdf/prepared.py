@@ -66,11 +66,11 @@ class Prepared:
         self._ok = ~(bad | below)
         wi_ok, wo_ok = wi[self._ok], wo[self._ok]
         self._pairs = (wi_ok, wo_ok)
-        # the Dr.Jit kernel (brdf.jit) shades (float64, float32), but for pairs with a subnormal
-        # component (``_exact``, NumPy's); NumPy's geometry is made on first use
+        # the Dr.Jit kernel (brdf.jit) shades (float64, float32), but for pairs with a nearly
+        # zero component (``_exact``, NumPy's: brdf.jit's notes); NumPy's geometry on first use
         self._jit, self._exact, self._jit_all = None, None, None
         if jit.backend() == "drjit":
-            exact = jit.subnormal_pairs(wi_ok, wo_ok)
+            exact = jit.tiny_pairs(wi_ok, wo_ok)
             self._jit = jit.compiled().PreparedJit(plan, wi_ok[~exact], wo_ok[~exact])
             self._exact = exact if exact.any() else None
             self._jit_all = None if exact.any() else self._jit
@@ -175,7 +175,8 @@ class Prepared:
 
     def _jit_eval(self, par: ShadeParams, dtype) -> np.ndarray:
         """The Dr.Jit kernel's f_r (nb, pairs above the horizon, 3), shaded in ``dtype``;
-        those with a subnormal component from the NumPy kernel."""
+        those with a nearly zero component (:func:`brdf.jit.tiny_pairs`) from the NumPy
+        kernel."""
         single = dtype == np.float32
         if self._exact is None:
             return self._jit.eval(par, single)

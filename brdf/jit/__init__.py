@@ -10,9 +10,11 @@ plugin (:mod:`reports.mitsuba.bsdf`) runs the same kernel in its variant's float
 and 15 abort the process on Dr.Jit's ``fmaximum``), else ``numpy`` with the reason written
 once per process (a :class:`RuntimeWarning`).
 
-Dr.Jit's LLVM kernels flush subnormal numbers to zero: pairs with a subnormal component
-(:func:`subnormal_pairs`, |w_k| < 2.2e-308, rare) are left to the NumPy kernel, which keeps
-them, so that both backends give the same f_r everywhere.
+Dr.Jit's LLVM kernels flush subnormal numbers (below 2.2e-308) to zero, inputs and
+intermediates alike, where NumPy keeps them: pairs with a component nearly 0 (:func:`tiny_pairs`,
+0 < |w_k| < 2^-250, about 5.5e-76: products of up to four such factors stay normal) are left to
+the NumPy kernel, so that both backends give the same f_r everywhere (at n . wi = 5e-301 a
+flushed sample term had moved f_r by 5%).
 
 This package imports no Dr.Jit: :func:`compiled` loads it on first use (about a second).
 """
@@ -25,8 +27,9 @@ import warnings
 
 import numpy as np
 
-__all__ = ["backend", "available", "compiled", "subnormal_pairs", "BACKENDS", "BACKEND_ENV",
-           "MIN_LLVM"]
+__all__ = ["backend", "available", "compiled", "tiny_pairs", "BACKENDS", "BACKEND_ENV",
+           "MIN_LLVM",
+           "TINY_COMPONENT"]
 
 #: The kernels ``MICROCYL_BACKEND`` chooses between.
 BACKENDS = ("numpy", "drjit")
@@ -34,6 +37,8 @@ BACKENDS = ("numpy", "drjit")
 BACKEND_ENV = "MICROCYL_BACKEND"
 #: The least LLVM major version Dr.Jit's LLVM backend runs the kernel with.
 MIN_LLVM = 16
+#: Pairs with a nonzero component below this (2^-250) are shaded by the NumPy kernel.
+TINY_COMPONENT = 2.0 ** -250
 
 
 def compiled():
@@ -113,16 +118,15 @@ def _fallback(why: str) -> None:
                   stacklevel=3)
 
 
-def subnormal_pairs(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """The pairs of unit (n, 3) ``wi``, ``wo`` with a subnormal component, which Dr.Jit's
-    kernels would take as 0 (the NumPy kernel evaluates them): a bool array (n,).
+def tiny_pairs(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+    """The pairs of unit (n, 3) ``wi``, ``wo`` with a nonzero component below
+    :data:`TINY_COMPONENT`, which the NumPy kernel shades (module notes): a bool array (n,).
 
-    >>> w = np.array([[0.6, 0.0, 0.8], [1.0, 0.0, 1e-310]])
-    >>> subnormal_pairs(w, w[::-1]).tolist()
-    [True, True]
-    >>> subnormal_pairs(w[:1], w[:1]).tolist()
+    >>> w = np.array([[0.6, 0.0, 0.8], [1.0, 0.0, 1e-310], [1.0, 1e-80, 0.0]])
+    >>> tiny_pairs(w, w[::-1]).tolist()
+    [True, True, True]
+    >>> tiny_pairs(w[:1], w[:1]).tolist()
     [False]
     """
-    tiny = np.finfo(np.float64).tiny
-    sub = lambda w: ((w != 0.0) & (np.abs(w) < tiny)).any(axis=-1)  # noqa: E731
+    sub = lambda w: ((w != 0.0) & (np.abs(w) < TINY_COMPONENT)).any(axis=-1)  # noqa: E731
     return sub(wi) | sub(wo)

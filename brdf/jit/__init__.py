@@ -2,8 +2,9 @@
 written once for every Dr.Jit float type, behind the same :class:`brdf.FabricPlan` as the
 NumPy kernel (:mod:`brdf.kernel`, :mod:`brdf.shading`), which stays the reference.
 
-``Fabric.eval``, ``Fabric.eval_threads`` and ``Prepared.eval`` (float64) run on Dr.Jit's LLVM
-backend in float64 (:mod:`brdf.jit.llvm`) when :func:`backend` says ``"drjit"``; the Mitsuba
+``Fabric.eval``, ``Fabric.eval_threads`` and ``Prepared.eval`` run on Dr.Jit's LLVM backend
+in float64 (``Prepared.eval(dtype=float32)`` in float32; :mod:`brdf.jit.llvm`) when
+:func:`backend` says ``"drjit"``; the Mitsuba
 plugin (:mod:`reports.mitsuba.bsdf`) runs the same kernel in its variant's float32.
 ``MICROCYL_BACKEND=numpy|drjit`` chooses; unset, the default is ``drjit`` where it runs
 (Dr.Jit importable, its LLVM backend initialised with an LLVM of version 16 or later: LLVM 14

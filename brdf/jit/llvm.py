@@ -1,5 +1,6 @@
-r"""The Dr.Jit kernel (:mod:`brdf.jit.kernel`) on the LLVM backend in float64: what
-``Fabric.eval`` (:func:`eval_pairs`) and ``Prepared.eval`` (:class:`PreparedJit`) run when
+r"""The Dr.Jit kernel (:mod:`brdf.jit.kernel`) on the LLVM backend in float64 (a batch's
+shading also in float32): what ``Fabric.eval`` (:func:`eval_pairs`) and ``Prepared.eval``
+(:class:`PreparedJit`) run when
 :func:`brdf.jit.backend` is ``"drjit"``, and the gradients of a fit's batched f_r with
 respect to the optical parameters (:meth:`PreparedJit.eval_and_grad`, Dr.Jit's forward-mode
 AD).

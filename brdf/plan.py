@@ -229,7 +229,7 @@ class FabricPlan:
         return out.reshape(shape + out.shape[1:])
 
     def _eval_into(self, wi, wo, out, split):
-        if jit.backend() == "drjit":     # the Dr.Jit kernel (brdf.jit), float64 on LLVM
+        if jit.use_jit(self, wi.shape[0]):   # the Dr.Jit kernel (brdf.jit), float64 on LLVM
             exact = jit.tiny_pairs(wi, wo)   # NumPy's (brdf.jit's notes)
             if exact.any():
                 part = np.zeros((int(exact.sum()),) + out.shape[1:])

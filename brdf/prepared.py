@@ -69,7 +69,7 @@ class Prepared:
         # the Dr.Jit kernel (brdf.jit) shades (float64, float32), but for pairs with a nearly
         # zero component (``_exact``, NumPy's: brdf.jit's notes); NumPy's geometry on first use
         self._jit, self._exact, self._jit_all = None, None, None
-        if jit.backend() == "drjit":
+        if jit.use_jit(plan, wi_ok.shape[0]):
             exact = jit.tiny_pairs(wi_ok, wo_ok)
             self._jit = jit.compiled().PreparedJit(plan, wi_ok[~exact], wo_ok[~exact])
             self._exact = exact if exact.any() else None
@@ -159,9 +159,9 @@ class Prepared:
         nb = par.eta.shape[0]
         f, grads = np.zeros((nb, self._ok.size, 3)), {}
         if self._zi.size:
-            vals, gvals = self._jit_all.eval_and_grad(par)
-            if self._exact is not None:     # f_r as eval gives it
-                vals = self._jit_eval(par, np.float64)
+            gvals = self._jit_all.eval_and_grad(par)[1]
+            vals = (self._jit_eval(par, np.float64) if self._jit is not None   # eval's f_r
+                    else self._numpy_eval(par, np.float64, None).copy())
         else:
             vals, gvals = f[:, :0], {k: np.zeros((nb, 0, 3, 2)) for k in GRAD_PARAMS}
         f[:, self._ok] = vals

@@ -19,6 +19,13 @@ needs_drjit = pytest.mark.skipif(not jit.available()[0],
 RTOL = 1e-6
 
 
+@pytest.fixture(autouse=True)
+def every_call_on_drjit(monkeypatch):
+    """The drjit backend shades every call here, however few its pairs (below
+    brdf.jit.MIN_ELEMENTS it would leave them to NumPy)."""
+    monkeypatch.setattr(jit, "MIN_ELEMENTS", 0)
+
+
 def _unit(v):
     v = np.asarray(v, dtype=np.float64)
     with np.errstate(invalid="ignore"):             # the zero and NaN directions
@@ -207,7 +214,7 @@ def test_gradients_match_central_differences(monkeypatch, preset, options):
     kw["area"] = kw["area"] * 0.9                       # room to step both areas up
     prep = with_backend(monkeypatch, "drjit", lambda: fab.prepare(wi, wo))
     f, grads = prep.eval_and_grad(**kw)
-    np.testing.assert_allclose(f, prep.eval(**kw), rtol=1e-13, atol=0)
+    np.testing.assert_array_equal(f, prep.eval(**kw))
     assert set(grads) == set(brdf.prepared.GRAD_PARAMS)
     ref = with_backend(monkeypatch, "numpy", lambda: fab.prepare(wi, wo))
     for name, g in grads.items():
@@ -236,6 +243,24 @@ def _central(prep, kw, name, index, h, forward=False):
         return (prep.eval(**up) - prep.eval(**down)) / h
     down[name][index] -= h
     return (prep.eval(**up) - prep.eval(**down)) / (2 * h)
+
+
+@needs_drjit
+def test_small_calls_stay_on_numpy(monkeypatch):
+    """Under the drjit backend, calls of fewer than MIN_ELEMENTS (pair, sample) elements
+    run the NumPy kernel (Dr.Jit's tracing would cost more): a Prepared of 10 velvet pairs
+    has no Dr.Jit half, one of 1,000 has, and eval_and_grad works on either."""
+    monkeypatch.setattr(jit, "MIN_ELEMENTS", 1 << 14)
+    monkeypatch.setenv(jit.BACKEND_ENV, "drjit")
+    plan = brdf.fabric("velvet").plan                  # 32 + 32 distinct samples
+    assert not jit.use_jit(plan, 255) and jit.use_jit(plan, 256)
+    for n, on in ((10, False), (1000, True)):
+        wi, wo = random_pairs(n, np.random.default_rng(n))
+        prep = brdf.fabric("velvet").prepare(wi, wo)
+        assert (prep._jit is not None) is on
+        f, g = prep.eval_and_grad(eta=[[1.4, 1.5]])
+        np.testing.assert_array_equal(f, prep.eval(eta=[[1.4, 1.5]]))
+        assert np.abs(g["eta"]).max() > 0
 
 
 def test_backend_choice(monkeypatch):

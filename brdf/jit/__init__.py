@@ -9,7 +9,8 @@ plugin (:mod:`reports.mitsuba.bsdf`) runs the same kernel in its variant's float
 ``MICROCYL_BACKEND=numpy|drjit`` chooses; unset, the default is ``drjit`` where it runs
 (Dr.Jit importable, its LLVM backend initialised with an LLVM of version 16 or later: LLVM 14
 and 15 abort the process on Dr.Jit's ``fmaximum``), else ``numpy`` with the reason written
-once per process (a :class:`RuntimeWarning`).
+once per process (a :class:`BackendWarning`, a UserWarning: the test suite's filters make
+brdf's RuntimeWarnings errors, and this one must not fail a machine without Dr.Jit).
 
 Dr.Jit's LLVM kernels flush subnormal numbers (below 2.2e-308) to zero, inputs and
 intermediates alike, where NumPy keeps them: pairs with a component nearly 0 (:func:`tiny_pairs`,
@@ -28,7 +29,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["backend", "available", "compiled", "tiny_pairs", "use_jit", "MIN_ELEMENTS", "BACKENDS", "BACKEND_ENV",
+__all__ = ["BackendWarning", "backend", "available", "compiled", "tiny_pairs", "use_jit", "MIN_ELEMENTS", "BACKENDS", "BACKEND_ENV",
            "MIN_LLVM",
            "TINY_COMPONENT"]
 
@@ -116,11 +117,15 @@ def backend() -> str:
     return "numpy"
 
 
+class BackendWarning(UserWarning):
+    """The Dr.Jit backend does not run here; the NumPy kernel does (said once a process)."""
+
+
 @functools.cache
 def _fallback(why: str) -> None:
     """Say once per process why the NumPy kernel runs."""
     warnings.warn(f"microcyl: the Dr.Jit backend does not run here ({why}); using the "
-                  f"NumPy kernel (set {BACKEND_ENV}=numpy to silence this)", RuntimeWarning,
+                  f"NumPy kernel (set {BACKEND_ENV}=numpy to silence this)", BackendWarning,
                   stacklevel=3)
 
 

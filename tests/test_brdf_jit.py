@@ -378,3 +378,23 @@ def test_no_pair_to_shade(monkeypatch):
             monkeypatch, "numpy", lambda: fab.prepare(wi[rows], wo[rows]).eval(eta=eta)),
             axis=1)
         assert np.isnan(prep.eval_and_grad()[1]["eta"][0]).all()
+
+
+@needs_drjit
+def test_threads_sharing_a_prepared(monkeypatch):
+    """Python threads sharing one Dr.Jit-backed Prepared (a fit's ensemble may) each get
+    their own batch's f_r, in both precisions, as when called one after another."""
+    import concurrent.futures
+    monkeypatch.setenv(jit.BACKEND_ENV, "drjit")
+    fab = brdf.fabric("velvet")
+    wi, wo = random_pairs(200, np.random.default_rng(12))
+    prep = fab.prepare(wi, wo)
+    assert prep._jit is not None
+    batches = [_batch(fab, 3, np.random.default_rng(s)) for s in range(8)]
+    dtypes = [np.float64, np.float32] * 4
+    serial = [prep.eval(**kw, dtype=dt) for kw, dt in zip(batches, dtypes)]
+    with concurrent.futures.ThreadPoolExecutor(4) as ex:
+        got = list(ex.map(lambda a: prep.eval(**a[0], dtype=a[1]), zip(batches, dtypes)))
+    for g, s in zip(got, serial):
+        np.testing.assert_array_equal(g, s)
+    assert not np.array_equal(serial[0], serial[2])

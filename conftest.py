@@ -5,10 +5,13 @@ import importlib.util
 import numpy as np
 import pytest
 
-#: These import Mitsuba at their top (an optional dependency at run time, imported only by
-#: reports.mitsuba.register()): their doctests are collected only where it is installed.
-collect_ignore = [] if importlib.util.find_spec("mitsuba") else [
-    "reports/mitsuba/kernel.py", "reports/mitsuba/bsdf.py"]
+#: These import Mitsuba or Dr.Jit at their top (optional dependencies at run time, imported
+#: only by reports.mitsuba.register() and brdf.jit.compiled()): their doctests are collected
+#: only where it is installed.
+collect_ignore = ([] if importlib.util.find_spec("mitsuba") else ["reports/mitsuba/bsdf.py",
+                                                                  "reports/mitsuba/scene.py"])
+collect_ignore += [] if importlib.util.find_spec("drjit") else [
+    f"brdf/jit/{m}.py" for m in ("consts", "kernel", "llvm", "sampler")]
 
 
 @pytest.fixture(autouse=True)

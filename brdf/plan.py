@@ -20,6 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from brdf import jit
 from brdf.combine import combine_rgb, inverse_denominator, normalization_q
 from brdf.frames import flat_pairs
 from brdf.kernel import ThreadGeometry, thread_geometry
@@ -212,7 +213,8 @@ class FabricPlan:
     # -- evaluation ----------------------------------------------------------------------
     def eval(self, wi, wo, split: bool = False) -> np.ndarray:
         """f_r (1/sr) of (..., 3) direction pairs, RGB (..., 3), or per thread (..., 2, 3)
-        with ``split``: what ``Fabric.eval`` and ``Fabric.eval_threads`` return."""
+        with ``split``: what ``Fabric.eval`` and ``Fabric.eval_threads`` return, from the
+        kernel :func:`brdf.jit.backend` names (NumPy's, or Dr.Jit's in float64)."""
         wi, wo, shape, bad, below = flat_pairs(wi, wo)
         n = wi.shape[0]
         out = np.zeros((n, 2, 3) if split else (n, 3))
@@ -227,6 +229,22 @@ class FabricPlan:
         return out.reshape(shape + out.shape[1:])
 
     def _eval_into(self, wi, wo, out, split):
+        if jit.use_jit(self, wi.shape[0]):   # the Dr.Jit kernel (brdf.jit), float64 on LLVM
+            exact = jit.tiny_pairs(wi, wo)   # NumPy's (brdf.jit's notes)
+            if exact.any():
+                part = np.zeros((int(exact.sum()),) + out.shape[1:])
+                self._numpy_into(wi[exact], wo[exact], part, split)
+                out[exact] = part
+                keep = ~exact
+                if keep.any():
+                    out[keep] = jit.compiled().eval_pairs(self, wi[keep], wo[keep], split)
+            else:
+                out[...] = jit.compiled().eval_pairs(self, wi, wo, split)
+            return
+        self._numpy_into(wi, wo, out, split)
+
+    def _numpy_into(self, wi, wo, out, split):
+        """The NumPy kernel's f_r of unit pairs above the horizon into ``out``."""
         par = self.params
         chunk = max(64, CHUNK_ELEMENTS // self.samples)
         for start in range(0, wi.shape[0], chunk):

@@ -6,14 +6,17 @@ import math
 
 import numpy as np
 
-from brdf import schema
+from brdf import jit, schema
 from brdf.frames import flat_pairs
 from brdf.kernel import ThreadGeometry
 from brdf.plan import FabricPlan, ShadeParams, plan_of
 from brdf.scratch import Scratch
 from brdf.shading import shade_dtype
 
-__all__ = ["Prepared"]
+__all__ = ["Prepared", "GRAD_PARAMS"]
+
+#: The parameters :meth:`Prepared.eval_and_grad` differentiates f_r by.
+GRAD_PARAMS = ("eta", "kd", "gamma_s", "gamma_v", "area", "albedo")
 
 
 class Prepared:
@@ -62,7 +65,16 @@ class Prepared:
         self._bad = bad
         self._ok = ~(bad | below)
         wi_ok, wo_ok = wi[self._ok], wo[self._ok]
-        self._geoms = plan.geometry(wi_ok, wo_ok)
+        self._pairs = (wi_ok, wo_ok)
+        # the Dr.Jit kernel (brdf.jit) shades (float64, float32), but for pairs with a nearly
+        # zero component (``_exact``, NumPy's: brdf.jit's notes); NumPy's geometry on first use
+        self._jit, self._exact, self._jit_all = None, None, None
+        if jit.use_jit(plan, wi_ok.shape[0]):
+            exact = jit.tiny_pairs(wi_ok, wo_ok)
+            self._jit = jit.compiled().PreparedJit(plan, wi_ok[~exact], wo_ok[~exact])
+            self._exact = exact if exact.any() else None
+            self._jit_all = None if exact.any() else self._jit
+        self._geoms: list[ThreadGeometry] | None = None
         self._geoms32: list[ThreadGeometry] | None = None
         self._scratch = Scratch()
         self._zi = wi_ok[:, 2]
@@ -82,7 +94,8 @@ class Prepared:
             computed, and the threads combined, in float64 either way, and the result is
             float64. float32 shades about twice as fast (the sampling of a fit uses it), at
             a relative error of a few 1e-6 where f_r is not far below its largest value
-            over the pairs; terms below about 1e-38 of their scale round to zero.
+            over the pairs; terms below about 1e-38 of their scale round to zero. Either
+            runs on the kernel :func:`brdf.jit.backend` names (Dr.Jit's or NumPy's).
 
         Returns
         -------
@@ -98,19 +111,92 @@ class Prepared:
             albedo >= 0, all finite), or a parameter set's areas sum above 1; checked on the
             whole batch before any shading. If ``dtype`` is not float64 or float32.
         """
-        geoms = self._geometries(dtype)
+        dtype = shade_dtype(dtype)
         par, batch = self._params(eta, albedo, kd, gamma_s, gamma_v, area)
         nb = par.eta.shape[0]
-        plan, block = self.plan, self.block_elements
-        shades = plan.shade(geoms, par, block=block, scratch=self._scratch)
         out = (np.empty if self._ok.all() else np.zeros)((nb, self._ok.size, 3))
-        vals = out if self._ok.all() else self._scratch.array("vals", (nb, self._zi.size, 3))
-        plan.combine_into(shades, [g.pmean for g in self._geoms], self._zi, self._zo, par,
-                          vals, block=block)
+        if self._jit is not None:
+            vals = self._jit_eval(par, dtype)
+            if self._ok.all():
+                out = vals                  # a new array of every pair
+        else:
+            vals = self._numpy_eval(par, dtype, out)
         if vals is not out:
             out[:, self._ok] = vals
         out[:, self._bad] = np.nan
         return out.reshape(batch + self.shape + (3,))
+
+    def eval_and_grad(self, *, eta=None, albedo=None, kd=None, gamma_s=None, gamma_v=None,
+                      area=None) -> tuple[np.ndarray, dict]:
+        r"""f_r (1/sr) of the prepared pairs for a batch of parameter sets, as :meth:`eval`
+        (float64), and its derivatives by each parameter, from Dr.Jit's automatic
+        differentiation (forward mode) whatever :func:`brdf.jit.backend` says.
+
+        Returns
+        -------
+        f : ndarray, shape (B..., n..., 3)
+        grads : dict of ndarray, shape (B..., n..., 3, 2)
+            For each of ``eta``, ``kd``, ``gamma_s``, ``gamma_v``, ``area``, ``albedo``:
+            ``grads[name][..., ch, j]`` = d f_r[..., ch] / d name[..., j] of the same
+            parameter set (thread j; per degree for the gammas, 1/sr per degree; for
+            ``albedo`` the derivative by thread j's albedo in the same channel ch, those by
+            the other channels being 0). NaN where f_r is NaN (bad pairs), 0 below the
+            horizon.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`eval`.
+        RuntimeError
+            Dr.Jit does not run here (the reason given).
+        """
+        par, batch = self._params(eta, albedo, kd, gamma_s, gamma_v, area)
+        ok, why = jit.available()
+        if not ok:
+            raise RuntimeError(f"eval_and_grad needs Dr.Jit, which does not run here: {why}")
+        if self._jit_all is None:       # subnormal components raised to the least normal
+            self._jit_all = jit.compiled().PreparedJit(self.plan, *map(_normal, self._pairs))
+        nb = par.eta.shape[0]
+        f, grads = np.zeros((nb, self._ok.size, 3)), {}
+        if self._zi.size:
+            gvals = self._jit_all.eval_and_grad(par)[1]
+            vals = (self._jit_eval(par, np.float64) if self._jit is not None   # eval's f_r
+                    else self._numpy_eval(par, np.float64, None).copy())
+        else:
+            vals, gvals = f[:, :0], {k: np.zeros((nb, 0, 3, 2)) for k in GRAD_PARAMS}
+        f[:, self._ok] = vals
+        f[:, self._bad] = np.nan
+        for name, g in gvals.items():
+            full = np.zeros((nb, self._ok.size, 3, 2))
+            full[:, self._ok] = g
+            full[:, self._bad] = np.nan
+            grads[name] = full.reshape(batch + self.shape + (3, 2))
+        return f.reshape(batch + self.shape + (3,)), grads
+
+    def _jit_eval(self, par: ShadeParams, dtype) -> np.ndarray:
+        """The Dr.Jit kernel's f_r (nb, pairs above the horizon, 3), shaded in ``dtype``;
+        those with a nearly zero component (:func:`brdf.jit.tiny_pairs`) from the NumPy
+        kernel."""
+        single = dtype == np.float32
+        if self._exact is None:
+            return self._jit.eval(par, single)
+        vals = self._numpy_eval(par, dtype, None).copy()
+        keep = ~self._exact
+        if keep.any():
+            vals[:, keep] = self._jit.eval(par, single)
+        return vals
+
+    def _numpy_eval(self, par: ShadeParams, dtype, out) -> np.ndarray:
+        """The NumPy kernel's shading of the prepared pairs into ``out`` (nb, n, 3) where
+        every pair is above the horizon, else into a buffer of the pairs that are (returned)."""
+        geoms = self._geometries(dtype)
+        nb, plan, block = par.eta.shape[0], self.plan, self.block_elements
+        shades = plan.shade(geoms, par, block=block, scratch=self._scratch)
+        vals = out if out is not None and self._ok.all() else self._scratch.array(
+            "vals", (nb, self._zi.size, 3))
+        plan.combine_into(shades, [g.pmean for g in self._geometries(np.float64)], self._zi,
+                          self._zo, par, vals, block=block)
+        return vals
 
     def _params(self, eta, albedo, kd, gamma_s, gamma_v, area) -> tuple[ShadeParams, tuple]:
         """The parameters checked (the plan's where omitted; gammas to radians) and
@@ -149,13 +235,23 @@ class Prepared:
         return ShadeParams(*(flat(x, 1) for x in (eta, kd, gs, gv, area)), flat(alb, 2)), batch
 
     def _geometries(self, dtype) -> list[ThreadGeometry]:
-        """The threads' geometry in ``dtype`` (float32 copies made once, on first use)."""
+        """The NumPy kernel's geometry in ``dtype`` (made once, on first use; float32 copies
+        of the float64)."""
+        if self._geoms is None:
+            self._geoms = self.plan.geometry(*self._pairs)
         if shade_dtype(dtype) == np.float64:
             return self._geoms
         if self._geoms32 is None:
             self._geoms32 = [ThreadGeometry(*(None if a is None else _to_float32(a) for a in g))
                              for g in self._geoms]
         return self._geoms32
+
+
+def _normal(w: np.ndarray) -> np.ndarray:
+    """``w`` with its subnormal components raised to the least normal number, their sign
+    kept (what Dr.Jit's kernels would flush to 0)."""
+    tiny = np.finfo(np.float64).tiny
+    return np.where((w != 0) & (np.abs(w) < tiny), np.copysign(tiny, w), w)
 
 
 def _to_float32(a: np.ndarray) -> np.ndarray:

@@ -508,14 +508,15 @@ def test_export_xml_loads_in_a_scene_file(fit_folder, scalar, tmp_path):
 
 @needs_mitsuba
 def test_kernel_on_its_consts_matches_fabric_without_the_plugin(scalar):
-    """reports.mitsuba.kernel.eval_cos on reports.mitsuba.consts.consts, called directly (no
+    """brdf.jit.sampler.eval_cos on brdf.jit.consts.consts in the variant's types, called directly (no
     BSDF object): f_r cos(theta_i) of brdf.Fabric in float64 at random pairs; the constants
     carry the fabric's options and gap area, the sampler's cdf ends at 1; and
     reports.mitsuba.bsdf.bsdf_class() is one mi.BSDF subclass per variant."""
     mi = scalar
-    from reports.mitsuba import bsdf as mbsdf, consts as mconsts, kernel as mkernel
+    from brdf.jit import consts as mconsts, sampler as mkernel
+    from reports.mitsuba import bsdf as mbsdf
     fab = brdf.fabric("silk_shot", masking=False, gap="outgoing")
-    k = mconsts.consts(fab)
+    k = mconsts.consts(fab.plan, mbsdf.variant_types(), brdf.sampling.lobe_probabilities(fab))
     assert k.masking is False and k.reweighting is True and str(k.gap) == "outgoing"
     assert k.gap_area == pytest.approx(1 - fab.threads[0].area - fab.threads[1].area)
     assert k.comp_cdf[-1] == 1.0 and len(k.comp_cdf) == k.comp_size

@@ -2,8 +2,8 @@
 
 :mod:`~reports.mitsuba.plugin` registers the plugin (:func:`register`; its names are re-exported
 here, with the plugin's dictionary, which needs no Mitsuba); :mod:`~reports.mitsuba.bsdf`
-the BSDF class, :mod:`~reports.mitsuba.kernel` its Dr.Jit kernel, :mod:`~reports.mitsuba.consts` a
-fabric's numbers as the kernel's parameters; :mod:`~reports.mitsuba.scene` the scenes as Mitsuba scenes,
+the BSDF class around brdf's Dr.Jit kernel (:mod:`brdf.jit`, in the variant's float type);
+:mod:`~reports.mitsuba.scene` the scenes as Mitsuba scenes,
 :mod:`~reports.mitsuba.render` the render and its variant choice. Mitsuba is imported on use.
 """
 

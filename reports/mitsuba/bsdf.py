@@ -1,5 +1,5 @@
 """The Mitsuba BSDF class of :mod:`reports.mitsuba.plugin`: Mitsuba's interface around
-:mod:`reports.mitsuba.kernel`.
+brdf's Dr.Jit kernel (:mod:`brdf.jit.kernel`, :mod:`brdf.jit.sampler`) in the variant's types.
 
 A Mitsuba plugin class derives from the ``mi.BSDF`` of one variant, so :func:`bsdf_class`
 builds one per variant (and keeps it). Imports Mitsuba at its top: it is imported only by
@@ -13,15 +13,17 @@ import math
 import numpy as np
 
 import brdf
+from brdf import sampling
 
 # optional dependencies: this module is imported only by reports.mitsuba.register()
 import drjit as dr
 import mitsuba as mi
 
-from reports.mitsuba import kernel as kern
+from brdf.jit import sampler as kern
+from brdf.jit.consts import Types, consts
 from analysis.fabricfile import PLUGIN_NAME, fabric_from_dict
 
-__all__ = ["bsdf_class", "TRAVERSED_THREAD_KEYS", "TEXTURED_KEYS"]
+__all__ = ["bsdf_class", "variant_types", "TRAVERSED_THREAD_KEYS", "TEXTURED_KEYS"]
 
 _CLASSES: dict = {}
 
@@ -66,7 +68,8 @@ def _warp(si, rotation):
     c, s = dr.select(ok, d.x * inv, 1.0), dr.select(ok, d.y * inv, 0.0)
     # the turn in double precision: in float32, cos(40 degrees) alone moved velvet's f_r by
     # 1.5e-4 of its peak
-    c, s = kern.wide(c), kern.wide(s)
+    if dr.is_jit_v(c):
+        c, s = mi.Float64(c), mi.Float64(s)
     cr, sr = math.cos(rotation), math.sin(rotation)
     return c * cr - s * sr, s * cr + c * sr
 
@@ -133,6 +136,18 @@ def _fabric_with(fabric, params, keys) -> brdf.Fabric:
     return fabric.replace(threads=threads, rotation=rotation)
 
 
+def variant_types() -> Types:
+    """The kernel's types in the variant that is set: ``mi.Float`` (float32) shading, the
+    frame in ``mi.Float64``."""
+    return Types(mi.Float, mi.Float64, mi.UInt32, mi.Color3f, mi.Vector3f,
+                 mi.warp.square_to_cosine_hemisphere)
+
+
+def _consts(fabric):
+    """The kernel's constants of ``fabric`` in the variant's types, the sampler's included."""
+    return consts(fabric.plan, variant_types(), sampling.lobe_probabilities(fabric.plan))
+
+
 def bsdf_class():
     """The ``microcylinder`` BSDF class of the variant that is set."""
     variant = mi.variant()
@@ -151,7 +166,7 @@ def _make_class():
             mi.BSDF.__init__(self, props)
             plain, self.textures = _props_dict(props)
             self.fabric = fabric_from_dict(plain)
-            self.k = kern.consts(self.fabric)
+            self.k = _consts(self.fabric)
             self.params = {key: _param(v)
                            for key, v in _values_of(self.fabric, self.textures).items()}
             self.m_components = [flags]
@@ -174,7 +189,7 @@ def _make_class():
             except ValueError:
                 _write(self.params, self.fabric)        # back to the values in use
                 raise
-            self.fabric, self.k = fabric, kern.consts(fabric)
+            self.fabric, self.k = fabric, _consts(fabric)
 
         def _frame(self, si):
             return _warp(si, self.k.rotation)
@@ -202,7 +217,7 @@ def _make_class():
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             c, s = self._frame(si)
-            cn, sn = kern.narrow(c), kern.narrow(s)
+            cn, sn = (mi.Float(c), mi.Float(s)) if dr.is_jit_v(c) else (c, s)
             wo = kern.sample(self.k, si.wi, sample1, sample2, cn, sn)
             f, p = kern.eval_pdf(self.k, wo, si.wi, c, s, albedo=self._albedo(si, active))
             on = active & ctx.is_enabled(mi.BSDFFlags.GlossyReflection) & (p > 0.0) \

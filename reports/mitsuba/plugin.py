@@ -10,8 +10,8 @@ also take a Mitsuba texture (``bitmap``, ``checkerboard``, ...): f_r uses its va
 hit, the sampler its mean (:data:`reports.mitsuba.bsdf.TEXTURED_KEYS`). ``mi.traverse`` exposes each
 thread's ``eta``, ``albedo``, ``kd``, ``gamma_s``, ``gamma_v`` and ``area`` (1 or 2 appended) and
 ``rotation`` for editing (:data:`reports.mitsuba.bsdf.TRAVERSED_THREAD_KEYS`); a JIT variant
-then reuses its compiled kernel. The kernel is written in
-Dr.Jit (:mod:`reports.mitsuba.kernel`) and runs in ``scalar_rgb``, ``llvm_ad_rgb`` and
+then reuses its compiled kernel. The kernel is brdf's Dr.Jit kernel (:mod:`brdf.jit.kernel`,
+:mod:`brdf.jit.sampler`, in the variant's float type) and runs in ``scalar_rgb``, ``llvm_ad_rgb`` and
 ``cuda_ad_rgb``.
 
 Conventions. Mitsuba's ``si.wi`` points toward the viewer and a BSDF's ``wo`` toward the light:
@@ -46,17 +46,18 @@ RGB_VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
 
 
 def mitsuba_modules():
-    """``(mitsuba, drjit, bsdf)``: Mitsuba, Dr.Jit and :mod:`reports.mitsuba.bsdf`, imported on
-    first use (the one place the plugin's modules load them).
+    """``(mitsuba, drjit, bsdf, scene)``: Mitsuba, Dr.Jit, :mod:`reports.mitsuba.bsdf` and
+    :mod:`reports.mitsuba.scene`, imported on first use (the one place the modules of
+    reports.mitsuba load them).
 
     Raises
     ------
     ImportError
         Mitsuba is not installed.
     """
-    # optional dependency, loaded on use: bsdf imports mitsuba and drjit at its top
-    from reports.mitsuba import bsdf
-    return bsdf.mi, bsdf.dr, bsdf
+    # optional dependency, loaded on use: bsdf and scene import mitsuba and drjit at their top
+    from reports.mitsuba import bsdf, scene
+    return bsdf.mi, bsdf.dr, bsdf, scene
 
 
 def register() -> None:
@@ -72,7 +73,7 @@ def register() -> None:
     ValueError
         No variant is set, or it is not one of :data:`RGB_VARIANTS`' kind (``*_rgb``).
     """
-    mi, _, mitsuba_bsdf = mitsuba_modules()
+    mi, _, mitsuba_bsdf, _ = mitsuba_modules()
 
     variant = mi.variant()
     if variant is None or not variant.endswith("_rgb") or "polarized" in variant:

@@ -196,7 +196,7 @@ def render_mitsuba(scene, fabric, width=1280, height=720, spp=16, *, seed=0, max
 
 def _start_mitsuba(variant, workers):
     """Set ``variant``, register the plugin, set Dr.Jit's threads; return the mitsuba module."""
-    mi, dr, _ = plugin.mitsuba_modules()
+    mi, dr, _, _ = plugin.mitsuba_modules()
     mi.set_variant(variant)
     plugin.register()
     if workers is not None and variant != "scalar_rgb":
@@ -206,7 +206,7 @@ def _start_mitsuba(variant, workers):
 
 def _load_scenes(mi, scene, fabric, width, height, per_pass, max_depth) -> list:
     """The Mitsuba scenes of ``scene``: one per light (key, sky), or one of its only light."""
-    from reports.mitsuba import scene as mitsuba_scene  # imports mitsuba at its top
+    mitsuba_scene = plugin.mitsuba_modules()[3]
 
     # one scene per light (key, sky), their images summed: every path samples both lights
     # (one scene of both would send each shadow ray to one of them, chosen at random)

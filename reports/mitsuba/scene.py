@@ -37,7 +37,7 @@ import numpy as np
 # optional dependency: this module is imported only by reports.mitsuba.render on use
 import mitsuba as mi
 
-from reports.mitsuba import plugin
+from analysis.fabricfile import plugin_dict
 from reports.render.cameras import OrthographicCamera, PinholeCamera
 from reports.render.lights import DirectionalLight, PointLight
 from reports.render.primitives import Curtain, Cylinder, Plane, Rectangle, Sphere
@@ -211,8 +211,8 @@ def _bsdf(prim, fabric):
     closed) or a two-sided diffuse grey."""
     if prim.material == "cloth":
         if isinstance(prim, (Cylinder, Sphere)):
-            return plugin.plugin_dict(fabric)
-        return {"type": "twosided", "bsdf": plugin.plugin_dict(fabric)}
+            return plugin_dict(fabric)
+        return {"type": "twosided", "bsdf": plugin_dict(fabric)}
     a = float(prim.albedo)
     return {"type": "twosided",
             "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [a, a, a]}}}

@@ -1,0 +1,149 @@
+"""The Dr.Jit backend against the NumPy kernel: single-thread float64 ``Fabric.eval`` on
+every preset, and a fit's batched ``Prepared.eval``, as ratios drjit/numpy of their rates.
+
+Both backends run in this one process, interleaved (numpy, drjit, numpy, drjit, ...) so that
+the load of a shared machine falls on both alike; each figure is the median over
+``--rounds`` rounds of the CPU time of one call (after a warm-up call that compiles the
+Dr.Jit kernel). Single-threaded: NumPy's BLAS through threadpoolctl, Dr.Jit's pool by
+``dr.set_thread_count(1)``; then the batched eval again with Dr.Jit on every core (wall
+time; NumPy's kernel has one thread). The machine and its load average are printed with the figures.
+
+Run: DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so \
+     .venv/bin/python bench/bench_backend.py [--pairs N] [--rounds R] [--batch B]
+"""
+
+import os
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[var] = "1"
+
+import argparse  # noqa: E402
+import platform  # noqa: E402
+import statistics  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+import brdf  # noqa: E402
+import gonio  # noqa: E402
+from brdf import jit  # noqa: E402
+
+
+_clock = time.process_time
+
+
+def _cpu(fn) -> float:
+    """Seconds of ``fn()``: CPU time of the process (single-threaded runs), or wall time
+    once Dr.Jit runs on several threads (``_clock``)."""
+    t0 = _clock()
+    fn()
+    return _clock() - t0
+
+
+def interleaved(calls: dict, rounds: int) -> dict:
+    """Median seconds of each of ``calls`` ((backend, label) -> function), run in turn."""
+    times = {key: [] for key in calls}
+    for key, fn in calls.items():         # warm-up: compiles the Dr.Jit kernel
+        with_backend(key[0], fn)
+    for _ in range(rounds):
+        for key, fn in calls.items():
+            times[key].append(with_backend(key[0], lambda: _cpu(fn)))
+    return {key: statistics.median(t) for key, t in times.items()}
+
+
+def with_backend(name, fn):
+    """``fn()`` with MICROCYL_BACKEND set to ``name``."""
+    os.environ[jit.BACKEND_ENV] = name
+    try:
+        return fn()
+    finally:
+        del os.environ[jit.BACKEND_ENV]
+
+
+def hemisphere(rng, n):
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2])
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def bench_eval(pairs, rounds):
+    rng = np.random.default_rng(0)
+    wi, wo = hemisphere(rng, pairs), hemisphere(rng, pairs)
+    out = {}
+    for name in brdf.PRESETS:
+        fab = brdf.fabric(name)
+        t = interleaved({(b, ""): (lambda: fab.eval(wi, wo)) for b in ("numpy", "drjit")},
+                        rounds)
+        t = {b: v for (b, _), v in t.items()}
+        out[name] = t
+        print(f"eval  {name:32s} {pairs} pairs  numpy {t['numpy'] * 1e3:8.1f} ms  drjit "
+              f"{t['drjit'] * 1e3:8.1f} ms  ratio {t['numpy'] / t['drjit']:5.1f}x", flush=True)
+    return out
+
+
+def walkers(fab, batch):
+    """A fit's batch: each parameter of each thread spread by a few percent about the
+    fabric's (gamma_v no longer 2 gamma_s: the NumPy kernel's one-exp shortcut is off, as
+    in a fit that frees both)."""
+    rng = np.random.default_rng(1)
+    spread = lambda v: np.asarray(v) * rng.uniform(0.95, 1.05, (batch,) + np.shape(v))  # noqa: E731
+    th = fab.threads
+    kw = {name: spread([getattr(t, name) for t in th])
+          for name in ("kd", "gamma_s", "gamma_v", "albedo")}
+    kw["eta"] = 1.0 + spread([t.eta - 1.0 for t in th])
+    kw["area"] = spread([t.area for t in th]) * 0.95
+    return kw
+
+
+def bench_prepared(batch, rounds, fabrics):
+    out = {}
+    for name in fabrics:
+        fab = brdf.fabric(name)
+        tab = gonio.measure(fab, "full:15:30", gonio.Instrument(snr=20, floor=1e-4), seed=0,
+                            progress=False)
+        kw = walkers(fab, batch)
+        preps = {b: with_backend(b, lambda: fab.prepare(tab.wi, tab.wo))
+                 for b in ("numpy", "drjit")}
+        t = interleaved({(b, dt): (lambda p=p, dt=dt: p.eval(**kw, dtype=dt))
+                         for b, p in preps.items() for dt in ("float64", "float32")}, rounds)
+        out[name] = t
+        n64, d64 = t["numpy", "float64"], t["drjit", "float64"]
+        n32, d32 = t["numpy", "float32"], t["drjit", "float32"]
+        print(f"batch {name:28s} {len(tab.wi)} pairs x {batch} sets  float64 numpy "
+              f"{n64 * 1e3:6.1f} ms drjit {d64 * 1e3:6.1f} ms ratio {n64 / d64:4.1f}x;  "
+              f"float32 numpy {n32 * 1e3:6.1f} ms drjit {d32 * 1e3:6.1f} ms ratio "
+              f"{n32 / d32:4.1f}x", flush=True)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--pairs", type=int, default=20000)
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--batch", type=int, default=32)
+    ap.add_argument("--fabrics", nargs="+", default=["silk_crepe_de_chine", "linen_plain"])
+    args = ap.parse_args()
+    ok, why = jit.available()
+    if not ok:
+        raise SystemExit(f"Dr.Jit does not run here: {why}")
+    import drjit as dr  # the benchmark's own: brdf.jit has loaded it already
+    dr.set_thread_count(1)
+    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"Dr.Jit {dr.__version__}, LLVM {'.'.join(map(str, dr.detail.llvm_version()))}; "
+          f"load average {os.getloadavg()[0]:.2f}", flush=True)
+    with threadpool_limits(1):
+        bench_eval(args.pairs, args.rounds)
+        bench_prepared(args.batch, args.rounds, args.fabrics)
+        cores = os.cpu_count()
+        dr.set_thread_count(cores)
+        print(f"-- Dr.Jit on {cores} threads (NumPy still one); wall time, not CPU time:",
+              flush=True)
+        global _clock
+        _clock = time.perf_counter
+        bench_prepared(args.batch, args.rounds, args.fabrics)
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -36,8 +36,8 @@ integrating to 1.
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
+from brdf import horizon
 from brdf.frames import as_directions, flat_pairs, normalize
 from brdf.plan import plan_of
 from brdf.shading import GAUSS_NORM
@@ -53,7 +53,6 @@ LOBE_FLOOR = 0.05
 _COS_MIN = 1e-12
 #: (pair, tangent sample) elements per chunk of the pdf.
 _CHUNK = 1 << 15
-_HALF_PI = 0.5 * np.pi
 
 
 def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
@@ -121,11 +120,6 @@ def _sigmas(plan):
     return np.array([[2.0 * c.gamma_s, 2.0 * c.gamma_v] for c in plan.threads])
 
 
-def _gauss_mass(mu, sigma):
-    """Mass of N(mu, sigma) on [-pi/2, pi/2] (mu in that interval: the mass is >= 1/2)."""
-    return ndtr((_HALF_PI - mu) / sigma) - ndtr((-_HALF_PI - mu) / sigma)
-
-
 def pdf(fabric, wo, wi) -> np.ndarray:
     r"""Density of :func:`sample`'s directions wi for the viewer wo, 1/sr (solid angle).
 
@@ -182,6 +176,7 @@ def _pdf_flat(plan, wi, wo):
     masking = plan.options.masking
     if wo.shape[0] > 1 and np.all(wo == wo[:1]):
         wo = wo[:1]                     # one viewer (the common case): its terms once
+    up = wi[:, 2] > 0.0
     total = (1.0 - thread.sum()) / np.pi * np.maximum(wi[:, 2], 0.0)
     for j, c in enumerate(plan.threads):
         if thread[j] == 0.0:
@@ -196,17 +191,21 @@ def _pdf_flat(plan, wi, wo):
         br = wo @ b[j]                                    # only theta_r of wo is needed
         mu = -np.arctan2(sr, np.sqrt(xr * xr + br[:, None] ** 2))
         th = np.arctan2(si, cth)
-        scale = [GAUSS_NORM / (s * _gauss_mass(mu, s)) for s in sig[j]]
-        # p_phi / cos(theta) and p_phi for the two parametrizations
+        lo, hi = horizon.theta_range(ca, sa)
+        _, mass_phi = horizon.azimuth_window(si, cth, ca, sa, masking)
+        # p_phi / (M cos(theta)): the azimuth's density truncated to its window
         if masking:
             pphi = np.maximum(xi, 0.0) / (2.0 * cth)
         else:
             pphi = np.full_like(cth, 0.5 / np.pi)
-        dens = 0.5 * lobe[j, 2]
+        pphi = np.divide(pphi, mass_phi, out=np.zeros_like(pphi),
+                         where=up[:, None] & (mass_phi > 0))
+        dens = lobe[j, 2] / (np.sin(hi) - np.sin(lo))
         for k in range(2):
             s = sig[j, k]
             z = (th - mu) / s
-            g = np.exp(-0.5 * z * z) * scale[k]
+            log_mass = horizon.truncnorm_logmass(mu, s, lo, hi)
+            g = np.exp(-0.5 * z * z - log_mass) * (GAUSS_NORM / s)
             dens = dens + lobe[j, k] * g / cth
         total += thread[j] * ((dens * pphi) @ c.weight)
     return total
@@ -257,8 +256,8 @@ def _draw(plan, wo, u0, u1):
     """Directions wi (n, 3) for unit wo (n, 3) and uniforms u0, u1 (n,)."""
     cdf, jj, ca, sa, kind = _components(plan)
     k = np.minimum(np.searchsorted(cdf, u0, side="right"), cdf.size - 1)
-    lo = np.where(k > 0, cdf[np.maximum(k - 1, 0)], 0.0)
-    v = np.clip((u0 - lo) / (cdf[k] - lo), 0.0, np.nextafter(1.0, 0.0))
+    start = np.where(k > 0, cdf[np.maximum(k - 1, 0)], 0.0)
+    v = np.clip((u0 - start) / (cdf[k] - start), 0.0, np.nextafter(1.0, 0.0))
     j, ca, sa, kind = jj[k], ca[k], sa[k], kind[k]
     t0, b = _axes(plan)
     t0, b = t0[j], b[j]
@@ -271,17 +270,14 @@ def _draw(plan, wo, u0, u1):
     br = np.einsum("ij,ij->i", wo, b)
     mu = -np.arctan2(sr, np.hypot(xr, br))
     sig = _sigmas(plan)[j, np.minimum(kind, 1)]
-    lo_p = ndtr((-_HALF_PI - mu) / sig)
-    th = mu + sig * ndtri(lo_p + v * _gauss_mass(mu, sig))
-    th = np.clip(th, -_HALF_PI, _HALF_PI)
+    lo, hi = horizon.theta_range(ca, sa)
+    th = horizon.truncnorm_draw(mu, sig, lo, hi, v)
     s, c = np.sin(th), np.cos(th)
-    iso = kind == 2
-    s[iso] = 2.0 * v[iso] - 1.0
-    c[iso] = 2.0 * np.sqrt(v[iso] * (1.0 - v[iso]))
-    if plan.options.masking:
-        phi = np.arcsin(2.0 * u1 - 1.0)
-    else:
-        phi = np.pi * (2.0 * u1 - 1.0)
+    iso = kind == 2                                    # sin(theta) uniform in its range
+    s[iso] = np.sin(lo[iso]) + v[iso] * (np.sin(hi[iso]) - np.sin(lo[iso]))
+    c[iso] = np.sqrt(np.maximum(1.0 - s[iso] ** 2, 0.0))
+    m, _ = horizon.azimuth_window(s, c, ca, sa, plan.options.masking)
+    phi = horizon.azimuth_draw(m, u1, plan.options.masking)
     wi = s[:, None] * t + c[:, None] * (np.cos(phi)[:, None] * nt + np.sin(phi)[:, None] * b)
     cos = kind < 0                                     # cosine-weighted hemisphere
     r = np.sqrt(v[cos])

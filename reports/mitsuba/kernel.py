@@ -35,12 +35,12 @@ import mitsuba as mi
 
 from brdf.options import Gap, Transmission
 from brdf.terms import SIGMA_U
+from reports.mitsuba import horizon
 from reports.mitsuba.consts import GAUSS_NORM, Consts, consts
 
 __all__ = ["Consts", "consts", "eval_pdf", "eval_cos", "sample", "wide", "narrow"]
 
 _K_U = -0.5 / SIGMA_U**2            # u(x) = exp(_K_U x^2)
-_HALF_PI = 0.5 * math.pi
 _COS_MIN = 1e-12                    # as brdf.sampling: the 1/cos(theta) density stays finite
 
 
@@ -122,6 +122,7 @@ def _sample_terms(th, ca, sa, light, view, k, density):
     ui_x, ui_y = dr.select(zero_i, 1.0, xi / ci_s), dr.select(zero_i, 0.0, bi / ci_s)
     ur_x, ur_y = dr.select(zero_r, 1.0, xr / cr_s), dr.select(zero_r, 0.0, bo / cr_s)
     hp = narrow(dr.clip(0.25 * (dr.square(ui_x + ur_x) + dr.square(ui_y + ur_y)), 0.0, 1.0))
+    wide_angles = (ca, sa, si, xi, ci, sr, cr)           # the density's, in double precision
     cc, ss = ci * cr, si * sr
     c2d = narrow(1.0 + cc + ss)                           # 2 cos^2(theta_d)
     th2 = dr.square(narrow(dr.atan2(si * cr + ci * sr, cc - ss)))   # (theta_i + theta_r)^2
@@ -154,7 +155,7 @@ def _sample_terms(th, ca, sa, light, view, k, density):
     vol = ft * (gv + th.kd) * geo / dr.select(csum > 0.0, csum, 1.0)
     if not density:
         return surf, vol, p
-    return surf, vol, p, _density(k, th, si, xi, ci, sr, cr)
+    return surf, vol, p, narrow(_density(k, th, *wide_angles))
 
 
 def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True, albedo=(None, None)):
@@ -214,32 +215,28 @@ def eval_cos(k: Consts, light, view, rot_c, rot_s, albedo=(None, None)):
 
 
 # -- the sampler (brdf/sampling.py) --------------------------------------------------------
-def _ndtr(x):
-    """Standard normal CDF."""
-    return 0.5 * (1.0 + dr.erf(x * (1.0 / math.sqrt(2.0))))
-
-
-def _ndtri(p):
-    """Standard normal quantile."""
-    return math.sqrt(2.0) * dr.erfinv(dr.clip(2.0 * p - 1.0, -1.0, 1.0))
-
-
-def _density(k, th, si, xi, ci, sr, cr):
-    """The density (1/sr) of a thread's lobes at one tangent sample, unweighted: the
-    light's longitudinal angle (sine ``si``, cosine ``ci``; ``xi`` its cosine's component
-    along the normal's side) under the Gaussians about the mirror of the viewer's (``sr``,
-    ``cr``), times the azimuth's density (brdf.sampling)."""
+def _density(k, th, ca, sa, si, xi, ci, sr, cr):
+    """The density (1/sr) of a thread's lobes at one tangent sample (cos, sin of its offset
+    ``ca``, ``sa``), unweighted: the light's longitudinal angle (sine ``si``, cosine ``ci``;
+    ``xi`` its cosine's component along the normal's side) under the Gaussians about the
+    mirror of the viewer's (``sr``, ``cr``), truncated to the angles with an azimuth above
+    the horizon, times the azimuth's density truncated to its window (brdf.sampling,
+    brdf.horizon)."""
     cth = dr.maximum(ci, _COS_MIN)
     mu = -dr.atan2(sr, cr)
     th_i = dr.atan2(si, cth)
-    dens = 0.5 * th.lobe_p[2]
+    lo, hi = horizon.theta_range(ca, sa)
+    dens = wide(th.lobe_p[2]) / (dr.sin(hi) - dr.sin(lo))
     for lobe in (0, 1):
-        inv = th.inv_sig[lobe]
-        mass = _ndtr((_HALF_PI - mu) * inv) - _ndtr((-_HALF_PI - mu) * inv)
+        inv = wide(th.inv_sig[lobe])
+        log_mass = horizon.truncnorm_logmass(mu, inv, lo, hi)
         z = (th_i - mu) * inv
-        dens += th.lobe_p[lobe] * dr.exp(-0.5 * z * z) * (GAUSS_NORM * inv) / (mass * cth)
+        dens += (wide(th.lobe_p[lobe]) * dr.exp(-0.5 * z * z - log_mass)
+                 * (GAUSS_NORM * inv) / cth)
+    _, mass = horizon.azimuth_window(si, cth, ca, sa, k.masking)
     pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
-    return dens * pphi
+    ok = mass > 0.0
+    return dr.select(ok, dens * pphi / dr.select(ok, mass, 1.0), 0.0)
 
 
 def _pick(k: Consts, u):
@@ -271,15 +268,13 @@ def sample(k: Consts, view, u1, u2, rot_c, rot_s):
     mu = -dr.atan2(dr.dot(view, t), dr.sqrt(dr.square(dr.dot(view, nt))
                                             + dr.square(dr.dot(view, b))))
     v = u2.x
-    lo = _ndtr((-_HALF_PI - mu) / sig)
-    mass = _ndtr((_HALF_PI - mu) / sig) - lo
-    th = dr.clip(mu + sig * _ndtri(lo + v * mass), -_HALF_PI, _HALF_PI)
-    iso = kind > 1.5
-    s = dr.select(iso, 2.0 * v - 1.0, dr.sin(th))
-    c = dr.select(iso, 2.0 * dr.sqrt(dr.maximum(v * (1.0 - v), 0.0)), dr.cos(th))
-    if k.masking:
-        phi = dr.asin(dr.clip(2.0 * u2.y - 1.0, -1.0, 1.0))
-    else:
-        phi = math.pi * (2.0 * u2.y - 1.0)
+    lo, hi = horizon.theta_range(ca, sa)
+    th = horizon.truncnorm_draw(mu, sig, lo, hi, v)
+    iso = kind > 1.5                                   # sin(theta) uniform in its range
+    s_lo, s_hi = dr.sin(lo), dr.sin(hi)
+    s = dr.select(iso, s_lo + v * (s_hi - s_lo), dr.sin(th))
+    c = dr.select(iso, dr.sqrt(dr.maximum(1.0 - s * s, 0.0)), dr.cos(th))
+    m, _ = horizon.azimuth_window(s, c, ca, sa, k.masking)
+    phi = horizon.azimuth_draw(m, u2.y, k.masking)
     wi = s * t + c * (dr.cos(phi) * nt + dr.sin(phi) * b)
     return dr.select(kind < -0.5, mi.warp.square_to_cosine_hemisphere(u2), wi)

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import log_ndtr, ndtri_exp
 
-__all__ = ["theta_range", "azimuth_window", "azimuth_draw", "truncnorm_logmass",
+__all__ = ["theta_range", "azimuth_window", "azimuth_mass", "azimuth_draw", "truncnorm_logmass",
            "truncnorm_draw"]
 
 _HALF_PI = 0.5 * np.pi
@@ -97,17 +97,42 @@ def azimuth_window(st, ct, ca, sa, masking) -> tuple[np.ndarray, np.ndarray]:
     >>> float(np.degrees(m)), float(M)
     (90.0, 1.0)
     """
-    st, ct, ca, sa = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
-                                           for x in (st, ct, ca, sa)))
-    den = ct * ca
-    with np.errstate(divide="ignore", invalid="ignore"):
-        one_minus_q = (ct * ca + st * sa) / den
-    one_minus_q = np.where(den > 0, one_minus_q, np.where(st * sa > 0, np.inf, -np.inf))
-    m = 2.0 * np.arcsin(np.sqrt(np.clip(0.5 * one_minus_q, 0.0, 1.0)))
+    x = _half_versine(st, ct, ca, sa)
+    m = 2.0 * np.arcsin(np.sqrt(x))
     if masking:
         m = np.minimum(m, _HALF_PI)
         return m, np.sin(m)
     return m, m / np.pi
+
+
+def azimuth_mass(st, ct, ca, sa, masking) -> np.ndarray:
+    r"""The mass M of :func:`azimuth_window` alone, without its inverse sines where
+    ``masking`` is on: :math:`M = \sin m = 2\sqrt{x(1 - x)}` for :math:`x = \sin^2(m/2) \le
+    1/2`, else 1.
+
+    Examples
+    --------
+    >>> st, ct = np.sin(0.3), np.cos(0.3)
+    >>> bool(np.isclose(azimuth_mass(st, ct, 0.8, -0.6, True),
+    ...                 azimuth_window(st, ct, 0.8, -0.6, True)[1]))
+    True
+    """
+    x = _half_versine(st, ct, ca, sa)
+    if masking:
+        return np.where(x >= 0.5, 1.0, 2.0 * np.sqrt(x * (1.0 - x)))
+    return (2.0 / np.pi) * np.arcsin(np.sqrt(x))
+
+
+def _half_versine(st, ct, ca, sa):
+    """x = (1 - q) / 2 = sin^2(m / 2) of the window (m = arccos q), clipped to [0, 1]: 1
+    where every azimuth is above the horizon (cos(theta) cos(alpha) = 0, sin theta sin
+    alpha > 0), 0 where none is."""
+    den = np.asarray(ct * ca, dtype=np.float64)
+    lift = np.asarray(st * sa, dtype=np.float64)
+    out = np.array(np.broadcast_to(np.where(lift > 0, 1.0, 0.0),
+                                   np.broadcast_shapes(den.shape, lift.shape)))
+    x = np.divide(0.5 * (den + lift), den, out=out, where=den > 0)
+    return np.clip(x, 0.0, 1.0, out=x)
 
 
 def azimuth_draw(m, u, masking) -> np.ndarray:

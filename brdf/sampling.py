@@ -13,24 +13,31 @@ The sampler is a mixture of components whose densities are all known in closed f
     :math:`-\theta_r` (specular longitudinal reflection) and standard deviation
     :math:`2\gamma_s` or :math:`2\gamma_v` (the lobe :math:`g(\gamma, \theta_h)`,
     :math:`\theta_h = (\theta_i + \theta_r)/2`, is a Gaussian of width :math:`2\gamma` in
-    :math:`\theta_i`), truncated to :math:`[-\pi/2, \pi/2]`;
-  - *isotropic* (the k_d part of the volume term): :math:`\sin\theta_i` uniform in [-1, 1];
+    :math:`\theta_i`);
+  - *isotropic* (the k_d part of the volume term): :math:`\sin\theta_i` uniform;
 
   and the azimuth :math:`\phi_i = \operatorname{atan2}(\omega_i\cdot b, \omega_i\cdot n_t)`
-  with density :math:`\max(\cos\phi, 0)/2` when ``masking`` is on (M(wi) = max(cos phi, 0)
-  is a factor of f_r) and :math:`1/(2\pi)` when it is off.
+  from the density :math:`p_\phi = \max(\cos\phi, 0)/2` when ``masking`` is on (M(wi) =
+  max(cos phi, 0) is a factor of f_r) and :math:`1/(2\pi)` when it is off.
+
+Each lobe is restricted to the upper hemisphere (:mod:`brdf.horizon`): :math:`\theta_i` is
+drawn from its distribution truncated to :math:`[\theta_{lo}, \theta_{hi}] = [\max(-\pi/2,
+\alpha - \pi/2), \min(\pi/2, \alpha + \pi/2)]`, the angles that have some azimuth above
+the horizon, then :math:`\phi_i` from :math:`p_\phi` truncated to the window
+:math:`|\phi| < m(\theta_i)` above it, of mass :math:`M(\theta_i)`. No draw lands below the
+surface (the untruncated lobes put up to 71% of velvet's draws there: a tilted thread
+reflects part of its lobe downward), and the density above it is never less than the
+untruncated lobe's, so weights only shrink.
 
 Since :math:`d\omega = \cos\theta\, d\theta\, d\phi = d(\sin\theta)\, d\phi`, a lobe's
-density in solid angle is :math:`p_\theta(\theta)\, p_\phi(\phi) / \cos\theta` and the
-isotropic one's :math:`p_\phi(\phi) / 2`. The integrand :math:`f_r \cos\theta_i` carries the
-same Gaussian and a factor :math:`\cos^2\theta_i` in these coordinates, so the lobe weights
-stay bounded; the pdf grows like :math:`1/\cos\theta` toward the thread's tangent (where the
-weight goes to 0), an integrable singularity.
-
-Lobe directions that land at or below the surface (a tilted thread reflects part of its lobe
-downward: most of velvet's near-vertical pile) are kept: their weight is 0 and the share of
-such draws is what :func:`sample` costs there. The pdf is a density on the whole sphere,
-integrating to 1.
+density in solid angle is :math:`p_\theta(\theta)\, p_\phi(\phi) / (M(\theta)\cos\theta)`
+and the isotropic one's :math:`p_\phi(\phi) / (M(\theta)(\sin\theta_{hi} -
+\sin\theta_{lo}))`. The integrand :math:`f_r \cos\theta_i` carries the same Gaussian and a
+factor :math:`\cos^2\theta_i` in these coordinates, so the lobe weights stay bounded; the pdf
+grows like :math:`1/\cos\theta` toward the thread's tangent (where the weight goes to 0) and
+like :math:`1/m` where the azimuth window closes (at the horizon, where
+:math:`\cos\theta_i = 0`), integrable singularities. The pdf is a density on the whole
+sphere, 0 at and below the horizon, integrating to 1 over the upper hemisphere.
 """
 
 from __future__ import annotations
@@ -134,8 +141,8 @@ def pdf(fabric, wo, wi) -> np.ndarray:
     Returns
     -------
     ndarray, shape (...)
-        The mixture density of the module notes, on the whole sphere (> 0 below the surface
-        too, where lobes spill); NaN where either vector is zero or not finite.
+        The mixture density of the module notes (0 at and below the horizon, z <= 0); NaN
+        where either vector is zero or not finite.
 
     Raises
     ------
@@ -145,9 +152,14 @@ def pdf(fabric, wo, wi) -> np.ndarray:
     Notes
     -----
     .. math::
-        p(\omega_i) = c\,\frac{\max(z_i, 0)}{\pi} + \sum_j P_j \sum_\alpha w_\alpha
-        \Big[\sum_{L=s,v} P_{jL}\, \frac{N_{[-\pi/2,\pi/2]}(\theta_i; -\theta_r,
-        2\gamma_L)}{\cos\theta_i} + \frac{P_{ji}}{2}\Big] p_\phi(\phi_i)
+        p(\omega_i) = c\,\frac{\max(z_i, 0)}{\pi} + [z_i > 0] \sum_j P_j \sum_\alpha
+        w_\alpha \Big[\sum_{L=s,v} P_{jL}\, \frac{N_{[\theta_{lo},\theta_{hi}]}(\theta_i;
+        -\theta_r, 2\gamma_L)}{\cos\theta_i} + \frac{P_{ji}}{\sin\theta_{hi} -
+        \sin\theta_{lo}}\Big] \frac{p_\phi(\phi_i)}{M(\theta_i)}
+
+    with :math:`N_{[a,b]}` the normal density truncated to [a, b] (its normaliser in
+    logarithms: :func:`brdf.horizon.truncnorm_logmass`) and :math:`\theta_{lo}`,
+    :math:`\theta_{hi}`, :math:`M` of each tangent offset alpha (:mod:`brdf.horizon`).
 
     Examples
     --------
@@ -192,7 +204,7 @@ def _pdf_flat(plan, wi, wo):
         mu = -np.arctan2(sr, np.sqrt(xr * xr + br[:, None] ** 2))
         th = np.arctan2(si, cth)
         lo, hi = horizon.theta_range(ca, sa)
-        _, mass_phi = horizon.azimuth_window(si, cth, ca, sa, masking)
+        mass_phi = horizon.azimuth_mass(si, cth, ca, sa, masking)
         # p_phi / (M cos(theta)): the azimuth's density truncated to its window
         if masking:
             pphi = np.maximum(xi, 0.0) / (2.0 * cth)
@@ -302,10 +314,10 @@ def sample(fabric, wo, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Returns
     -------
     wi : ndarray, shape (..., 3)
-        Unit directions toward the light; some lie at or below the surface (weight 0).
+        Unit directions toward the light, above the surface (z > 0).
     weight : ndarray, shape (..., 3)
         :math:`f_r(\omega_i, \omega_o) \cos\theta_i / p(\omega_i)`, RGB, dimensionless (0
-        below the surface and where f_r = 0).
+        where f_r = 0).
     pdf : ndarray, shape (...)
         :math:`p(\omega_i)` in 1/sr, equal to :func:`pdf` at the returned directions.
 
@@ -319,10 +331,11 @@ def sample(fabric, wo, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Notes
     -----
     The component is chosen by ``u[..., 0]`` against the cumulative probabilities of
-    :func:`lobe_probabilities` (and ``COSINE_SHARE``), then rescaled to [0, 1) within it; the
-    longitudinal Gaussian is inverted with ``scipy.special.ndtri``:
-    :math:`\theta = \mu + \sigma\,\Phi^{-1}(\Phi(a) + v(\Phi(b) - \Phi(a)))`,
-    :math:`a, b = (\mp\pi/2 - \mu)/\sigma`.
+    :func:`lobe_probabilities` (and ``COSINE_SHARE``), then rescaled to [0, 1) within it to
+    draw the longitudinal angle from its truncated Gaussian (:func:`brdf.horizon.truncnorm_draw`,
+    inverted in logarithms with ``scipy.special.ndtri_exp``) or :math:`\sin\theta` uniform
+    on its range; ``u[..., 1]`` draws the azimuth in its window
+    (:func:`brdf.horizon.azimuth_draw`).
 
     Examples
     --------

@@ -189,6 +189,9 @@ def test_horizon_twin_matches_brdf_horizon(scalar):
         want = float(brdf.horizon.truncnorm_logmass(mu, sig, lo, hi))
         assert twin.truncnorm_logmass(mu, 1.0 / sig, lo2, hi2) == pytest.approx(
             want, rel=1e-6, abs=1e-6)
+        z = (rng.uniform(float(lo), float(hi)) - mu) / sig
+        assert twin.truncnorm_density(z, (lo2 - mu) / sig, (hi2 - mu) / sig) == pytest.approx(
+            math.exp(-0.5 * z * z - want), rel=1e-6)
         v = rng.random()
         assert twin.truncnorm_draw(mu, sig, lo2, hi2, v) == pytest.approx(
             float(brdf.horizon.truncnorm_draw(mu, sig, lo, hi, v)), abs=1e-5)

@@ -155,7 +155,7 @@ def _sample_terms(th, ca, sa, light, view, k, density):
     vol = ft * (gv + th.kd) * geo / dr.select(csum > 0.0, csum, 1.0)
     if not density:
         return surf, vol, p
-    return surf, vol, p, narrow(_density(k, th, *wide_angles))
+    return surf, vol, p, _density(k, th, *wide_angles)
 
 
 def eval_pdf(k: Consts, light, view, rot_c, rot_s, with_pdf=True, albedo=(None, None)):
@@ -223,20 +223,20 @@ def _density(k, th, ca, sa, si, xi, ci, sr, cr):
     the horizon, times the azimuth's density truncated to its window (brdf.sampling,
     brdf.horizon)."""
     cth = dr.maximum(ci, _COS_MIN)
-    mu = -dr.atan2(sr, cr)
-    th_i = dr.atan2(si, cth)
-    lo, hi = horizon.theta_range(ca, sa)
-    dens = wide(th.lobe_p[2]) / (dr.sin(hi) - dr.sin(lo))
-    for lobe in (0, 1):
-        inv = wide(th.inv_sig[lobe])
-        log_mass = horizon.truncnorm_logmass(mu, inv, lo, hi)
-        z = (th_i - mu) * inv
-        dens += (wide(th.lobe_p[lobe]) * dr.exp(-0.5 * z * z - log_mass)
-                 * (GAUSS_NORM * inv) / cth)
-    _, mass = horizon.azimuth_window(si, cth, ca, sa, k.masking)
+    _, mass = horizon.azimuth_window(si, cth, ca, sa, k.masking)     # double: closing windows
     pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
     ok = mass > 0.0
-    return dr.select(ok, dens * pphi / dr.select(ok, mass, 1.0), 0.0)
+    pphi = narrow(dr.select(ok, pphi / dr.select(ok, mass, 1.0), 0.0))
+    # the lobes in the variant's precision (float32)
+    mu, th_i = narrow(-dr.atan2(sr, cr)), narrow(dr.atan2(si, cth))
+    lo, hi = map(narrow, horizon.theta_range(ca, sa))
+    cth = narrow(cth)
+    dens = th.lobe_p[2] / (1.0 + narrow(ca))           # sin(hi) - sin(lo) = 1 + cos(alpha)
+    for lobe in (0, 1):
+        inv = th.inv_sig[lobe]
+        trunc = horizon.truncnorm_density((th_i - mu) * inv, (lo - mu) * inv, (hi - mu) * inv)
+        dens += th.lobe_p[lobe] * trunc * (GAUSS_NORM * inv) / cth
+    return dens * pphi
 
 
 def _pick(k: Consts, u):

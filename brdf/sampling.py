@@ -13,31 +13,38 @@ The sampler is a mixture of components whose densities are all known in closed f
     :math:`-\theta_r` (specular longitudinal reflection) and standard deviation
     :math:`2\gamma_s` or :math:`2\gamma_v` (the lobe :math:`g(\gamma, \theta_h)`,
     :math:`\theta_h = (\theta_i + \theta_r)/2`, is a Gaussian of width :math:`2\gamma` in
-    :math:`\theta_i`), truncated to :math:`[-\pi/2, \pi/2]`;
-  - *isotropic* (the k_d part of the volume term): :math:`\sin\theta_i` uniform in [-1, 1];
+    :math:`\theta_i`);
+  - *isotropic* (the k_d part of the volume term): :math:`\sin\theta_i` uniform;
 
   and the azimuth :math:`\phi_i = \operatorname{atan2}(\omega_i\cdot b, \omega_i\cdot n_t)`
-  with density :math:`\max(\cos\phi, 0)/2` when ``masking`` is on (M(wi) = max(cos phi, 0)
-  is a factor of f_r) and :math:`1/(2\pi)` when it is off.
+  from the density :math:`p_\phi = \max(\cos\phi, 0)/2` when ``masking`` is on (M(wi) =
+  max(cos phi, 0) is a factor of f_r) and :math:`1/(2\pi)` when it is off.
+
+Each lobe is restricted to the upper hemisphere (:mod:`brdf.horizon`): :math:`\theta_i` is
+drawn from its distribution truncated to :math:`[\theta_{lo}, \theta_{hi}] = [\max(-\pi/2,
+\alpha - \pi/2), \min(\pi/2, \alpha + \pi/2)]`, the angles that have some azimuth above
+the horizon, then :math:`\phi_i` from :math:`p_\phi` truncated to the window
+:math:`|\phi| < m(\theta_i)` above it, of mass :math:`M(\theta_i)`. No draw lands below the
+surface (the untruncated lobes put up to 71% of velvet's draws there: a tilted thread
+reflects part of its lobe downward), and the density above it is never less than the
+untruncated lobe's, so weights only shrink.
 
 Since :math:`d\omega = \cos\theta\, d\theta\, d\phi = d(\sin\theta)\, d\phi`, a lobe's
-density in solid angle is :math:`p_\theta(\theta)\, p_\phi(\phi) / \cos\theta` and the
-isotropic one's :math:`p_\phi(\phi) / 2`. The integrand :math:`f_r \cos\theta_i` carries the
-same Gaussian and a factor :math:`\cos^2\theta_i` in these coordinates, so the lobe weights
-stay bounded; the pdf grows like :math:`1/\cos\theta` toward the thread's tangent (where the
-weight goes to 0), an integrable singularity.
-
-Lobe directions that land at or below the surface (a tilted thread reflects part of its lobe
-downward: most of velvet's near-vertical pile) are kept: their weight is 0 and the share of
-such draws is what :func:`sample` costs there. The pdf is a density on the whole sphere,
-integrating to 1.
+density in solid angle is :math:`p_\theta(\theta)\, p_\phi(\phi) / (M(\theta)\cos\theta)`
+and the isotropic one's :math:`p_\phi(\phi) / (M(\theta)(\sin\theta_{hi} -
+\sin\theta_{lo}))`. The integrand :math:`f_r \cos\theta_i` carries the same Gaussian and a
+factor :math:`\cos^2\theta_i` in these coordinates, so the lobe weights stay bounded; the pdf
+grows like :math:`1/\cos\theta` toward the thread's tangent (where the weight goes to 0) and
+like :math:`1/m` where the azimuth window closes (at the horizon, where
+:math:`\cos\theta_i = 0`), integrable singularities. The pdf is a density on the whole
+sphere, 0 at and below the horizon, integrating to 1 over the upper hemisphere.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
+from brdf import horizon
 from brdf.frames import as_directions, flat_pairs, normalize
 from brdf.plan import plan_of
 from brdf.shading import GAUSS_NORM
@@ -53,7 +60,6 @@ LOBE_FLOOR = 0.05
 _COS_MIN = 1e-12
 #: (pair, tangent sample) elements per chunk of the pdf.
 _CHUNK = 1 << 15
-_HALF_PI = 0.5 * np.pi
 
 
 def lobe_probabilities(fabric) -> tuple[np.ndarray, np.ndarray]:
@@ -121,11 +127,6 @@ def _sigmas(plan):
     return np.array([[2.0 * c.gamma_s, 2.0 * c.gamma_v] for c in plan.threads])
 
 
-def _gauss_mass(mu, sigma):
-    """Mass of N(mu, sigma) on [-pi/2, pi/2] (mu in that interval: the mass is >= 1/2)."""
-    return ndtr((_HALF_PI - mu) / sigma) - ndtr((-_HALF_PI - mu) / sigma)
-
-
 def pdf(fabric, wo, wi) -> np.ndarray:
     r"""Density of :func:`sample`'s directions wi for the viewer wo, 1/sr (solid angle).
 
@@ -140,8 +141,8 @@ def pdf(fabric, wo, wi) -> np.ndarray:
     Returns
     -------
     ndarray, shape (...)
-        The mixture density of the module notes, on the whole sphere (> 0 below the surface
-        too, where lobes spill); NaN where either vector is zero or not finite.
+        The mixture density of the module notes (0 at and below the horizon, z <= 0); NaN
+        where either vector is zero or not finite.
 
     Raises
     ------
@@ -151,9 +152,14 @@ def pdf(fabric, wo, wi) -> np.ndarray:
     Notes
     -----
     .. math::
-        p(\omega_i) = c\,\frac{\max(z_i, 0)}{\pi} + \sum_j P_j \sum_\alpha w_\alpha
-        \Big[\sum_{L=s,v} P_{jL}\, \frac{N_{[-\pi/2,\pi/2]}(\theta_i; -\theta_r,
-        2\gamma_L)}{\cos\theta_i} + \frac{P_{ji}}{2}\Big] p_\phi(\phi_i)
+        p(\omega_i) = c\,\frac{\max(z_i, 0)}{\pi} + [z_i > 0] \sum_j P_j \sum_\alpha
+        w_\alpha \Big[\sum_{L=s,v} P_{jL}\, \frac{N_{[\theta_{lo},\theta_{hi}]}(\theta_i;
+        -\theta_r, 2\gamma_L)}{\cos\theta_i} + \frac{P_{ji}}{\sin\theta_{hi} -
+        \sin\theta_{lo}}\Big] \frac{p_\phi(\phi_i)}{M(\theta_i)}
+
+    with :math:`N_{[a,b]}` the normal density truncated to [a, b] (its normaliser in
+    logarithms: :func:`brdf.horizon.truncnorm_logmass`) and :math:`\theta_{lo}`,
+    :math:`\theta_{hi}`, :math:`M` of each tangent offset alpha (:mod:`brdf.horizon`).
 
     Examples
     --------
@@ -182,6 +188,7 @@ def _pdf_flat(plan, wi, wo):
     masking = plan.options.masking
     if wo.shape[0] > 1 and np.all(wo == wo[:1]):
         wo = wo[:1]                     # one viewer (the common case): its terms once
+    up = wi[:, 2] > 0.0
     total = (1.0 - thread.sum()) / np.pi * np.maximum(wi[:, 2], 0.0)
     for j, c in enumerate(plan.threads):
         if thread[j] == 0.0:
@@ -196,17 +203,21 @@ def _pdf_flat(plan, wi, wo):
         br = wo @ b[j]                                    # only theta_r of wo is needed
         mu = -np.arctan2(sr, np.sqrt(xr * xr + br[:, None] ** 2))
         th = np.arctan2(si, cth)
-        scale = [GAUSS_NORM / (s * _gauss_mass(mu, s)) for s in sig[j]]
-        # p_phi / cos(theta) and p_phi for the two parametrizations
+        lo, hi = horizon.theta_range(ca, sa)
+        mass_phi = horizon.azimuth_mass(si, cth, ca, sa, masking)
+        # p_phi / (M cos(theta)): the azimuth's density truncated to its window
         if masking:
             pphi = np.maximum(xi, 0.0) / (2.0 * cth)
         else:
             pphi = np.full_like(cth, 0.5 / np.pi)
-        dens = 0.5 * lobe[j, 2]
+        pphi = np.divide(pphi, mass_phi, out=np.zeros_like(pphi),
+                         where=up[:, None] & (mass_phi > 0))
+        dens = lobe[j, 2] / (np.sin(hi) - np.sin(lo))
         for k in range(2):
             s = sig[j, k]
             z = (th - mu) / s
-            g = np.exp(-0.5 * z * z) * scale[k]
+            log_mass = horizon.truncnorm_logmass(mu, s, lo, hi)
+            g = np.exp(-0.5 * z * z - log_mass) * (GAUSS_NORM / s)
             dens = dens + lobe[j, k] * g / cth
         total += thread[j] * ((dens * pphi) @ c.weight)
     return total
@@ -257,8 +268,8 @@ def _draw(plan, wo, u0, u1):
     """Directions wi (n, 3) for unit wo (n, 3) and uniforms u0, u1 (n,)."""
     cdf, jj, ca, sa, kind = _components(plan)
     k = np.minimum(np.searchsorted(cdf, u0, side="right"), cdf.size - 1)
-    lo = np.where(k > 0, cdf[np.maximum(k - 1, 0)], 0.0)
-    v = np.clip((u0 - lo) / (cdf[k] - lo), 0.0, np.nextafter(1.0, 0.0))
+    start = np.where(k > 0, cdf[np.maximum(k - 1, 0)], 0.0)
+    v = np.clip((u0 - start) / (cdf[k] - start), 0.0, np.nextafter(1.0, 0.0))
     j, ca, sa, kind = jj[k], ca[k], sa[k], kind[k]
     t0, b = _axes(plan)
     t0, b = t0[j], b[j]
@@ -271,17 +282,14 @@ def _draw(plan, wo, u0, u1):
     br = np.einsum("ij,ij->i", wo, b)
     mu = -np.arctan2(sr, np.hypot(xr, br))
     sig = _sigmas(plan)[j, np.minimum(kind, 1)]
-    lo_p = ndtr((-_HALF_PI - mu) / sig)
-    th = mu + sig * ndtri(lo_p + v * _gauss_mass(mu, sig))
-    th = np.clip(th, -_HALF_PI, _HALF_PI)
+    lo, hi = horizon.theta_range(ca, sa)
+    th = horizon.truncnorm_draw(mu, sig, lo, hi, v)
     s, c = np.sin(th), np.cos(th)
-    iso = kind == 2
-    s[iso] = 2.0 * v[iso] - 1.0
-    c[iso] = 2.0 * np.sqrt(v[iso] * (1.0 - v[iso]))
-    if plan.options.masking:
-        phi = np.arcsin(2.0 * u1 - 1.0)
-    else:
-        phi = np.pi * (2.0 * u1 - 1.0)
+    iso = kind == 2                                    # sin(theta) uniform in its range
+    s[iso] = np.sin(lo[iso]) + v[iso] * (np.sin(hi[iso]) - np.sin(lo[iso]))
+    c[iso] = np.sqrt(np.maximum(1.0 - s[iso] ** 2, 0.0))
+    m, _ = horizon.azimuth_window(s, c, ca, sa, plan.options.masking)
+    phi = horizon.azimuth_draw(m, u1, plan.options.masking)
     wi = s[:, None] * t + c[:, None] * (np.cos(phi)[:, None] * nt + np.sin(phi)[:, None] * b)
     cos = kind < 0                                     # cosine-weighted hemisphere
     r = np.sqrt(v[cos])
@@ -306,10 +314,10 @@ def sample(fabric, wo, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Returns
     -------
     wi : ndarray, shape (..., 3)
-        Unit directions toward the light; some lie at or below the surface (weight 0).
+        Unit directions toward the light, above the surface (z > 0).
     weight : ndarray, shape (..., 3)
         :math:`f_r(\omega_i, \omega_o) \cos\theta_i / p(\omega_i)`, RGB, dimensionless (0
-        below the surface and where f_r = 0).
+        where f_r = 0).
     pdf : ndarray, shape (...)
         :math:`p(\omega_i)` in 1/sr, equal to :func:`pdf` at the returned directions.
 
@@ -323,10 +331,11 @@ def sample(fabric, wo, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Notes
     -----
     The component is chosen by ``u[..., 0]`` against the cumulative probabilities of
-    :func:`lobe_probabilities` (and ``COSINE_SHARE``), then rescaled to [0, 1) within it; the
-    longitudinal Gaussian is inverted with ``scipy.special.ndtri``:
-    :math:`\theta = \mu + \sigma\,\Phi^{-1}(\Phi(a) + v(\Phi(b) - \Phi(a)))`,
-    :math:`a, b = (\mp\pi/2 - \mu)/\sigma`.
+    :func:`lobe_probabilities` (and ``COSINE_SHARE``), then rescaled to [0, 1) within it to
+    draw the longitudinal angle from its truncated Gaussian (:func:`brdf.horizon.truncnorm_draw`,
+    inverted in logarithms with ``scipy.special.ndtri_exp``) or :math:`\sin\theta` uniform
+    on its range; ``u[..., 1]`` draws the azimuth in its window
+    (:func:`brdf.horizon.azimuth_draw`).
 
     Examples
     --------

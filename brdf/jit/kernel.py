@@ -125,6 +125,7 @@ class SampleGeometry(NamedTuple):
     si: object      # longitudinal sines, and wi . n_t (the sampler's density)
     sr: object
     xi: object
+    wide: tuple     # (ca, sa, si, xi, ci, sr, cr) in double precision: the density's window
 
 
 def _blend(a, b, cos_delta):
@@ -167,6 +168,7 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
         pu_i, pu_r = narrow(xi * ii, k), narrow(xr * ir, k)
         cpsi = pu_i * pu_r + narrow(si * ii, k) * narrow(sr * ir, k)
         p = _blend(dr.maximum(pu_i, 0.0), dr.maximum(pu_r, 0.0), cpsi)
+    wide_angles = (ca, sa, si, xi, ci, sr, cr)
     si, xi, ci, sr, cr, ui_x, ur_x = (narrow(v, k) for v in (si, xi, ci, sr, cr, ui_x, ur_x))
     ok = c2d > 0.0
     c2d = dr.select(ok, c2d, 1.0)
@@ -176,7 +178,8 @@ def sample_geometry(k: Consts, ca, sa, light, view, irho) -> SampleGeometry:
     geo *= p
     csum = ci + cr
     return SampleGeometry(th2, dr.sqrt(0.5 * c2d * hp), geo * dr.sqrt(hp),
-                          geo / dr.select(csum > 0.0, csum, 1.0), p, ci, cr, si, sr, xi)
+                          geo / dr.select(csum > 0.0, csum, 1.0), p, ci, cr, si, sr, xi,
+                          wide_angles)
 
 
 def _fresnel(eta2, eta2m1, c, wide_float: bool):

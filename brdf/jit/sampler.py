@@ -17,11 +17,11 @@ import math
 import drjit as dr
 
 from brdf.jit.consts import GAUSS_NORM, Consts
-from brdf.jit.kernel import SampleGeometry, at, fabric_q, fabric_sums
+from brdf.jit import horizon
+from brdf.jit.kernel import SampleGeometry, at, fabric_q, fabric_sums, narrow
 
 __all__ = ["eval_pdf", "eval_cos", "density", "sample"]
 
-_HALF_PI = 0.5 * math.pi
 _COS_MIN = 1e-12                    # as brdf.sampling: the 1/cos(theta) density stays finite
 
 
@@ -65,31 +65,27 @@ def eval_cos(k: Consts, light, view, rot_c, rot_s, albedo=(None, None)):
     return eval_pdf(k, light, view, rot_c, rot_s, with_pdf=False, albedo=albedo)[0]
 
 
-def _ndtr(x):
-    """Standard normal CDF."""
-    return 0.5 * (1.0 + dr.erf(x * (1.0 / math.sqrt(2.0))))
-
-
-def _ndtri(p):
-    """Standard normal quantile."""
-    return math.sqrt(2.0) * dr.erfinv(dr.clip(2.0 * p - 1.0, -1.0, 1.0))
-
-
 def density(k: Consts, th, g: SampleGeometry):
     """The density (1/sr) of a thread's lobes at one tangent sample, unweighted: the
-    light's longitudinal angle (sine ``g.si``, cosine ``g.ci``; ``g.xi`` its cosine's
-    component along the normal's side) under the Gaussians about the mirror of the viewer's
-    (``g.sr``, ``g.cr``), times the azimuth's density (brdf.sampling)."""
-    cth = dr.maximum(g.ci, _COS_MIN)
-    mu = -dr.atan2(g.sr, g.cr)
-    th_i = dr.atan2(g.si, cth)
-    dens = 0.5 * th.lobe_p[2]
+    light's longitudinal angle (sine ``si``, cosine ``ci``; ``xi`` its cosine's component
+    along the normal's side) under the Gaussians about the mirror of the viewer's (``sr``,
+    ``cr``), truncated to the angles with an azimuth above the horizon, times the azimuth's
+    density truncated to its window (brdf.sampling, brdf.horizon). The window is found in
+    double precision (``g.wide``: windows that close), the lobes in the kernel's."""
+    ca, sa, si, xi, ci, sr, cr = g.wide
+    cth = dr.maximum(ci, _COS_MIN)
+    _, mass = horizon.azimuth_window(si, cth, ca, sa, k.masking)
+    pphi = dr.maximum(xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
+    ok = mass > 0.0
+    pphi = narrow(dr.select(ok, pphi / dr.select(ok, mass, 1.0), 0.0), k)
+    mu, th_i = narrow(-dr.atan2(sr, cr), k), narrow(dr.atan2(si, cth), k)
+    lo, hi = (narrow(x, k) for x in horizon.theta_range(ca, sa))
+    cth = narrow(cth, k)
+    dens = th.lobe_p[2] / (1.0 + narrow(ca, k))          # sin(hi) - sin(lo) = 1 + cos(alpha)
     for lobe in (0, 1):
         inv = th.inv_sig[lobe]
-        mass = _ndtr((_HALF_PI - mu) * inv) - _ndtr((-_HALF_PI - mu) * inv)
-        z = (th_i - mu) * inv
-        dens += th.lobe_p[lobe] * dr.exp(-0.5 * z * z) * (GAUSS_NORM * inv) / (mass * cth)
-    pphi = dr.maximum(g.xi, 0.0) / (2.0 * cth) if k.masking else 0.5 / math.pi
+        trunc = horizon.truncnorm_density((th_i - mu) * inv, (lo - mu) * inv, (hi - mu) * inv)
+        dens += th.lobe_p[lobe] * trunc * (GAUSS_NORM * inv) / cth
     return dens * pphi
 
 
@@ -123,15 +119,13 @@ def sample(k: Consts, view, u1, u2, rot_c, rot_s):
     mu = -dr.atan2(dr.dot(view, t), dr.sqrt(dr.square(dr.dot(view, nt))
                                             + dr.square(dr.dot(view, b))))
     v = u2.x
-    lo = _ndtr((-_HALF_PI - mu) / sig)
-    mass = _ndtr((_HALF_PI - mu) / sig) - lo
-    th = dr.clip(mu + sig * _ndtri(lo + v * mass), -_HALF_PI, _HALF_PI)
-    iso = kind > 1.5
-    s = dr.select(iso, 2.0 * v - 1.0, dr.sin(th))
-    c = dr.select(iso, 2.0 * dr.sqrt(dr.maximum(v * (1.0 - v), 0.0)), dr.cos(th))
-    if k.masking:
-        phi = dr.asin(dr.clip(2.0 * u2.y - 1.0, -1.0, 1.0))
-    else:
-        phi = math.pi * (2.0 * u2.y - 1.0)
+    lo, hi = horizon.theta_range(ca, sa)
+    th = horizon.truncnorm_draw(mu, sig, lo, hi, v)
+    iso = kind > 1.5                                   # sin(theta) uniform in its range
+    s_lo, s_hi = dr.sin(lo), dr.sin(hi)
+    s = dr.select(iso, s_lo + v * (s_hi - s_lo), dr.sin(th))
+    c = dr.select(iso, dr.sqrt(dr.maximum(1.0 - s * s, 0.0)), dr.cos(th))
+    m, _ = horizon.azimuth_window(s, c, ca, sa, k.masking)
+    phi = horizon.azimuth_draw(m, u2.y, k.masking)
     wi = s * t + c * (dr.cos(phi) * nt + dr.sin(phi) * b)
     return dr.select(kind < -0.5, t_.cosine_hemisphere(u2), wi)

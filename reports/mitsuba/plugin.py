@@ -22,10 +22,10 @@ follows the surface's first tangent ``dp_du`` projected onto the tangent plane, 
 renderer has the warp follow each primitive's tangent; ``rotation`` turns it further about n.
 Mitsuba counts a draw of weight 0 as no draw, so the plugin's ``pdf`` is the density of
 the draws of nonzero weight: :func:`brdf.sampling.pdf` where :math:`f_r\cos\theta_i > 0`, 0
-elsewhere (below the horizon, where lobes spill, and where the model's f_r vanishes above it,
-as it does for velvet seen at grazing angles: every tangent sample then faces away from the
-light or the viewer). The BSDF is one-sided (``FrontSide``); wrap it in Mitsuba's
-``twosided`` for cloth seen from both sides.
+elsewhere (where the model's f_r vanishes above the horizon, as it does for velvet seen at
+grazing angles: every tangent sample then faces away from the light or the viewer; the
+sampler draws nothing below it, :mod:`brdf.horizon`). The BSDF is one-sided
+(``FrontSide``); wrap it in Mitsuba's ``twosided`` for cloth seen from both sides.
 
 :func:`plugin_dict`, :func:`plugin_xml` and :func:`fabric_from_dict` need no Mitsuba: they
 turn a :class:`brdf.Fabric` into the plugin's dictionary (or its XML ``<bsdf>`` element, for

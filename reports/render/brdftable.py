@@ -3,10 +3,12 @@ r"""A tabulated importance sampler of :math:`f_r \cos\theta_i`, built once per r
 The sky's light on cloth (:mod:`reports.render.envlight`) is the integral
 :math:`\int f_r(\omega_i, \omega_o) \cos\theta_i L(\omega_i) V\, d\omega_i` over a broad,
 smooth sky. A fabric's own sampler (:meth:`brdf.Fabric.sample`) draws its lobes in each
-thread's frame, and for a fabric whose reflection gathers at grazing incidence (velvet:
-:math:`f_r` near 20 / sr at :math:`\cos\theta_i = 0.003`, two thirds of the draws below the
-surface) its density there is some 30 times too low: a few samples carry most of the light
-and show as white speckles. :class:`BRDFTable` tabulates the integrand itself instead:
+thread's frame; for a fabric whose reflection gathers at grazing incidence (velvet:
+:math:`f_r` near 20 / sr at :math:`\cos\theta_i = 0.003`) its density there was some 30
+times too low, with two thirds of the draws below the surface, until its lobes were
+truncated to the upper hemisphere (issue 36: it now exceeds :math:`f_r\cos\theta_i / \rho`
+there; the table was not compared with it again): a few samples carried most of the light and
+showed as white speckles. :class:`BRDFTable` tabulates the integrand itself instead:
 
 - the viewer directions in :data:`WO_BINS` equal bins of (:math:`\cos\theta_o`,
   :math:`\phi_o`), the light directions in :data:`WI_BINS` bins of

@@ -20,8 +20,9 @@ strategy:
   directions). The table needs ``eval`` alone; without one (``table=None``) the cosine
   directions are used alone.
 
-The fabric's own sampler (:meth:`brdf.Fabric.sample`) is not used here: for velvet it puts
-two thirds of its draws below the surface and some 30 times too few at grazing incidence,
+The fabric's own sampler (:meth:`brdf.Fabric.sample`) is not used here: for velvet it put
+(before issue 36 truncated its lobes to the upper hemisphere; not compared since) two thirds
+of its draws below the surface and some 30 times too few at grazing incidence,
 where velvet's f_r cos gathers, so that a few sky samples carried most of the light and
 showed as white speckles on the cylinder's shaded side; the table's estimate has 8 to 60
 times less variance there and on every preset, and costs two ``eval`` calls instead of an

@@ -125,7 +125,7 @@ class SampleGeometry(NamedTuple):
     si: object      # longitudinal sines, and wi . n_t (the sampler's density)
     sr: object
     xi: object
-    wide: tuple     # (ca, sa, si, xi, ci, sr, cr) in double precision: the density's window
+    wide: tuple = ()    # (ca, sa, si, xi, ci, sr, cr), double precision: the density's window
 
 
 def _blend(a, b, cos_delta):

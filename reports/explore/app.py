@@ -30,7 +30,6 @@ from __future__ import annotations
 from bokeh.layouts import column, row
 from bokeh.models import Button, Div, Select, Slider
 
-from analysis.views.common import QUANTITIES
 from brdf.fabric import Fabric
 from reports.explore.data import Inputs, load_inputs
 from reports.explore.engine import Explorer, State
@@ -38,7 +37,10 @@ from reports.explore.figures import VIEWS, make_figures, update_figures
 from reports.explore.models import explore_model, model_names
 from reports.explore.page import page_script
 
-__all__ = ["app", "Controller"]
+__all__ = ["app", "Controller", "CHANNELS"]
+
+#: What the lobe, the hemisphere and the slice show: luminance or one channel.
+CHANNELS = ("luminance", "r", "g", "b")
 
 _VIEW = {"theta_i": ("incidence θi (deg)", 0.0, 85.0, 1.0),
          "plane": ("plane of incidence φ (deg)", 0.0, 180.0, 5.0),
@@ -63,7 +65,7 @@ class Controller:
         self.status = Div(text="", name="status")
         self._pending = self._quiet = False
         self.sliders: dict = {}
-        self.slider_box = column()
+        self.slider_box = row()
         self.variant_box = column()
         self.widgets = self._view_widgets()
         self._rebuild_model_controls()
@@ -83,7 +85,7 @@ class Controller:
                 lambda v: self.set(**{key: float(v)}), new))
             out.append(w)
         labels = self.ex.labels()
-        out += [self._select("channel", "channel", self.state.channel, QUANTITIES,
+        out += [self._select("channel", "channel", self.state.channel, CHANNELS,
                              lambda v: self.set(channel=v)),
                 self._select("scale", "scale", "linear", ("linear", "log"),
                              lambda v: self.set(log=v == "log")),
@@ -109,7 +111,8 @@ class Controller:
             w.on_change("value", lambda _a, _o, new, n=s.name: self._user(
                 lambda v: self._set_value(n, v), new))
             self.sliders[s.name] = w
-        self.slider_box.children = list(self.sliders.values())
+        ws = list(self.sliders.values())
+        self.slider_box.children = [column(ws[k:k + 8]) for k in range(0, len(ws), 8)]
         self.variant_box.children = [
             self._select(k, k, str(self.state.options.get(k, v[0])), [str(c) for c in v],
                          lambda val, k=k: self._set_option(k, val))
@@ -188,12 +191,12 @@ class Controller:
         update_figures(self.figs, self.src, frame, self.state.log)
 
     def layout(self):
-        """The document's one root: controls on the left, views in a grid."""
+        """The document's one root: the view controls beside the views, then the variants
+        and the parameters in columns of eight."""
         views = [self.figs[v] for v in VIEWS]
         grid = column(row(views[:4]), row(views[4:]), self.status)
-        controls = column(Div(text="<b>view</b>"), *self.widgets, Div(text="<b>variants</b>"),
-                          self.variant_box, Div(text="<b>parameters</b>"), self.slider_box)
-        return row(controls, grid)
+        self.param_box = row(self.variant_box, self.slider_box)
+        return column(row(column(*self.widgets), grid), self.param_box)
 
 
 def app(*texts, inputs: Inputs | None = None):

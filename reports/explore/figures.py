@@ -28,7 +28,7 @@ VIEWS = ("lobe", "hemisphere", "slice", "sphere", "albedo", "masking", "tangent"
 DECADES = 3.0
 #: The sphere's exposure: radiance (1/sr, unit irradiance) times this before tone mapping.
 EXPOSURE = 4.0
-_SIZE = 300
+_SIZE = 280
 
 
 def tone_map(rgb: np.ndarray, exposure: float = EXPOSURE) -> np.ndarray:
@@ -95,14 +95,14 @@ def make_figures() -> tuple[dict, dict]:
         g.image("image", x=x, y=y, dw=w, dh=h, source=src[name], color_mapper=maps[name])
     s = figs["sphere"] = _fig("sphere", "lit sphere", x_range=(-1, 1), y_range=(-1, 1))
     s.image_rgba("image", x=-1, y=-1, dw=2, dh=2, source=src["sphere"])
-    a = figs["albedo"] = _fig("albedo", "directional albedo against θi (deg)",
+    a = figs["albedo"] = _fig("albedo", "albedo against θi (deg)",
                               y_range=(0, 1.05))
     for c, col in (("r", "#d62728"), ("g", "#2ca02c"), ("b", "#1f77b4")):
         a.line("t", c, source=src["albedo"], color=col, line_width=2, legend_label=c)
     m = figs["masking"] = _fig("masking", "masking M, u, pair weight (deg)", y_range=(0, 1.05))
     for c, col in (("M", "#1f77b4"), ("u", "#ff7f0e"), ("pair", "#2ca02c")):
         m.line("a", c, source=src["masking"], color=col, legend_label=c)
-    tg = figs["tangent"] = _fig("tangent", "tangent curves: offset (deg) by arc length")
+    tg = figs["tangent"] = _fig("tangent", "tangent offset (deg) by arc length")
     tg.multi_line("xs", "ys", source=src["tangent"], color="c", line_width=2)
     for g in (a, m):
         g.legend.location = "bottom_left"
@@ -154,17 +154,29 @@ def update_figures(figs: dict, src: dict, frame, log: bool) -> None:
     """Put ``frame``'s numbers into the figures' sources (titles say the peaks)."""
     peak = _lobe(src, frame, log)
     scale = f"log, {DECADES:g} decades" if log else "linear"
-    figs["lobe"].title.text = f"lobe in the plane ({scale}; peak {peak:.3g} 1/sr)"
+    figs["lobe"].title.text = f"lobe ({scale}; peak {peak:.3g} 1/sr)"
     for name in ("hemisphere", "slice"):
         p = _map(src, name, getattr(frame, name), log)
-        figs[name].title.text = f"{name}: f_r ({scale}; peak {p:.3g} 1/sr)"
+        figs[name].title.text = f"{name} ({scale}; peak {p:.3g} 1/sr)"
     src["sphere"].data = {"image": [tone_map(frame.sphere)]}
     a = frame.albedo
     src["albedo"].data = {"t": frame.albedo_theta, "r": a[:, 0], "g": a[:, 1], "b": a[:, 2]}
+    if not _same(src["masking"].data.get("M"), frame.masking["M"]):
+        _masking(src, frame)
+    cols = ("#1f77b4", "#d62728")
+    tangent = {"xs": [s for s, _ in frame.tangents], "ys": [o for _, o in frame.tangents],
+               "c": list(cols[:len(frame.tangents)])}
+    if not all(_same(a, b) for a, b in zip(src["tangent"].data["ys"], tangent["ys"])) \
+            or len(src["tangent"].data["ys"]) != len(tangent["ys"]):
+        src["tangent"].data = tangent
+
+
+def _same(a, b) -> bool:
+    return a is not None and np.shape(a) == np.shape(b) and np.array_equal(a, b)
+
+
+def _masking(src, frame) -> None:
+    """The masking terms (no slider changes them: sent once)."""
     m = frame.masking
     src["masking"].data = {"a": frame.masking_angle, "M": m["M"], "u": m["u"],
                            "pair": m["pair"]}
-    cols = ("#1f77b4", "#d62728")
-    src["tangent"].data = {"xs": [s for s, _ in frame.tangents],
-                           "ys": [o for _, o in frame.tangents],
-                           "c": list(cols[:len(frame.tangents)])}

@@ -6,7 +6,8 @@ another model's sliders) finds the hosts by their CSS class (``param-NAME``,
 ``view-NAME``), sets ``data-testid`` to that class, makes each control focusable
 (``tabindex=0``) and moves it with the arrow keys (a slider by its step, a choice to the
 next or previous option) when it is focused itself, and counts each view's redraws in
-``data-version`` (its data sources' changes, after the next animation frame). Nothing
+``data-version`` (its data sources' changes, after the next animation frame; the time of
+the last in ``data-drawn-at``, milliseconds of ``performance.now()``). Nothing
 is loaded from anywhere.
 
 Examples
@@ -68,6 +69,7 @@ function tag() {
           if (m.name && m.name.startsWith('src-' + name)) {
             m.change.connect(() => requestAnimationFrame(() => {
               el.dataset.version = String(Number(el.dataset.version) + 1);
+              el.dataset.drawnAt = String(performance.now());
             }));
           }
         }
@@ -76,6 +78,11 @@ function tag() {
   }
 }
 tag();
+if (!window.__microcylKeys) {
+  window.__microcylKeys = true;
+  window.addEventListener('keydown', () => { window.__microcylKeyAt = performance.now(); },
+                          true);
+}
 if (!window.__microcylTag) { window.__microcylTag = setInterval(tag, 500); }
 """
 

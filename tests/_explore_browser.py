@@ -86,8 +86,8 @@ def by_testid(drv, testid):
 def versions(drv) -> dict:
     """Each view's redraw count."""
     return drv.execute_script(
-        DEEP + "const o = {}; for (const e of deep(document, '[data-testid^=\"view-\"]', []))"
-        " o[e.dataset.testid.slice(5)] = Number(e.dataset.version); return o;")
+        "const o = {}, v = window.__microcylViews || {};"
+        "for (const k in v) o[k] = Number(v[k].dataset.version); return o;")
 
 
 def wait_for(fn, timeout: float = 60.0, every: float = 0.01):
@@ -118,9 +118,8 @@ def press(drv, testid, key, views=VIEWS, timeout: float = 30.0) -> float:
     wait_for(lambda: all(versions(drv).get(v, 0) > before.get(v, 0) for v in views),
              timeout=timeout, every=0.05)
     return drv.execute_script(
-        DEEP + "const t = deep(document, '[data-testid^=\"view-\"]', [])"
-        ".filter(e => arguments[0].includes(e.dataset.testid.slice(5)))"
-        ".map(e => Number(e.dataset.drawnAt));"
+        "const v = window.__microcylViews;"
+        "const t = arguments[0].map(k => Number(v[k].dataset.drawnAt));"
         "return (Math.max(...t) - window.__microcylKeyAt) / 1000;", list(views))
 
 

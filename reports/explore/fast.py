@@ -13,7 +13,7 @@ Examples
 >>> m = explore_model()
 >>> fab = m.start("linen_plain")
 >>> cache = PreparedCache()
->>> fast = FastBRDF(m, m.values_of(fab), fab, cache)
+>>> fast = FastBRDF(m, m.values_of(fab), fab, cache, dtype=np.float64)
 >>> wi, wo = np.array([[0.0, 0.0, 1.0]]), np.array([[0.5, 0.0, 0.866]])
 >>> bool(np.allclose(fast.eval(wi, wo), fab.eval(wi, wo)))
 True
@@ -74,10 +74,14 @@ def batch_kwargs(model_name: str, values: Mapping) -> dict:
 class FastBRDF:
     """``eval(wi, wo)``: the model of ``explore_model`` at ``values`` (every slider, natural
     units; arrays of a batch shape B... give (B..., n, 3)), prepared on ``base`` (a fabric:
-    its options and tangent curves; a baseline model) through ``cache``."""
+    its options and tangent curves; a baseline model) through ``cache``; the microcylinder
+    shaded in ``dtype`` (float32 by default: about twice as fast, a relative error of a few
+    1e-6, :meth:`brdf.Prepared.eval`)."""
 
-    def __init__(self, explore_model, values: Mapping, base, cache: PreparedCache):
+    def __init__(self, explore_model, values: Mapping, base, cache: PreparedCache,
+                 dtype=np.float32):
         self.model = explore_model
+        self.dtype = dtype
         self.base = base
         self.cache = cache
         self.kwargs = batch_kwargs(explore_model.name, values)
@@ -93,4 +97,6 @@ class FastBRDF:
         wo = np.asarray(wo, dtype=np.float64)
         key = (self._tag, _pairs_key(wi, wo))
         prepared = self.cache.get(key, lambda: self.base.prepare(wi, wo))
+        if self.model.is_microcylinder:
+            return prepared.eval(dtype=self.dtype, **self.kwargs)
         return prepared.eval(**self.kwargs)

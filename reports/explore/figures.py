@@ -110,6 +110,12 @@ def make_figures() -> tuple[dict, dict]:
     return figs, src
 
 
+def _put(source, data) -> None:
+    """Set a source's data, unless both are empty (nothing to send)."""
+    if any(len(v) for v in data.values()) or any(len(v) for v in source.data.values()):
+        source.data = data
+
+
 def _lobe(src, frame, log):
     peak = max(float(np.nanmax(frame.lobe_f)) if np.isfinite(frame.lobe_f).any() else 0.0,
                float(np.nanmax(frame.compare_f)) if frame.compare_f is not None else 0.0)
@@ -117,13 +123,13 @@ def _lobe(src, frame, log):
     x, y = polar(th, frame.lobe_f, peak, log)
     src["lobe"].data = {"x": x, "y": y}
     cx, cy = polar(th, frame.compare_f, peak, log) if frame.compare_f is not None else ([], [])
-    src["lobe_compare"].data = {"x": cx, "y": cy}
+    _put(src["lobe_compare"], {"x": cx, "y": cy})
     if frame.band is not None:
         hx, hy = polar(th, frame.band.hi, peak, log)
         lx, ly = polar(th, frame.band.lo, peak, log)
-        src["lobe_band"].data = {"x": np.r_[hx, lx[::-1]], "y": np.r_[hy, ly[::-1]]}
+        _put(src["lobe_band"], {"x": np.r_[hx, lx[::-1]], "y": np.r_[hy, ly[::-1]]})
     else:
-        src["lobe_band"].data = {"x": [], "y": []}
+        _put(src["lobe_band"], {"x": [], "y": []})
     px, py, s0, s1 = [], [], [], []
     for _label, p in frame.points:
         x, y = polar(p.theta_o_deg, p.value, peak, log)
@@ -131,9 +137,9 @@ def _lobe(src, frame, log):
         s0.append(polar(p.theta_o_deg, p.value - p.sigma, peak, log))
         s1.append(polar(p.theta_o_deg, p.value + p.sigma, peak, log))
     cat = lambda parts: np.concatenate(parts) if parts else np.zeros(0)  # noqa: E731
-    src["lobe_points"].data = {"x": cat(px), "y": cat(py)}
-    src["lobe_sigma"].data = {"x0": cat([a[0] for a in s0]), "y0": cat([a[1] for a in s0]),
-                              "x1": cat([a[0] for a in s1]), "y1": cat([a[1] for a in s1])}
+    _put(src["lobe_points"], {"x": cat(px), "y": cat(py)})
+    _put(src["lobe_sigma"], {"x0": cat([a[0] for a in s0]), "y0": cat([a[1] for a in s0]),
+                              "x1": cat([a[0] for a in s1]), "y1": cat([a[1] for a in s1])})
     return peak
 
 

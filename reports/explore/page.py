@@ -7,12 +7,13 @@ another model's sliders) finds the hosts by their CSS class (``param-NAME``,
 (``tabindex=0``) and moves it with the arrow keys (a slider by its step, a choice to the
 next or previous option) when it is focused itself, and counts each view's redraws in
 ``data-version`` (its data sources' changes, after the next animation frame; the time of
-the last in ``data-drawn-at``, milliseconds of ``performance.now()``). Nothing
+the last in ``data-drawn-at``, milliseconds of ``performance.now()``; the views by name in
+``window.__microcylViews``, for tests that read them without walking the page). Nothing
 is loaded from anywhere.
 
 Examples
 --------
->>> "data-testid" in SCRIPT and "http" not in SCRIPT
+>>> "dataset.testid" in SCRIPT and "http" not in SCRIPT
 True
 """
 
@@ -64,6 +65,7 @@ function tag() {
     } else {
       el.dataset.version = '0';
       const name = c.slice(5);
+      (window.__microcylViews = window.__microcylViews || {})[name] = el;
       for (const d of docs) {
         for (const m of d.all_models) {
           if (m.name && m.name.startsWith('src-' + name)) {

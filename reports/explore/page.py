@@ -4,8 +4,9 @@ Bokeh draws each widget and figure in a shadow root; this script (run on the doc
 ``document_ready`` event, and again every half second for controls made later, such as
 another model's sliders) finds the hosts by their CSS class (``param-NAME``,
 ``view-NAME``), sets ``data-testid`` to that class, makes each control focusable
-(``tabindex=0``) and moves it with the arrow keys (a slider by its step, a choice to the
-next or previous option) when it is focused itself, and counts each view's redraws in
+(``tabindex=0``) and moves it with the arrow keys (a slider by its step, up and right
+raising it; a choice to the next option with down or right, the previous with up or left)
+when it is focused itself, and counts each view's redraws in
 ``data-version`` (its data sources' changes, after the next animation frame; the time of
 the last in ``data-drawn-at``, milliseconds of ``performance.now()``; the views by name in
 ``window.__microcylViews``, for tests that read them without walking the page). Nothing
@@ -58,8 +59,10 @@ function tag() {
       el.tabIndex = 0;
       el.addEventListener('keydown', e => {
         if (e.composedPath()[0] !== el) return;
-        const dir = {ArrowRight: 1, ArrowUp: 1, ArrowLeft: -1, ArrowDown: -1}[e.key];
         const m = model(c);
+        const choice = m && m.options !== undefined;     // a list: down is the next one
+        const dir = {ArrowRight: 1, ArrowLeft: -1, ArrowUp: choice ? -1 : 1,
+                     ArrowDown: choice ? 1 : -1}[e.key];
         if (dir && m) { e.preventDefault(); step(m, dir); }
       });
     } else {

@@ -28,7 +28,7 @@ pytestmark = pytest.mark.skipif(
 
 @pytest.fixture(scope="module")
 def page():
-    proc, url = eb.start_server("velvet", "linen_plain")
+    proc, url = eb.start_server("linen_plain", "velvet")
     drv = eb.open_browser()
     try:
         eb.load(drv, url)
@@ -79,8 +79,10 @@ def test_a_choice_moves_with_the_keyboard(page):
 def test_no_console_error_and_nothing_from_another_host(page):
     drv, url = page
     if os.environ.get("MICROCYL_EXPLORE_SHOT"):
+        drv.set_window_size(1400, 1040)
         drv.execute_script("window.scrollTo(0, 0);")
         drv.save_screenshot(os.environ["MICROCYL_EXPLORE_SHOT"])
+        drv.set_window_size(1500, 800)
     errors = [e for e in drv.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
     assert not errors, errors
     assert eb.foreign_requests(drv, url.rstrip("/")) == []

@@ -97,7 +97,7 @@ class Controller:
                              lambda v: self.set(compare=v))]
         self.preset = self._select("preset", "preset", "", [""] + list(explore_model().presets),
                                    self._pick_preset)
-        reset = _name(Button(label="reset to the loaded model (a fit's medians)", width=200),
+        reset = _name(Button(label="reset (a fit: its medians)", width=200),
                       "reset")
         reset.on_click(lambda: self._switch_source(self.state.source))
         return out + [self.preset, reset]

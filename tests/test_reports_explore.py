@@ -11,10 +11,11 @@ import brdf
 import gonio
 from analysis.views.lobes import plane_directions
 from reports.cli import main
-from reports.explore import Explorer, app
+from reports.explore import Controller, Explorer, app
 from reports.explore.data import Inputs, lobe_band, lobe_points, load_inputs
 from reports.explore.fast import FastBRDF, PreparedCache
 from reports.explore.models import explore_model, model_names
+from test_cli_state_files import fit  # noqa: F401 (fixture: a short real fit and its table)
 
 
 @pytest.mark.parametrize("name", model_names())
@@ -95,3 +96,35 @@ def test_the_verb_refuses_a_bad_port_and_an_unknown_source(capsys):
     assert "--port" in capsys.readouterr().err
     assert main(["explore", "--no-browser", "no_such_preset_or_file"]) != 0
     assert "no_such_preset_or_file" in capsys.readouterr().err
+
+
+def test_a_fit_folder_gives_its_medians_and_band_and_its_table_its_points(fit):
+    """A short real fit (tests/test_cli_state_files.py's fixture: silk_crepe_de_chine, 40
+    steps) and its table: the sliders start at the medians, the lobe carries the band."""
+    inputs = load_inputs([str(fit / "fit"), str(fit / "silk.csv")])
+    (src,), ((label, table),) = inputs.sources, inputs.tables
+    assert src.kind == "fit" and label == "silk.csv" and len(table) == 60
+    draws = inputs.draws[src.label]
+    assert draws["gamma_s1"].shape == (48,) and np.ptp(draws["gamma_s1"]) > 0
+    ex = Explorer(inputs)
+    st = ex.initial_state()
+    assert st.source == src.label
+    assert np.isclose(st.values["gamma_s1"], src.brdf.threads[0].gamma_s)
+    band = ex.frame(st).band
+    assert band is not None and np.all(band.lo <= band.hi + 1e-12)
+    assert np.max(band.hi - band.lo) > 0
+
+
+def test_a_refused_value_is_said_as_plain_text_and_nothing_is_drawn():
+    """SECURITY.md: a message (which may quote a file's text) reaches the page as text."""
+    doc = Document()
+    ctl = Controller(doc, Explorer(load_inputs(["velvet"])))
+    ctl.redraw()
+    assert type(ctl.status).__name__ == "Paragraph"        # text, not a Div's HTML
+    before = ctl.src["lobe"].data["x"]
+    ctl.state = ctl.state.replace(values=dict(ctl.state.values, eta1=-1.0))
+    ctl.redraw()
+    assert "eta" in ctl.status.text and ctl.src["lobe"].data["x"] is before
+    ctl.state = ctl.state.replace(values=dict(ctl.state.values, eta1=1.5))
+    ctl.redraw()
+    assert ctl.status.text == "" and ctl.src["lobe"].data["x"] is not before

@@ -28,7 +28,7 @@ Examples
 from __future__ import annotations
 
 from bokeh.layouts import column, row
-from bokeh.models import Button, Div, Select, Slider
+from bokeh.models import Button, Paragraph, Select, Slider
 
 from brdf.fabric import Fabric
 from reports.explore.data import Inputs, load_inputs
@@ -62,7 +62,7 @@ class Controller:
         self.doc, self.ex = doc, explorer
         self.state = explorer.initial_state()
         self.figs, self.src = make_figures()
-        self.status = Div(text="", name="status")
+        self.status = Paragraph(text="", name="status")   # plain text, never HTML
         self._pending = self._quiet = False
         self.sliders: dict = {}
         self.slider_box = row()

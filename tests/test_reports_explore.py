@@ -46,6 +46,9 @@ def test_a_slider_move_changes_every_parameter_view_and_reuses_the_prepared_pair
     assert len(ex.cache) == held                     # the same pairs: nothing prepared
     for view in ("lobe_f", "hemisphere", "slice", "sphere", "albedo"):
         assert not np.allclose(getattr(a, view), getattr(b, view)), view
+    assert a.compare_f is None
+    d = ex.frame(st.replace(compare="velvet"))       # a preset not loaded: compared too
+    assert d.compare_f is not None and not np.allclose(d.compare_f, a.lobe_f)
     c = ex.frame(st.replace(options=dict(st.options, masking=False)))
     assert len(ex.cache) > held and not np.allclose(a.lobe_f, c.lobe_f)
 

@@ -93,7 +93,7 @@ class Controller:
                              self._switch_model),
                 self._select("source", "loaded", self.state.source, labels or [""],
                              self._switch_source),
-                self._select("compare", "compare with", "", [""] + labels,
+                self._select("compare", "compare with", "", [""] + self.ex.compare_choices(),
                              lambda v: self.set(compare=v))]
         self.preset = self._select("preset", "preset", "", [""] + list(explore_model().presets),
                                    self._pick_preset)

@@ -30,7 +30,9 @@ from analysis.views.hemisphere import compute_hemisphere
 from analysis.views.lobes import compute_lobes
 from analysis.views.masking import masking_terms
 from analysis.views.slices import compute_slice_image
+from brdf import PRESETS
 from brdf.fabric import Fabric
+from brdf.presets import fabric as preset_fabric
 from reports.explore.data import Band, Inputs, Points, lobe_band, lobe_points
 from reports.explore.fast import FastBRDF, PreparedCache
 from reports.explore.models import explore_model
@@ -142,11 +144,17 @@ class Explorer:
         return FastBRDF(model, state.values if values is None else values,
                         self.base(state) if base is None else base, self.cache)
 
+    def compare_choices(self) -> list:
+        """What the lobe may be compared with: the loaded models, then the presets."""
+        return self.labels() + [p for p in PRESETS if p not in self.sources]
+
     def _compare(self, state: State, theta):
         src = self.sources.get(state.compare)
-        if src is None:
+        obj = src.brdf if src is not None else (
+            preset_fabric(state.compare) if state.compare in PRESETS else None)
+        if obj is None:
             return None
-        v = compute_lobes(src.brdf, state.theta_i, state.plane, resolution=theta.size)
+        v = compute_lobes(obj, state.theta_i, state.plane, resolution=theta.size)
         return reduce_quantity(v.rgb[0, 0], state.channel)
 
     def _band(self, state: State, theta) -> Band | None:

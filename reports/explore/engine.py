@@ -109,8 +109,10 @@ def _tangents(base) -> list:
 
 
 class Explorer:
-    """The views' numbers for the loaded ``inputs`` (:func:`reports.explore.data.
-    load_inputs`), at ``resolution`` (:data:`RESOLUTION`'s keys)."""
+    """The views' numbers for the loaded ``inputs``, at ``resolution``.
+
+    ``inputs`` come from :func:`reports.explore.data.load_inputs`; ``resolution`` overrides
+    some of :data:`RESOLUTION`'s entries."""
 
     def __init__(self, inputs: Inputs, resolution: dict | None = None):
         self.inputs = inputs

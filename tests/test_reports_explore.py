@@ -86,12 +86,13 @@ def test_the_document_has_a_named_control_per_parameter_and_switches_models():
     doc = Document()
     app(inputs=Inputs(load_inputs(["velvet"]).sources, [], {}))(doc)
     names = {m.name for m in doc.select({"type": Slider})}
-    assert {f"param-{s.name}" for s in explore_model().sliders} <= names
+    assert {f"param-{s.name}" for s in explore_model().sliders} | {"param-rotation"} <= names
     pick = doc.select_one({"name": "param-model"})
     assert isinstance(pick, Select)
     pick.value = "charlie"                           # Python-side change runs the callback
     names = {m.name for m in doc.select({"type": Slider})}
     assert "param-roughness" in names and "param-gamma_s1" not in names
+    assert doc.select_one({"name": "param-rotation"}) is None    # the fabric's alone
 
 
 def test_the_verb_refuses_a_bad_port_and_an_unknown_source(capsys):
@@ -131,3 +132,15 @@ def test_a_refused_value_is_said_as_plain_text_and_nothing_is_drawn():
     ctl.state = ctl.state.replace(values=dict(ctl.state.values, eta1=1.5))
     ctl.redraw()
     assert ctl.status.text == "" and ctl.src["lobe"].data["x"] is not before
+
+
+def test_the_rotation_slider_turns_the_fabric_about_its_normal():
+    doc = Document()
+    ctl = Controller(doc, Explorer(load_inputs(["silk_shot"])))
+    doc.add_root(ctl.layout())
+    ctl.redraw()
+    before = ctl.src["hemisphere"].data["image"][0].copy()
+    doc.select_one({"name": "param-rotation"}).value = 90.0
+    assert np.isclose(ctl.state.options["rotation"], np.pi / 2)
+    ctl.redraw()
+    assert not np.allclose(ctl.src["hemisphere"].data["image"][0], before)

@@ -13,8 +13,8 @@ share (:class:`reports.explore.engine.State`).
 Every control is named ``param-NAME`` (a model parameter's name, e.g. ``param-gamma_s1``,
 or ``param-theta_i``, ``param-plane``, ``param-channel``, ``param-scale``,
 ``param-light_theta``, ``param-light_phi``, ``param-model``, ``param-source``,
-``param-preset``, ``param-compare``, ``param-reset`` and each variant's,
-``param-masking``...), every view ``view-NAME`` (:data:`reports.explore.figures.VIEWS`).
+``param-preset``, ``param-compare``, ``param-reset``, ``param-rotation`` and each
+variant's, ``param-masking``...), every view ``view-NAME`` (:data:`reports.explore.figures.VIEWS`).
 
 Examples
 --------
@@ -26,6 +26,8 @@ Examples
 """
 
 from __future__ import annotations
+
+import math
 
 from bokeh.layouts import column, row
 from bokeh.models import Button, Paragraph, Select, Slider
@@ -116,8 +118,21 @@ class Controller:
         self.variant_box.children = [
             self._select(k, k, str(self.state.options.get(k, v[0])), [str(c) for c in v],
                          lambda val, k=k: self._set_option(k, val))
-            for k, v in model.variants.items()]
+            for k, v in model.variants.items()] + self._rotation(model)
         self.preset.disabled = not model.is_microcylinder
+
+    def _rotation(self, model) -> list:
+        """The fabric's rotation about n (schema.FABRIC's ``rotation``, shown in degrees;
+        each move prepares new pairs, like a variant)."""
+        if not model.is_microcylinder:
+            return []
+        deg = math.degrees(self.state.options.get("rotation", 0.0)) % 180.0
+        w = _name(Slider(title="rotation (deg)", start=0.0, end=180.0, step=5.0,
+                         value=round(deg / 5.0) * 5.0, width=200), "rotation")
+        w.on_change("value", lambda _a, _o, new: self._user(
+            lambda v: self.set(options=dict(self.state.options, rotation=math.radians(v))),
+            new))
+        return [w]
 
     def _user(self, fn, value) -> None:
         if not self._quiet:
@@ -160,7 +175,8 @@ class Controller:
         model = explore_model(name)
         src = self.ex.sources.get(self.state.source)
         obj = src.brdf if src is not None and src.model == name else model.start()
-        opts = {k: obj.options[k] for k in model.variants} if isinstance(obj, Fabric) else {}
+        opts = ({k: obj.options[k] for k in (*model.variants, "rotation")}
+                if isinstance(obj, Fabric) else {})
         self.state = self.state.replace(model=name, values=model.values_of(obj), options=opts)
         self._rebuild_model_controls()
         self.set()

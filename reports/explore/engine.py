@@ -138,7 +138,8 @@ class Explorer:
         src = self.sources.get(label)
         model = explore_model(src.model if src is not None else "microcylinder")
         obj = src.brdf if src is not None else model.start("linen_plain")
-        opts = {k: obj.options[k] for k in model.variants} if isinstance(obj, Fabric) else {}
+        opts = ({k: obj.options[k] for k in (*model.variants, "rotation")}
+                if isinstance(obj, Fabric) else {})
         return State(model.name, model.values_of(obj), opts, label)
 
     def fast(self, state: State, values=None, base=None) -> FastBRDF:

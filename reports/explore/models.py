@@ -132,4 +132,5 @@ def explore_model(name: str = MICROCYLINDER) -> ExploreModel:
         raise ValueError(f"unknown model {name!r}; models: {', '.join(model_names())}")
     micro = name == MICROCYLINDER
     variants = {k: v for k, v in VARIANTS.items() if k in OPTIONS} if micro else {}
+    # rotation (schema.FABRIC, an option of the fabric) is the app's own slider
     return ExploreModel(name, _sliders(name), variants, PRESETS if micro else ())

@@ -159,7 +159,7 @@ def _map(src, name, image, log):
 def update_figures(figs: dict, src: dict, frame, log: bool) -> None:
     """Put ``frame``'s numbers into the figures' sources (titles say the peaks)."""
     peak = _lobe(src, frame, log)
-    scale = f"log, {DECADES:g} decades" if log else "linear"
+    scale = "log" if log else "linear"          # log: DECADES below the peak
     figs["lobe"].title.text = f"lobe ({scale}; peak {peak:.3g} 1/sr)"
     for name in ("hemisphere", "slice"):
         p = _map(src, name, getattr(frame, name), log)

@@ -36,6 +36,7 @@ COMMAND_MODULES = (
     "reports.cli.batch",
     "reports.cli.plot",
     "reports.cli.export",
+    "reports.cli.explore",
 )
 
 

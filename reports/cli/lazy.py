@@ -7,6 +7,7 @@ accessors (imported on first call, cached by Python's module table after).
 
 from __future__ import annotations
 
+import importlib
 from types import SimpleNamespace
 
 
@@ -37,3 +38,10 @@ def renderer() -> SimpleNamespace:
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
     from reports.render import engine, exposure, files, imageio
     return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio)
+
+
+def explorer():
+    """The :mod:`reports.explore` package (``microcyl explore``: the Bokeh server)."""
+    # lazy: bokeh (~1.5 s with the explorer's views), which every other verb skips; through
+    # importlib as reports.cli loads its verb modules
+    return importlib.import_module("reports.explore")

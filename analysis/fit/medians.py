@@ -27,7 +27,7 @@ from analysis.fit.results import read_results
 from brdf import schema
 from gonio.statefields import MAX_MAGNITUDE, FileFields
 
-__all__ = ["MedianFabric", "median_fabric", "FitModel"]
+__all__ = ["MedianFabric", "median_fabric", "fabric_at", "FitModel"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -163,6 +163,35 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
         raise ValueError(f"{folder / CONFIG_FILE}: cannot tell which preset was fitted "
                          f"({cfg['preset']!r}); name it")
     values = _values(folder, cfg, results)
+    fab = _fabric_at(folder, cfg, values)
+    return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))
+
+
+def fabric_at(med: "MedianFabric", fit_dir, values: dict):
+    """The fit's model at other parameter values (a posterior draw): ``values`` (natural
+    units) replace those of ``med`` (:func:`median_fabric` of ``fit_dir``); a
+    :class:`brdf.Fabric`, or the baseline model of a baseline fit.
+
+    Raises
+    ------
+    ValueError
+        Values that make no valid fabric or model.
+    """
+    folder = Path(fit_dir)
+    merged = {**med.values, **{k: float(v) for k, v in values.items()}}
+    if not med.is_fabric:
+        fam = family(med.model_name)
+        try:
+            return fam.build(merged)
+        except ValueError as exc:
+            raise ValueError(f"{folder}: the values make no valid {fam.name} model "
+                             f"({exc})") from None
+    cfg = {"preset": med.preset, "options": med.fabric.options}
+    return _fabric_at(folder, cfg, merged)
+
+
+def _fabric_at(folder: Path, cfg: dict, values: dict) -> brdf.Fabric:
+    """The fabric of the fitted preset with every parameter at ``values``."""
     threads = []
     for j, t in enumerate(brdf.preset_threads(cfg["preset"]), start=1):
         change = {q: values[f"{q}{j}"] for q in schema.SCALAR_PARAMS if f"{q}{j}" in values}
@@ -178,10 +207,9 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
             raise ValueError(f"{folder}: the fit's values make no valid fabric (thread {j}: "
                              f"{exc})") from None
     try:
-        fab = brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
+        return brdf.Fabric(threads, name=cfg["preset"], **cfg["options"])
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{folder / CONFIG_FILE}: config.extra.options: {exc}") from None
-    return MedianFabric(fab, cfg["preset"], values, cfg["free"], results.get("converged"))
 
 
 def _values(folder: Path, cfg: dict, results: dict) -> dict:

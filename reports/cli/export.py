@@ -85,8 +85,8 @@ def run(args) -> int:
         med = median_fabric(src.path)
         verdict = ("converged" if med.converged
                    else "NOT converged (medians of an unfinished fit)")
-        print(f"{src.label}: fit of {src.model}, medians of {', '.join(med.free)} "
-              f"({verdict})")
+        print(f"{med.preset or src.model}: medians of {', '.join(med.free)} ({verdict}) -> "
+              f"{out}")
     else:
         print(f"{src.label} ({src.kind})")
     for line in res.lines():

@@ -24,7 +24,7 @@ from analysis.export.workflow import export_fabric, fidelity_path
 from analysis.fit.medians import median_fabric
 from brdf.baselines import Charlie, Lambert, Zeltner
 
-GRID = HemisphereGrid(4, 8)
+GRID = HemisphereGrid(3, 6)
 NODE = Path(__file__).parent / "node"
 
 
@@ -38,7 +38,7 @@ class Scaled:
         return self.k * np.asarray(self.inner.eval(wi, wo))
 
 
-def _direct_rel_l2(source, target, n_theta=4, n_phi=8):
+def _direct_rel_l2(source, target, n_theta=3, n_phi=6):
     """Relative L2 error of f_r cos cos by explicit loops over the cells (no export code)."""
     dirs, dws = [], []
     for a in range(n_theta):

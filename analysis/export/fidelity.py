@@ -9,7 +9,7 @@ r"""How closely an export follows its source: the numbers written beside every e
 - **CIEDE2000** (colour-science) of a flat patch lit by a directional light at
   :data:`LIGHT_THETA` (azimuth 0): its reflected radiance f_r cos(theta_i) E, relative to a
   white Lambertian patch's under the same light (so Y = 1 is that white), seen from each of
-  :data:`VIEWS`; linear sRGB -> XYZ -> CIE Lab (D65).
+  :data:`VIEWS`; linear sRGB -> XYZ -> CIE Lab (D65), :func:`analysis.colour.albedo_delta_e`.
 - **What the target cannot follow** (every target here is isotropic, reciprocal or not, with
   one sheen colour over one base colour):
 
@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.colour import luminance
+from analysis.colour import albedo_delta_e, luminance
 from analysis.export.grid import DEFAULT_GRID, HemisphereGrid, albedo_rule
 
 __all__ = ["fidelity", "summary_lines", "ALBEDO_INCIDENCES", "LIGHT_THETA", "VIEWS", "LIMITS"]
@@ -74,16 +74,7 @@ def _albedos(brdf_obj) -> dict:
     return out
 
 
-def _lab(rgb):
-    import colour    # colour-science, imported on use (analysis/colour.py's note)
-    xyz = colour.RGB_to_XYZ(np.clip(rgb, 0, None), colour.RGB_COLOURSPACES["sRGB"],
-                            apply_cctf_decoding=False)
-    return colour.XYZ_to_Lab(xyz, colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard "
-                                                         "Observer"]["D65"])
-
-
 def _delta_e(source, target) -> dict:
-    import colour    # colour-science, imported on use (analysis/colour.py's note)
     wi = _dir(LIGHT_THETA, 0.0)
     white = np.cos(np.radians(LIGHT_THETA)) / np.pi
     out, rad = {}, {}
@@ -91,7 +82,7 @@ def _delta_e(source, target) -> dict:
         wo = _dir(t, p)
         ls = np.asarray(source.eval(wi[None], wo[None]))[0] * wi[2] / white
         lt = np.asarray(target.eval(wi[None], wo[None]))[0] * wi[2] / white
-        out[name] = float(colour.delta_E(_lab(ls), _lab(lt), method="CIE 2000"))
+        out[name] = albedo_delta_e(ls, lt)
         rad[name] = {"source": [float(v) for v in ls], "target": [float(v) for v in lt]}
     return {"light_theta_deg": LIGHT_THETA, "views_deg": {k: list(v) for k, v in VIEWS.items()},
             "per_view": out, "max": max(out.values()), "relative_radiance": rad}

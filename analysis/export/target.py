@@ -5,6 +5,12 @@ stands for what the renderer evaluates (``zeltner``, ``charlie``; None for the M
 which is the microcylinder fabric itself), a writer and, where the format can be read back as
 data, a reader. The registry is :data:`analysis.export.TARGETS`: a new target is its module
 (defining ``TARGET``) plus one line there.
+
+Examples
+--------
+>>> t = Target("demo", (".demo",), "zeltner", print, None, "a demonstration")
+>>> t.name, t.model, t.read is None
+('demo', 'zeltner', True)
 """
 
 from __future__ import annotations

@@ -94,10 +94,17 @@ def _draw_sources(src, draws: int, seed: int) -> tuple[list, list[str]]:
     except ValueError as exc:
         return [], [f"posterior draws not projected ({exc}); the medians only"]
     values = spec.values(thetas)
-    out = []
+    out, refused = [], []
     for k in range(len(thetas)):
-        out.append(fabric_at(med, src.path, {n: float(values[n][k]) for n in spec.free}))
-    return out, []
+        try:
+            out.append(fabric_at(med, src.path, {n: float(values[n][k]) for n in spec.params}))
+        except ValueError as exc:
+            refused.append(str(exc))
+    notes = []
+    if refused:
+        notes.append(f"{len(refused)} of {len(thetas)} posterior draws make no valid fabric "
+                     f"and were left out (first: {refused[0][:120]})")
+    return out, notes
 
 
 def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID,

@@ -84,6 +84,8 @@ def test_fidelity_of_a_scaled_source_is_the_scale():
     for a in lam["albedo"]["source"].values():
         assert np.allclose(a["rgb"], 0.5, atol=1e-12)
     assert lam["cannot_follow"] == [] and lam["delta_e2000"]["max"] == 0.0
+    retro = lam["limits"]["retroreflection"]["source_back_over_lambertian_60deg"]
+    assert abs(retro - 1.0) < 1e-9                   # a Lambertian is its own reference
 
 
 def test_fidelity_matches_a_direct_evaluation():
@@ -97,11 +99,15 @@ def test_fidelity_matches_a_direct_evaluation():
 
 def test_limits_flag_what_the_targets_cannot_follow():
     """Shot silk (warp and weft of different colours, anisotropic) is flagged for anisotropy
-    and colour shift; a Zeltner source exported as Zeltner for nothing."""
+    and colour shift, velvet's back-scatter peak for retroreflection; a Zeltner source
+    exported as Zeltner for nothing."""
     silk = brdf.fabric("silk_shot")
     fid = fidelity(silk, project(silk, "zeltner", GRID).brdf(), GRID)
     assert fid["limits"]["anisotropy"]["cannot_follow"]
     assert fid["limits"]["colour_shift"]["cannot_follow"]
+    velvet = brdf.fabric("velvet")
+    fid = fidelity(velvet, project(velvet, "zeltner", GRID).brdf(), GRID)
+    assert fid["limits"]["retroreflection"]["cannot_follow"]
     z = Zeltner(base=0.3, sheen=0.7, roughness=0.4)
     assert fidelity(z, project(z, "zeltner", GRID).brdf(), GRID)["cannot_follow"] == []
 

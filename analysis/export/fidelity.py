@@ -17,9 +17,9 @@ r"""How closely an export follows its source: the numbers written beside every e
   f_r cos cos's deviation from its mean as the pair is turned about the normal (6 turns of 30
   degrees), relative to the rms of that mean; flagged where the source's exceeds the
   target's by more than :data:`LIMITS` ``anisotropy``.
-  retroreflection: source and target f_r (luminance) at wo = wi over their values at the
-  mirror direction, at theta = 60 degrees; flagged when they differ by more than
-  :data:`LIMITS` ``retroreflection`` (relative).
+  retroreflection: f_r (luminance) at wo = wi over a Lambertian's of the same directional
+  albedo (a / pi), at theta = 60 degrees, source against target; flagged when they differ by
+  more than :data:`LIMITS` ``retroreflection`` (relative).
   colour shift with angle: the weighted rms over the grid of the rg-chromaticity difference
   between target and source (what the target's one colour pair misses) beside the source's
   own spread; flagged above :data:`LIMITS` ``colour_shift``.
@@ -104,10 +104,13 @@ def _anisotropy(source, grid: HemisphereGrid) -> float:
 
 
 def _retro(obj, theta=60.0) -> float:
+    """f_r's luminance at wo = wi over that of a Lambertian of the same directional albedo
+    (a / pi), at incidence ``theta`` degrees."""
     wi = _dir(theta, 0.0)
-    back, mirror = _dir(theta, 0.0), _dir(theta, 180.0)
-    f = luminance(obj.eval(np.stack([wi, wi]), np.stack([back, mirror])))
-    return float(f[0] / f[1]) if f[1] > 0 else float("inf")
+    back = float(luminance(obj.eval(wi[None], wi[None]))[0])
+    qi, qo, w = albedo_rule(theta)
+    a = float(luminance(w @ np.asarray(obj.eval(qi, qo))))
+    return back * np.pi / a if a > 0 else float("inf")
 
 
 def _chroma(f):
@@ -151,8 +154,8 @@ def fidelity(source, target, grid: HemisphereGrid = DEFAULT_GRID) -> dict:
                        "target_azimuthal_variation": aniso_t,
                        "threshold": LIMITS["anisotropy"],
                        "cannot_follow": aniso - aniso_t > LIMITS["anisotropy"]},
-        "retroreflection": {"source_back_over_mirror_60deg": rs,
-                            "target_back_over_mirror_60deg": rt,
+        "retroreflection": {"source_back_over_lambertian_60deg": rs,
+                            "target_back_over_lambertian_60deg": rt,
                             "threshold": LIMITS["retroreflection"],
                             "cannot_follow": retro_err > LIMITS["retroreflection"]},
         "colour_shift": {"source_chromaticity_spread": spread,
@@ -164,8 +167,8 @@ def fidelity(source, target, grid: HemisphereGrid = DEFAULT_GRID) -> dict:
         words.append(f"anisotropy: the source varies by {aniso:.0%} as it turns about its "
                      f"normal, the target by {aniso_t:.0%}")
     if limits["retroreflection"]["cannot_follow"]:
-        words.append(f"retroreflection: back-scatter over mirror at 60 deg is {rs:.3g} for "
-                     f"the source, {rt:.3g} for the target")
+        words.append(f"retroreflection: back-scatter at 60 deg is {rs:.3g} times a "
+                     f"Lambertian's of the same albedo for the source, {rt:.3g} for the target")
     if limits["colour_shift"]["cannot_follow"]:
         words.append(f"colour shift with angle: the target misses {missed:.3f} of rg "
                      f"chromaticity (rms; the source's own spread {spread:.3f})")

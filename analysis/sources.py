@@ -117,8 +117,8 @@ def accepted(tables: bool = False) -> str:
     True
     """
     kinds = [f"a preset ({', '.join(brdf.PRESETS)})", "a `microcyl fit` output folder",
-             f"a {' or '.join(FABRIC_SUFFIXES + tuple(read_suffixes()))} file of "
-             f"`microcyl export`"]
+             f"a {' or '.join(FABRIC_SUFFIXES)} fabric file or a "
+             f"{' or '.join(read_suffixes())} export of `microcyl export`"]
     if tables:
         kinds.append(f"a measured table ({' or '.join(TABLE_SUFFIXES)})")
     return ", ".join(kinds[:-1]) + " or " + kinds[-1]
@@ -175,7 +175,7 @@ def resolve(text, *, what: str = "FABRIC", tables: bool = False,
     >>> resolve("denim")
     Traceback (most recent call last):
     ...
-    ValueError: FABRIC 'denim': not a preset (linen_plain, silk_crepe_de_chine, polyester_satin_charmeuse, polyester_satin_charmeuse_back, silk_shot, velvet), a `microcyl fit` output folder or a .json or .xml or .mtlx or .gltf or .glb file of `microcyl export`
+    ValueError: FABRIC 'denim': not a preset (linen_plain, silk_crepe_de_chine, polyester_satin_charmeuse, polyester_satin_charmeuse_back, silk_shot, velvet), a `microcyl fit` output folder or a .json or .xml fabric file or a .mtlx or .gltf or .glb export of `microcyl export`
     """
     text = str(text)
     if text in brdf.PRESETS:

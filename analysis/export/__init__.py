@@ -49,8 +49,9 @@ def target_for(path) -> Target:
     for t in TARGETS.values():
         if suffix in t.suffixes:
             return t
-    raise ValueError(f"-o {str(path)!r}: no target writes {suffix or 'a file without suffix'}"
-                     f"; suffixes: {', '.join(s for t in TARGETS.values() for s in t.suffixes)}")
+    raise ValueError(f"-o {str(path)!r}: must end in "
+                     f"{', '.join(dict.fromkeys(s for t in TARGETS.values() for s in t.suffixes))} (no target "
+                     f"writes {suffix or 'a file without suffix'})")
 
 
 def read_suffixes() -> dict:

@@ -8,6 +8,10 @@ A source is one of
   fit's overall ``scale``, which only calibrates relative tables);
 - a fabric file of ``microcyl export``: the plugin dictionary (``.json``) or its ``<bsdf>``
   element (``.xml``), :func:`analysis.fabricfile.read_fabric_file`;
+- an export for a renderer read back as microcyl's model of what the renderer evaluates
+  (:data:`analysis.export.TARGETS`): a ``.mtlx`` (OpenPBR ``open_pbr_surface`` or MaterialX
+  ``sheen_bsdf`` mode zeltner over a diffuse base: :class:`brdf.baselines.Zeltner`) or a
+  ``.gltf`` / ``.glb`` (KHR_materials_sheen: :class:`brdf.baselines.Charlie`);
 - where the caller takes any BRDF (``tables=True``), a measured table that evaluates between
   its samples: an RGL ``.bsdf`` (:func:`gonio.load_rgl`) or a MERL ``.binary``
   (:func:`gonio.load_merl`).
@@ -28,6 +32,7 @@ from pathlib import Path
 
 import brdf
 import gonio
+from analysis.export import read_suffixes
 from analysis.fabricfile import SUFFIXES as FABRIC_SUFFIXES
 from analysis.fabricfile import read_fabric_file
 from analysis.fit.medians import median_fabric
@@ -35,7 +40,7 @@ from analysis.fit.medians import median_fabric
 __all__ = ["Source", "resolve", "resolve_all", "accepted", "KINDS", "TABLE_SUFFIXES"]
 
 #: The kinds of source, in the order :func:`accepted` names them.
-KINDS = ("preset", "fit", "json", "xml", "table")
+KINDS = ("preset", "fit", "json", "xml", "mtlx", "gltf", "glb", "table")
 #: Suffixes of the measured tables a BRDF-taking verb evaluates directly.
 TABLE_SUFFIXES = (".bsdf", ".binary")
 
@@ -86,7 +91,11 @@ class Source:
     @property
     def what(self) -> str:
         """What the source is when not a fabric, in words (for refusals)."""
-        return "a measured table" if self.kind == "table" else f"a fit of model {self.model}"
+        if self.kind == "table":
+            return "a measured table"
+        if self.kind == "fit":
+            return f"a fit of model {self.model}"
+        return f"a .{self.kind} export read back as model {self.model}"
 
     def with_options(self, **options) -> "Source":
         """The same source with the fabric's variant options changed (``masking``,
@@ -109,7 +118,8 @@ def accepted(tables: bool = False) -> str:
     True
     """
     kinds = [f"a preset ({', '.join(brdf.PRESETS)})", "a `microcyl fit` output folder",
-             f"a {' or '.join(FABRIC_SUFFIXES)} fabric file of `microcyl export`"]
+             f"a {' or '.join(FABRIC_SUFFIXES)} fabric file or a "
+             f"{' or '.join(read_suffixes())} export of `microcyl export`"]
     if tables:
         kinds.append(f"a measured table ({' or '.join(TABLE_SUFFIXES)})")
     return ", ".join(kinds[:-1]) + " or " + kinds[-1]
@@ -166,7 +176,7 @@ def resolve(text, *, what: str = "FABRIC", tables: bool = False,
     >>> resolve("denim")
     Traceback (most recent call last):
     ...
-    ValueError: FABRIC 'denim': not a preset (linen_plain, silk_crepe_de_chine, polyester_satin_charmeuse, polyester_satin_charmeuse_back, silk_shot, velvet), a `microcyl fit` output folder or a .json or .xml fabric file of `microcyl export`
+    ValueError: FABRIC 'denim': not a preset (linen_plain, silk_crepe_de_chine, polyester_satin_charmeuse, polyester_satin_charmeuse_back, silk_shot, velvet), a `microcyl fit` output folder or a .json or .xml fabric file or a .mtlx or .gltf or .glb export of `microcyl export`
     """
     text = str(text)
     if text in brdf.PRESETS:
@@ -191,6 +201,14 @@ def _resolve_path(text: str, what: str, tables: bool, preset: str | None) -> Sou
             raise ValueError(f"{what} {text!r}: {str(exc).removeprefix(f'{path}: ')}") \
                 from None
         return Source(suffix[1:], _label(path), fab, path, fab.name)
+    readers = read_suffixes()
+    if is_file and suffix in readers:
+        try:
+            model = readers[suffix].read(path)
+        except ValueError as exc:
+            raise ValueError(f"{what} {text!r}: {str(exc).removeprefix(f'{path}: ')}") \
+                from None
+        return Source(suffix[1:], _label(path), model, path, None, model.name)
     if tables and is_file and suffix in TABLE_SUFFIXES:
         load = gonio.load_rgl if suffix == ".bsdf" else gonio.load_merl
         try:

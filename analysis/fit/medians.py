@@ -28,7 +28,7 @@ from brdf.models import DEFAULT_MODEL
 from gonio.statefields import MAX_MAGNITUDE, FileFields
 from gonio.terminal import shown
 
-__all__ = ["MedianFabric", "median_fabric", "FitModel"]
+__all__ = ["MedianFabric", "median_fabric", "fabric_at", "FitModel"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,6 +179,26 @@ def median_fabric(fit_dir, preset: str | None = None) -> MedianFabric:
                          f"({exc})") from None
     return MedianFabric(model, preset, values, cfg["free"], results.get("converged"),
                         fam.name)
+
+
+def fabric_at(med: "MedianFabric", fit_dir, values: dict):
+    """The fit's model at other parameter values (a posterior draw): ``values`` (natural
+    units) replace those of ``med`` (:func:`median_fabric` of ``fit_dir``); the model
+    (a :class:`brdf.Fabric`, or the baseline of a baseline fit) through the protocol's
+    ``with_values``.
+
+    Raises
+    ------
+    ValueError
+        Values that make no valid model.
+    """
+    merged = {**med.values, **{k: float(v) for k, v in values.items()}}
+    fam = family(med.model_name)
+    try:
+        return med.fabric.with_values({n: merged[n] for n in fam.model_names if n in merged})
+    except ValueError as exc:
+        raise ValueError(f"{Path(fit_dir)}: the values make no valid {fam.name} model "
+                         f"({exc})") from None
 
 
 def _values(folder: Path, cfg: dict, results: dict) -> dict:

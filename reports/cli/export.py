@@ -1,25 +1,25 @@
-"""The ``microcyl export`` verb: a fabric (a fit's posterior medians) as a Mitsuba plugin
-dictionary.
+"""The ``microcyl export`` verb: a fabric for a renderer, with the fidelity of the export.
 
-``microcyl export FABRIC -o fabric.json`` (or ``-o fabric.xml``)
+``microcyl export FABRIC --to openpbr|materialx|gltf|blender|mitsuba -o FILE``
 
-FABRIC is any fabric source (:func:`analysis.sources.resolve`); for a fit folder, its
-``results.json`` and ``fit_config.json`` (:func:`analysis.fit.medians.median_fabric`). Writes
-the ``microcylinder`` BSDF's dictionary (:func:`analysis.fabricfile.plugin_dict`: every
-thread parameter and option spelled out) as JSON, or as a Mitsuba XML ``<bsdf>`` element
-where FILE ends in ``.xml`` (:func:`analysis.fabricfile.plugin_xml`), atomically
-(:func:`analysis.fabricfile.write_fabric_file`); the suffix
-and folder are checked before anything is read. ``microcyl render SCENE FILE`` and every
-other FABRIC argument read either back. After ``reports.mitsuba.register()``,
-``mi.load_dict(json.load(open("fabric.json")))`` loads the first, and a scene file holding the
-second refers to it by ``<ref id="fabric"/>``. Needs no Mitsuba.
+FABRIC is any fabric source (:func:`analysis.sources.resolve`): a preset, a fit folder of any
+model, an exported file. ``--to`` picks the target (default: the one that writes FILE's
+suffix: .json/.xml Mitsuba's ``microcylinder`` dictionary or element, .mtlx OpenPBR,
+.gltf/.glb glTF, .py Blender). For every target but Mitsuba the target's sheen model is
+projected from the source over a stated grid, for a fit folder its medians and ``--draws``
+posterior draws; FILE.fidelity.json beside FILE says how closely the export follows the source
+and where it cannot, and the terminal shows the same
+(:func:`analysis.export.workflow.export_fabric`). The suffix and folder are checked before
+anything is read.
 """
 
 from __future__ import annotations
 
 import logging
 
-from analysis.fabricfile import SUFFIXES, write_fabric_file
+from analysis.export import TARGETS, HemisphereGrid, target_for, target_named
+from analysis.export.projection import OBJECTIVES
+from analysis.export.workflow import DEFAULT_DRAWS, export_fabric
 from analysis.fit.medians import median_fabric
 from gonio.terminal import shown
 from reports.cli import options as cliutil
@@ -32,33 +32,65 @@ log = logging.getLogger("microcyl")
 def register(sub):
     """Add ``export`` to the ``microcyl`` sub-parsers."""
     p = sub.add_parser(
-        "export", help="write a fit's median parameters as a Mitsuba 3 BSDF dictionary",
-        description="Write a fabric as the JSON dictionary (or XML element) of the Mitsuba 3 "
-                    "BSDF 'microcylinder' (reports.mitsuba.plugin): for a `microcyl fit` output "
-                    "folder its posterior medians (free parameters; fixed and tied ones as "
-                    "the fit held them).")
+        "export", help="write a fabric for a renderer (Mitsuba, OpenPBR, MaterialX, glTF, "
+                       "Blender) with the export's fidelity",
+        description="Write a fabric for a renderer: the Mitsuba 3 BSDF 'microcylinder' "
+                    "(JSON dictionary or XML element), or the renderer's sheen model projected "
+                    "from the fabric by least squares (OpenPBR fuzz and MaterialX sheen_bsdf "
+                    "as .mtlx, glTF KHR_materials_sheen as .gltf/.glb, a Blender Principled "
+                    "BSDF script as .py). FILE.fidelity.json beside FILE holds the fidelity "
+                    "of the export (relative L2 error, albedos, CIEDE2000 of a lit patch) and "
+                    "what the target cannot follow.")
     cliutil.add_fabric_argument(p)
     cliutil.add_fabric_options(p)
+    p.add_argument("--to", choices=list(TARGETS), default=None,
+                   help="target (default: the one that writes FILE's suffix; .mtlx: openpbr)")
     p.add_argument("-o", "--output", required=True, metavar="FILE",
-                   help="file to write: fabric.json (the dictionary for mi.load_dict) or "
-                        "fabric.xml (a <bsdf> element for Mitsuba scene files)")
+                   help="file to write: " + "; ".join(
+                       f"{t.name} {'/'.join(t.suffixes)}" for t in TARGETS.values()))
+    p.add_argument("--draws", type=int, default=DEFAULT_DRAWS, metavar="N",
+                   help="posterior draws of a fit folder to project (0: the medians only; "
+                        "default %(default)s)")
+    p.add_argument("--grid", default="9x12", metavar="THETAxPHI",
+                   help="directions per hemisphere of the projection and fidelity grid: "
+                        "polar x azimuth bins (default %(default)s)")
+    p.add_argument("--objective", choices=list(OBJECTIVES), default="cos_cos",
+                   help="what the projection fits: f_r cos(theta_i) cos(theta_o) (cos_cos, the "
+                        "quantity whose error is reported) or f_r cos(theta_o) (cos_o)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     p.set_defaults(func=run)
 
 
+def _grid(text: str) -> HemisphereGrid:
+    try:
+        nt, npf = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise ValueError(f"--grid {text!r}: expected THETAxPHI, two integers such as "
+                         f"9x12") from None
+    try:
+        return HemisphereGrid(nt, npf)
+    except ValueError as exc:
+        raise ValueError(f"--grid {text!r}: {exc}") from None
+
+
 def run(args) -> int:
-    """Check the output, resolve the fabric, write its plugin dictionary, print a summary."""
-    out = cliutil.check_output_suffix(args.output, SUFFIXES)
+    """Check the output and options, resolve the fabric, export it, print its fidelity."""
+    tgt = target_named(args.to) if args.to else target_for(args.output)
+    out = cliutil.check_output_suffix(args.output, tgt.suffixes)
+    grid = _grid(args.grid)
     src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
-    if not src.is_fabric:
-        raise ValueError(f"export writes the microcylinder plugin's fabric; {src.label} is "
-                         f"{src.what} (exporting baseline models is not supported yet)")
-    write_fabric_file(out, src.brdf, src.preset)
-    log.info("wrote %s", out)
+    res = export_fabric(src, tgt.name, out, grid=grid, draws=args.draws, seed=args.seed,
+                       objective=args.objective)
+    log.info("wrote %s and %s", res.path, res.fidelity_path)
     if src.kind == "fit":
         med = median_fabric(src.path)
         verdict = ("converged" if med.converged
                    else "NOT converged (medians of an unfinished fit)")
-        print(shown(f"{med.preset}: medians of {', '.join(med.free)} ({verdict}) -> {out}"))
+        print(shown(f"{med.preset or src.model}: medians of {', '.join(med.free)} "
+                    f"({verdict}) -> {out}"))
     else:
-        print(shown(f"{src.label} ({src.kind}) -> {out}"))
+        print(shown(f"{src.label} ({src.kind})"))
+    for line in res.lines():
+        print(shown(line))
+    print(shown(f"fidelity -> {res.fidelity_path}"))
     return 0

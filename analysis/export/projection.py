@@ -39,7 +39,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from analysis.export.grid import DEFAULT_GRID, HemisphereGrid
-from brdf.baselines import model_class
+from brdf import model_class
 
 __all__ = ["Projection", "project", "project_draws", "target_model", "TARGET_MODELS",
            "OBJECTIVES"]

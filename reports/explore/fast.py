@@ -66,9 +66,13 @@ def _pairs_key(wi: np.ndarray, wo: np.ndarray) -> bytes:
 
 def batch_kwargs(model_name: str, values: Mapping) -> dict:
     """The keyword arguments of ``prepare(...).eval`` from slider values (scalars or arrays
-    of a batch shape B...)."""
+    of a batch shape B...). The microcylinder's tangent scales are not among them: they
+    change the tangent curves, which the base fabric holds (``prepare`` is made of it)."""
     fam = family(model_name)
-    return fam.model_kwargs({k: np.asarray(values[k], float) for k in fam.model_names})
+    kw = fam.model_kwargs({k: np.asarray(values[k], float) for k in fam.model_names
+                           if k in values})
+    kw.pop("tangent_scale", None)
+    return kw
 
 
 class FastBRDF:

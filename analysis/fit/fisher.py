@@ -26,6 +26,13 @@ suggested free set is chosen forward: the candidates in order of their own infor
 taken when, freed together with those taken before (the others fixed), all of them stay
 informed and no two of them are confounded; so of a confounded pair (which the marginal sds
 show both not informed) one is kept.
+
+One rule overrides the information: on an RGB table whose mean (albedo) colour the start
+contradicts (CIEDE2000 above :data:`analysis.fit.trust.COLOUR_DE_MAX` between the table's
+colour and the start's, the start's scaled to the table's luminance so that only hue and
+chroma count), every candidate colour channel is suggested. The information at a start of
+the wrong colour is no guide there: a colour the data contradict, held fixed, pulls every
+other parameter to make up for it (:func:`start_colour_difference`).
 """
 
 from __future__ import annotations
@@ -36,15 +43,18 @@ import math
 import numpy as np
 
 import gonio
+from analysis.colour import luminance
 from analysis.families import family_of
 from analysis.fit.driver import with_nuisance
 from analysis.fit.posterior import LogPosterior, forward_model
+from analysis.fit.quality import albedo_colours, albedo_delta_e
+from analysis.fit.trust import COLOUR_DE_MAX
 from analysis.fit.workflow import fit_spec
 from analysis.likelihood import Likelihood, is_grey
 from analysis.params import ParamSpec
 
 __all__ = ["FisherReport", "fisher_information", "table_information", "suggest_free",
-           "suggest_for_file",
+           "suggest_for_file", "start_colour_difference",
            "candidate_spec", "PRIOR_SD", "INFORMED_RATIO", "CONFOUNDED"]
 
 #: Standard deviation of the flat prior in the internal (logit) coordinates: the standard
@@ -275,7 +285,8 @@ def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
     :func:`analysis.fit.fit_spec` takes them when given; otherwise for a model with a default
     free set of its own (``DEFAULT_FREE``: the microcylinder's) that set and its ties plus its
     colours for an RGB table (a grey table cannot tell the channels apart: the
-    microcylinder's two albedos), for any other model its default free set for the table
+    microcylinder's two albedos) and its ``rotation`` (degrees; where the table cannot tell
+    it, the Fisher test leaves it out), for any other model its default free set for the table
     (every parameter, with :meth:`analysis.families.ModelFamily.default_free`'s
     identifiability choices)."""
     fam = family_of(fabric)
@@ -287,6 +298,7 @@ def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
         ties = list(default_ties) if ties is None else ties
         if not is_grey(np.asarray(table.values, dtype=np.float64)):
             free += list(fam.schema.colours)
+        free += [n for n in ("rotation",) if n in fam.schema]
     return fit_spec(fabric, free, ties, toml)
 
 
@@ -302,9 +314,44 @@ def suggest_free(table, fabric, model, free=None, ties=None, toml=None, *,
     """
     spec = candidate_spec(table, fabric, free, ties, toml)
     report = table_information(table, spec, model, likelihood=likelihood, nu=nu)
+    colours = [n for names in spec.family.aliases.values() for n in names if n in spec.free]
+    if colours and start_colour_difference(table, spec, model) > COLOUR_DE_MAX:
+        keep = set(report.suggested) | set(colours)
+        report = dataclasses.replace(report, suggested=tuple(n for n in report.names
+                                                             if n in keep))
     kept = {t: (src if kind == "equal" else f"1-{src}")
             for t, (src, kind) in spec.ties.items() if src in report.suggested}
     return report, kept
+
+
+def start_colour_difference(table, spec: ParamSpec, model) -> float:
+    """CIEDE2000 (unitless) between ``table``'s mean albedo colour and that of ``spec``'s start
+    (:func:`analysis.fit.quality.albedo_colours`), the start's colour scaled to the table's
+    luminance (only hue and chroma count); 0 for a grey table.
+
+    Examples
+    --------
+    >>> import brdf
+    >>> from analysis.fit import FabricModel
+    >>> from analysis.params import defaults_from_fabric
+    >>> from gonio import measure, Instrument
+    >>> linen = brdf.fabric("linen_plain")
+    >>> warm = linen.with_values({f"albedo{j}_{c}": a for j in (1, 2)
+    ...                           for c, a in zip("rgb", (0.8, 0.45, 0.2))})
+    >>> t = measure(warm, "full:30:60", Instrument(snr=50), seed=1, progress=False)
+    >>> spec = ParamSpec("kd1", defaults=defaults_from_fabric(linen))
+    >>> start_colour_difference(t, spec, FabricModel(linen, t.wi, t.wo)) > 10
+    True
+    """
+    if is_grey(np.asarray(table.values, dtype=np.float64)):
+        return 0.0
+    values = spec.values(spec.start()[None])
+    pred = np.asarray(model(**spec.model_kwargs(values)))[0]
+    measured, predicted = albedo_colours(table, pred)
+    lum = float(luminance(predicted))
+    if not lum > 0:
+        return float("inf")
+    return float(albedo_delta_e(measured, predicted * float(luminance(measured)) / lum))
 
 
 def suggest_for_file(path, fabric, free=None, ties=None, toml=None, *, read_options=None,

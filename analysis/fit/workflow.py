@@ -16,6 +16,7 @@ from analysis.families import family_of
 from analysis.fit.posterior import forward_model
 from analysis.fit.quality import fit_quality
 from analysis.fit.results import FitResult, write_results
+from analysis.fit.trust import colour_warnings
 from analysis.folderlock import output_lock
 from analysis.likelihood import is_grey, is_relative
 from analysis.params import ParamSpec
@@ -106,7 +107,8 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     (pid N)``; a folder holding a report is refused), and temporaries a killed fit left in it
     are removed. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
-    colours and their CIEDE2000 difference), the PSIS-LOO (:func:`analysis.fit.loo.psis_loo`:
+    colours and their CIEDE2000 difference; a ``colour_fixed`` warning when it is large with a
+    colour held fixed, :func:`analysis.fit.trust.colour_warnings`), the PSIS-LOO (:func:`analysis.fit.loo.psis_loo`:
     ``loo`` in the results, its pointwise values in ``loo.npz``, the LOO-PIT test in
     ``quality["loo_pit"]``, a ``pareto_k`` warning when values have a high Pareto k), the
     plots drawn when ``plots`` is given, and ``results.json`` / ``results.csv`` written, once,
@@ -142,6 +144,7 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
         result = fit(table, spec, forward_model(fabric, table.wi, table.wo), out_dir=out,
                      **fit_kw)
         result.quality = fit_quality(result, table)
+        result.warnings = [*result.warnings, *colour_warnings(result)]
         t0 = time.perf_counter()
         result.loo = psis_loo(result, table_digest(table))
         result.timing["loo_s"] = time.perf_counter() - t0

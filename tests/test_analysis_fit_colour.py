@@ -40,10 +40,20 @@ def test_suggest_frees_the_albedo_the_table_contradicts(warm_table):
 @pytest.mark.slow
 def test_a_fit_holding_the_wrong_albedo_is_warned(warm_table, tmp_path):
     linen = brdf.fabric("linen_plain")
-    spec = fit_spec(linen, "kd1,kd2", table=warm_table)
+    spec = fit_spec(linen, "kd1,kd2", table=warm_table)        # albedo held fixed
     r = fit_fabric(warm_table, linen, spec, tmp_path, max_steps=60, n_starts=1, seed=1,
                    progress=False)
     assert r.quality["albedo_delta_e2000"] > 5
     kinds = {w["kind"]: w for w in r.warnings}
     assert set(kinds["colour_fixed"]["parameters"]) == set(ALBEDOS)
     assert "albedo1" in kinds["colour_fixed"]["message"]
+
+
+def test_the_default_free_set_frees_the_albedo_on_a_table_of_another_colour(warm_table):
+    linen = brdf.fabric("linen_plain")
+    spec = fit_spec(linen, table=warm_table)
+    assert set(ALBEDOS) <= set(spec.free)
+    assert any("CIEDE2000" in n and "albedo1, albedo2 freed" in n for n in spec.notes)
+    # linen's own colour: the default free set is the microcylinder's, albedo fixed
+    own = gonio.measure(linen, "full:30:60", gonio.Instrument(snr=50), seed=3, progress=False)
+    assert not set(ALBEDOS) & set(fit_spec(linen, table=own).free)

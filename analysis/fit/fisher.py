@@ -32,7 +32,8 @@ contradicts (CIEDE2000 above :data:`analysis.fit.trust.COLOUR_DE_MAX` between th
 colour and the start's, the start's scaled to the table's luminance so that only hue and
 chroma count), every candidate colour channel is suggested. The information at a start of
 the wrong colour is no guide there: a colour the data contradict, held fixed, pulls every
-other parameter to make up for it (:func:`start_colour_difference`).
+other parameter to make up for it
+(:func:`analysis.fit.quality.start_colour_difference`).
 """
 
 from __future__ import annotations
@@ -43,18 +44,17 @@ import math
 import numpy as np
 
 import gonio
-from analysis.colour import luminance
 from analysis.families import family_of
 from analysis.fit.driver import with_nuisance
 from analysis.fit.posterior import LogPosterior, forward_model
-from analysis.fit.quality import albedo_colours, albedo_delta_e
+from analysis.fit.quality import start_colour_difference
 from analysis.fit.trust import COLOUR_DE_MAX
 from analysis.fit.workflow import fit_spec
 from analysis.likelihood import Likelihood, is_grey
 from analysis.params import ParamSpec
 
 __all__ = ["FisherReport", "fisher_information", "table_information", "suggest_free",
-           "suggest_for_file", "start_colour_difference",
+           "suggest_for_file",
            "candidate_spec", "PRIOR_SD", "INFORMED_RATIO", "CONFOUNDED"]
 
 #: Standard deviation of the flat prior in the internal (logit) coordinates: the standard
@@ -322,36 +322,6 @@ def suggest_free(table, fabric, model, free=None, ties=None, toml=None, *,
     kept = {t: (src if kind == "equal" else f"1-{src}")
             for t, (src, kind) in spec.ties.items() if src in report.suggested}
     return report, kept
-
-
-def start_colour_difference(table, spec: ParamSpec, model) -> float:
-    """CIEDE2000 (unitless) between ``table``'s mean albedo colour and that of ``spec``'s start
-    (:func:`analysis.fit.quality.albedo_colours`), the start's colour scaled to the table's
-    luminance (only hue and chroma count); 0 for a grey table.
-
-    Examples
-    --------
-    >>> import brdf
-    >>> from analysis.fit import FabricModel
-    >>> from analysis.params import defaults_from_fabric
-    >>> from gonio import measure, Instrument
-    >>> linen = brdf.fabric("linen_plain")
-    >>> warm = linen.with_values({f"albedo{j}_{c}": a for j in (1, 2)
-    ...                           for c, a in zip("rgb", (0.8, 0.45, 0.2))})
-    >>> t = measure(warm, "full:30:60", Instrument(snr=50), seed=1, progress=False)
-    >>> spec = ParamSpec("kd1", defaults=defaults_from_fabric(linen))
-    >>> start_colour_difference(t, spec, FabricModel(linen, t.wi, t.wo)) > 10
-    True
-    """
-    if is_grey(np.asarray(table.values, dtype=np.float64)):
-        return 0.0
-    values = spec.values(spec.start()[None])
-    pred = np.asarray(model(**spec.model_kwargs(values)))[0]
-    measured, predicted = albedo_colours(table, pred)
-    lum = float(luminance(predicted))
-    if not lum > 0:
-        return float("inf")
-    return float(albedo_delta_e(measured, predicted * float(luminance(measured)) / lum))
 
 
 def suggest_for_file(path, fabric, free=None, ties=None, toml=None, *, read_options=None,

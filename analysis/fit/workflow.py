@@ -14,9 +14,9 @@ from analysis.fit.driver import FitOptions, fit
 from analysis.fit.loo import psis_loo
 from analysis.families import family_of
 from analysis.fit.posterior import forward_model
-from analysis.fit.quality import fit_quality
+from analysis.fit.quality import fit_quality, start_colour_difference
 from analysis.fit.results import FitResult, write_results
-from analysis.fit.trust import colour_warnings
+from analysis.fit.trust import COLOUR_DE_MAX, colour_warnings, fixed_colour_channels
 from analysis.folderlock import output_lock
 from analysis.likelihood import is_grey, is_relative
 from analysis.params import ParamSpec
@@ -37,7 +37,9 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
         file. Default the family's default free set
         (:meth:`analysis.families.ModelFamily.default_free`: the microcylinder's
         :data:`analysis.params.DEFAULT_FREE`; every parameter of a baseline, with the
-        identifiability choices for a grey or relative ``table``).
+        identifiability choices for a grey or relative ``table``); on an RGB ``table``
+        whose mean colour the start contradicts, every colour channel besides (a note in
+        the spec says so).
     ties : sequence of str, optional
         ``"a=b"`` / ``"a=1-b"`` ties (each item may hold several, comma-separated; ``"none"``
         is dropped). Default the family's default ties when neither ``free`` nor ``toml`` is
@@ -75,9 +77,33 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
         free, default_ties, notes = fam.default_free(grey=grey, relative=relative)
         if ties is None:
             ties = list(default_ties)
+        if table is not None and not grey and fam.cls.DEFAULT_FREE is not None:
+            return _with_table_colour(fabric, table, free, ties, notes, defaults)
     if toml is not None:
         return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties, family=fam)
     return ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes)
+
+
+def _with_table_colour(fabric, table, free, ties, notes, defaults) -> ParamSpec:
+    """The default spec on an RGB table of a model with a default free set of its own (the
+    microcylinder's; a baseline's frees its colours already), with every colour channel freed
+    when the start's
+    hue and chroma contradict the table's mean colour (CIEDE2000 above
+    :data:`analysis.fit.trust.COLOUR_DE_MAX`, :func:`analysis.fit.quality.start_colour_difference`):
+    a fixed colour the data contradict pulls every other parameter to make up for it."""
+    fam = family_of(fabric)
+    spec = ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes)
+    fixed = fixed_colour_channels(spec)
+    if not fixed:
+        return spec
+    de = start_colour_difference(table, spec, forward_model(fabric, table.wi, table.wo))
+    if not de > COLOUR_DE_MAX:
+        return spec
+    groups = [g for g, names in fam.aliases.items() if any(n in fixed for n in names)]
+    note = (f"RGB table whose mean colour the start contradicts (CIEDE2000 {de:.1f} in hue "
+            f"and chroma, above {COLOUR_DE_MAX:g}): {', '.join(groups)} freed")
+    return ParamSpec(list(free) + list(fixed), defaults=defaults, ties=ties or (), family=fam,
+                     notes=(*notes, note))
 
 
 def check_fit_size(path, spec: ParamSpec, walkers: int | None = None, **read_options) -> None:

@@ -39,12 +39,14 @@ Examples
 from __future__ import annotations
 
 import copy
+import dataclasses
 from typing import ClassVar, Mapping
 
 import numpy as np
 
 from brdf import schema
 from brdf.paramschema import ParamSchema
+from brdf.prepared import Prepared
 from brdf.presettable import DEFAULT_PRESET, PRESETS, check_preset, preset_threads
 from brdf.shading import shade_dtype
 
@@ -249,10 +251,15 @@ class FabricForward:
         out = np.empty((int(np.prod(batch)), self.wi.shape[0], 3))
         ts = ts.reshape(-1, 2)
         for b in range(ts.shape[0]):
-            threads = tuple(
-                th.replace(offsets=tuple(np.clip(np.asarray(th.offsets) * ts[b, j], -90, 90)))
-                for j, th in enumerate(self.fab.threads))
-            prep = self.fab.replace(threads=threads, rotation=float(np.radians(rot[b]))
-                                    ).prepare(self.wi, self.wo)
+            if np.all(ts[b] == 1.0):            # the plan's threads as they are: rotate it
+                plan = self.prep.plan
+                plan = dataclasses.replace(plan, options=dataclasses.replace(
+                    plan.options, rotation=float(np.radians(rot[b]))))
+                prep = Prepared(plan, self.wi, self.wo)
+            else:
+                threads = tuple(th.replace(offsets=_scaled_offsets(th.offsets, ts[b, j]))
+                                for j, th in enumerate(self.fab.threads))
+                prep = self.fab.replace(threads=threads, rotation=float(np.radians(rot[b]))
+                                        ).prepare(self.wi, self.wo)
             out[b] = prep.eval(dtype=self.dtype, **{k: v[b] for k, v in flat_kw.items()})
         return out.reshape(batch + out.shape[1:])

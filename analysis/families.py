@@ -18,8 +18,13 @@ informed, so ``X_g`` and ``X_b`` are tied to ``X_r`` for each colour X. On a rel
 free ``scale``) the overall level of f_r is the scale's: a model's f_r is linear in its colours
 taken together (exactly for Lambert, nearly for the sheen models), so scale and colours would
 make a ridge of equal likelihood. The base colour (``BASE_PARAM``, else the first colour) is
-then fixed at its start value (its red channel on an RGB table, all three on a grey one) and
-the scale free: the other colours are fitted relative to the base. Each choice is recorded
+then fixed (its red channel on an RGB table, all three on a grey one) at :data:`RELATIVE_BASE`
+(:meth:`ModelFamily.fixed_values`) and the scale free: the other colours are fitted relative
+to the base. A colour bounded by 1 (a sheen) then spans ratios to the base of 0 to
+1/:data:`RELATIVE_BASE` = 20: the base's start value, 0.5, boxed the ratio in at 2, where
+the sheen of CUReT's velvet sat at its bound (the ``zeltner`` fit's elpd rose from 474 to
+518 with the base at 0.1, the sheen then 0.33; freeing the base as well gives the same elpd,
+517, with the sheen not informed and correlated with base and scale: the ridge). Each choice is recorded
 (:meth:`ModelFamily.default_free`'s notes, ``results.json``'s ``identifiability``).
 
 Examples
@@ -43,7 +48,11 @@ import numpy as np
 from analysis import paramnames
 from brdf.models import DEFAULT_MODEL, MODELS, model_class, model_name
 
-__all__ = ["ModelFamily", "MICROCYLINDER", "family", "family_of", "model_names"]
+__all__ = ["ModelFamily", "MICROCYLINDER", "RELATIVE_BASE", "family", "family_of",
+           "model_names"]
+
+#: The value the base colour is fixed at on a relative table (see the module notes).
+RELATIVE_BASE = 0.05
 
 #: The default model's name (``microcyl fit --model``'s default): the registry's.
 MICROCYLINDER = DEFAULT_MODEL
@@ -150,7 +159,7 @@ class ModelFamily:
         if base is not None:
             fixed = list(self.aliases[base]) if grey else [f"{base}_r"]
             free = [n for n in free if n not in fixed]
-            notes.append(f"relative table: {', '.join(fixed)} fixed at the start value and "
+            notes.append(f"relative table: {', '.join(fixed)} fixed at {RELATIVE_BASE:g} and "
                          f"scale free (f_r is linear in the colours together, so scale and "
                          f"colours would form a ridge; any other colour is fitted relative "
                          f"to {base})")
@@ -165,6 +174,24 @@ class ModelFamily:
         if relative:
             free.append("scale")
         return tuple(free), tuple(ties), tuple(notes)
+
+    def fixed_values(self, relative: bool = False) -> dict[str, float]:
+        """The values :meth:`default_free` fixes beyond the start's: on a relative table the
+        base colour's channels at :data:`RELATIVE_BASE` (so that a colour bounded by 1 spans
+        ratios to it of 0 to 20; on an RGB table its red channel fixed there and the other
+        two starting there); none otherwise, or for a model with a default free set of its
+        own.
+
+        Examples
+        --------
+        >>> family("zeltner").fixed_values(relative=True)
+        {'base_r': 0.05, 'base_g': 0.05, 'base_b': 0.05}
+        >>> family("zeltner").fixed_values(), family("microcylinder").fixed_values(relative=True)
+        ({}, {})
+        """
+        if self.cls.DEFAULT_FREE is not None or not relative or self.base_param is None:
+            return {}
+        return {n: RELATIVE_BASE for n in self.aliases[self.base_param]}
 
     def __repr__(self) -> str:
         return f"ModelFamily({self.name!r})"

@@ -17,14 +17,15 @@ same value in R, G and B everywhere: CUReT) the channels of a colour are not sep
 informed, so ``X_g`` and ``X_b`` are tied to ``X_r`` for each colour X. On a relative table (a
 free ``scale``) the overall level of f_r is the scale's: a model's f_r is linear in its colours
 taken together (exactly for Lambert, nearly for the sheen models), so scale and colours would
-make a ridge of equal likelihood. The base colour (``BASE_PARAM``, else the first colour) is
-then fixed (its red channel on an RGB table, all three on a grey one) at :data:`RELATIVE_BASE`
-(:meth:`ModelFamily.fixed_values`) and the scale free: the other colours are fitted relative
-to the base. A colour bounded by 1 (a sheen) then spans ratios to the base of 0 to
-1/:data:`RELATIVE_BASE` = 20: the base's start value, 0.5, boxed the ratio in at 2, where
-the sheen of CUReT's velvet sat at its bound (the ``zeltner`` fit's elpd rose from 474 to
-518 with the base at 0.1, the sheen then 0.33; freeing the base as well gives the same elpd,
-517, with the sheen not informed and correlated with base and scale: the ridge). Each choice is recorded
+make a ridge of equal likelihood. The scale is free, and the base colour (``BASE_PARAM``,
+else the first colour) is tied to the model's next colour (a sheen) as a mix: ``base = 1 -
+sheen`` (all three channels to ``sheen_r`` on a grey table, its red channel alone on an RGB
+one), so that the sheen is the share w of the two and the ratio sheen/base = w/(1 - w) spans
+0 to infinity with both colours inside [0, 1]. The bound w = 0 or 1 is then a pure base or a
+pure sheen, not a box: fixing the base at its start 0.5 instead boxed the ratio in at 2, where
+the sheen of CUReT's velvet sat at its bound (``zeltner``, elpd 474; 517 with the mix), and any
+fixed base boxes a model whose data want no base at all (``ashikhmin`` there). A model with one
+colour (Lambert) has its base fixed at its start value instead. Each choice is recorded
 (:meth:`ModelFamily.default_free`'s notes, ``results.json``'s ``identifiability``).
 
 Examples
@@ -35,6 +36,9 @@ Examples
 >>> free, ties, notes = lam.default_free(grey=True, relative=True)
 >>> free, ties
 (('scale',), ())
+>>> free, ties, notes = family("zeltner").default_free(grey=True, relative=True)
+>>> free, ties[:3]
+(('sheen_r', 'roughness', 'scale'), ('base_r=1-sheen_r', 'base_g=1-sheen_r', 'base_b=1-sheen_r'))
 >>> family("microcylinder").default_free()[0][:2]
 ('eta1', 'kd1')
 """
@@ -48,11 +52,7 @@ import numpy as np
 from analysis import paramnames
 from brdf.models import DEFAULT_MODEL, MODELS, model_class, model_name
 
-__all__ = ["ModelFamily", "MICROCYLINDER", "RELATIVE_BASE", "family", "family_of",
-           "model_names"]
-
-#: The value the base colour is fixed at on a relative table (see the module notes).
-RELATIVE_BASE = 0.05
+__all__ = ["ModelFamily", "MICROCYLINDER", "family", "family_of", "model_names"]
 
 #: The default model's name (``microcyl fit --model``'s default): the registry's.
 MICROCYLINDER = DEFAULT_MODEL
@@ -156,13 +156,20 @@ class ModelFamily:
         free = list(self.model_names)
         ties, notes = [], []
         base = self.base_param if relative else None
+        mix = next((q for q in self.schema.colours if q != base), None)
         if base is not None:
             fixed = list(self.aliases[base]) if grey else [f"{base}_r"]
             free = [n for n in free if n not in fixed]
-            notes.append(f"relative table: {', '.join(fixed)} fixed at {RELATIVE_BASE:g} and "
-                         f"scale free (f_r is linear in the colours together, so scale and "
-                         f"colours would form a ridge; any other colour is fitted relative "
-                         f"to {base})")
+            why = ("f_r is linear in the colours together, so scale and colours would form a "
+                   "ridge")
+            if mix is None:
+                notes.append(f"relative table: {', '.join(fixed)} fixed at the start value "
+                             f"and scale free ({why})")
+            else:
+                ties += [f"{n}=1-{mix}_r" for n in fixed]
+                notes.append(f"relative table: {', '.join(fixed)} = 1 - {mix}_r and scale "
+                             f"free ({why}; {mix}_r is the share of {mix} in {mix} + {base}, "
+                             f"so their ratio is unbounded)")
         tied = [q for q in self.schema.colours if not (grey and q == base)] if grey else []
         for q in tied:
             ties += [f"{q}_g={q}_r", f"{q}_b={q}_r"]
@@ -174,24 +181,6 @@ class ModelFamily:
         if relative:
             free.append("scale")
         return tuple(free), tuple(ties), tuple(notes)
-
-    def fixed_values(self, relative: bool = False) -> dict[str, float]:
-        """The values :meth:`default_free` fixes beyond the start's: on a relative table the
-        base colour's channels at :data:`RELATIVE_BASE` (so that a colour bounded by 1 spans
-        ratios to it of 0 to 20; on an RGB table its red channel fixed there and the other
-        two starting there); none otherwise, or for a model with a default free set of its
-        own.
-
-        Examples
-        --------
-        >>> family("zeltner").fixed_values(relative=True)
-        {'base_r': 0.05, 'base_g': 0.05, 'base_b': 0.05}
-        >>> family("zeltner").fixed_values(), family("microcylinder").fixed_values(relative=True)
-        ({}, {})
-        """
-        if self.cls.DEFAULT_FREE is not None or not relative or self.base_param is None:
-            return {}
-        return {n: RELATIVE_BASE for n in self.aliases[self.base_param]}
 
     def __repr__(self) -> str:
         return f"ModelFamily({self.name!r})"

@@ -75,7 +75,6 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
         grey = table is not None and is_grey(table.values)
         relative = table is not None and is_relative(getattr(table, "meta", {}))
         free, default_ties, notes = fam.default_free(grey=grey, relative=relative)
-        defaults = {**defaults, **fam.fixed_values(relative=relative)}
         if ties is None:
             ties = list(default_ties)
         if table is not None and not grey and fam.cls.DEFAULT_FREE is not None:

@@ -12,9 +12,12 @@ of :data:`brdf.schema.THREAD_PARAMS`, then the RGB one per channel), then
 degrees (the fabric option :attr:`brdf.FabricOptions.rotation` is in radians; the fit's
 parameter, its results and the command line are in degrees: warp along (cos rho, sin rho, 0),
 counter-clockwise from +x toward +y). Its search range and prior are uniform on [-90, 90]
-degrees: a fabric whose tangent curves are symmetric (offsets and weights unchanged by
-negation, every preset's) is unchanged by a half turn, so [-90, 90] holds every orientation;
-rotating by 90 degrees swaps the roles of the two threads. Search ranges, units and priors are the schema's (log-uniform where its
+degrees: a fabric whose tangent curves are symmetric (unchanged by negating and reversing
+the offsets: four presets' threads; not velvet's pile nor the satin back's first thread) is
+unchanged by a half turn, so [-90, 90] holds every orientation of it; rotating by 90 degrees
+swaps the roles of the two threads. Any finite angle is valid (a ``--spec`` file's
+``[bounds]`` may widen the range to [-180, 180] for an asymmetric fabric). Search ranges, units and priors
+are the schema's (log-uniform where its
 range spans decades); a thread parameter's plausible range is its row's (its typical range
 where the row gives none).
 
@@ -60,7 +63,7 @@ TANGENT_SCALE = schema.ParamInfo(
 
 #: The fit's rotation of both threads about n, degrees (the option ``rotation`` in radians).
 ROTATION = schema.ParamInfo(
-    "rotation", "scalar", "deg", -90.0, 90.0, "ρ", "rotation of both threads about the normal "
+    "rotation", "scalar", "deg", None, None, "ρ", "rotation of both threads about the normal "
     "n (warp along (cos ρ, sin ρ, 0))", typical=(-90.0, 90.0), typical_value=0.0,
     note="a half turn leaves a fabric with symmetric tangent curves unchanged")
 

@@ -3,7 +3,8 @@ of the table against the fit's (CIEDE2000, colour-science; :func:`albedo_colours
 :func:`albedo_delta_e` live in :mod:`analysis.colour` and are re-exported here). A grey table
 (the same value in R, G and B at every point: CUReT, a one-column CSV) has no colour: its
 colour difference is None, with the reason. :func:`start_colour_difference` measures the same
-difference before a fit, at its start, in hue and chroma alone. Whether the model describes the data at all is
+difference before a fit, at its start, in hue and chroma alone. Whether the model describes
+the data at all is
 :mod:`analysis.fit.adequacy`.
 """
 

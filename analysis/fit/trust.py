@@ -39,7 +39,8 @@ from analysis.families import family
 from analysis.params import INTERNAL_LIMIT
 
 __all__ = ["warning", "fit_warnings", "assess", "CHECKS", "prior_sd", "flat_values",
-           "colour_warnings", "fixed_colour_channels", "COLOUR_DE_MAX", "BOUND_ZONE", "SD_RATIO", "CORR_MAX", "PRIOR_DRAWS"]
+           "colour_warnings", "fixed_colour_channels", "COLOUR_DE_MAX", "BOUND_ZONE",
+           "SD_RATIO", "CORR_MAX", "PRIOR_DRAWS"]
 
 #: colour_fixed: the CIEDE2000 difference of mean colours above which a fit with a colour
 #: held fixed is warned (about 1 is just noticeable; 5 is plainly another colour).

@@ -134,7 +134,8 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     are removed. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
     colours and their CIEDE2000 difference; a ``colour_fixed`` warning when it is large with a
-    colour held fixed, :func:`analysis.fit.trust.colour_warnings`), the PSIS-LOO (:func:`analysis.fit.loo.psis_loo`:
+    colour held fixed, :func:`analysis.fit.trust.colour_warnings`), the PSIS-LOO
+    (:func:`analysis.fit.loo.psis_loo`:
     ``loo`` in the results, its pointwise values in ``loo.npz``, the LOO-PIT test in
     ``quality["loo_pit"]``, a ``pareto_k`` warning when values have a high Pareto k), the
     plots drawn when ``plots`` is given, and ``results.json`` / ``results.csv`` written, once,

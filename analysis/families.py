@@ -17,9 +17,15 @@ same value in R, G and B everywhere: CUReT) the channels of a colour are not sep
 informed, so ``X_g`` and ``X_b`` are tied to ``X_r`` for each colour X. On a relative table (a
 free ``scale``) the overall level of f_r is the scale's: a model's f_r is linear in its colours
 taken together (exactly for Lambert, nearly for the sheen models), so scale and colours would
-make a ridge of equal likelihood. The base colour (``BASE_PARAM``, else the first colour) is
-then fixed at its start value (its red channel on an RGB table, all three on a grey one) and
-the scale free: the other colours are fitted relative to the base. Each choice is recorded
+make a ridge of equal likelihood. The scale is free, and the base colour (``BASE_PARAM``,
+else the first colour) is tied to the model's next colour (a sheen) as a mix: ``base = 1 -
+sheen`` (all three channels to ``sheen_r`` on a grey table, its red channel alone on an RGB
+one), so that the sheen is the share w of the two and the ratio sheen/base = w/(1 - w) spans
+0 to infinity with both colours inside [0, 1]. The bound w = 0 or 1 is then a pure base or a
+pure sheen, not a box: fixing the base at its start 0.5 instead boxed the ratio in at 2, where
+the sheen of CUReT's velvet sat at its bound (``zeltner``, elpd 474; 517 with the mix), and any
+fixed base boxes a model whose data want no base at all (``ashikhmin`` there). A model with one
+colour (Lambert) has its base fixed at its start value instead. Each choice is recorded
 (:meth:`ModelFamily.default_free`'s notes, ``results.json``'s ``identifiability``).
 
 Examples
@@ -30,6 +36,9 @@ Examples
 >>> free, ties, notes = lam.default_free(grey=True, relative=True)
 >>> free, ties
 (('scale',), ())
+>>> free, ties, notes = family("zeltner").default_free(grey=True, relative=True)
+>>> free, ties[:3]
+(('sheen_r', 'roughness', 'scale'), ('base_r=1-sheen_r', 'base_g=1-sheen_r', 'base_b=1-sheen_r'))
 >>> family("microcylinder").default_free()[0][:2]
 ('eta1', 'kd1')
 """
@@ -147,13 +156,20 @@ class ModelFamily:
         free = list(self.model_names)
         ties, notes = [], []
         base = self.base_param if relative else None
+        mix = next((q for q in self.schema.colours if q != base), None)
         if base is not None:
             fixed = list(self.aliases[base]) if grey else [f"{base}_r"]
             free = [n for n in free if n not in fixed]
-            notes.append(f"relative table: {', '.join(fixed)} fixed at the start value and "
-                         f"scale free (f_r is linear in the colours together, so scale and "
-                         f"colours would form a ridge; any other colour is fitted relative "
-                         f"to {base})")
+            why = ("f_r is linear in the colours together, so scale and colours would form a "
+                   "ridge")
+            if mix is None:
+                notes.append(f"relative table: {', '.join(fixed)} fixed at the start value "
+                             f"and scale free ({why})")
+            else:
+                ties += [f"{n}=1-{mix}_r" for n in fixed]
+                notes.append(f"relative table: {', '.join(fixed)} = 1 - {mix}_r and scale "
+                             f"free ({why}; {mix}_r is the share of {mix} in {mix} + {base}, "
+                             f"so their ratio is unbounded)")
         tied = [q for q in self.schema.colours if not (grey and q == base)] if grey else []
         for q in tied:
             ties += [f"{q}_g={q}_r", f"{q}_b={q}_r"]

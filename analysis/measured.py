@@ -110,7 +110,7 @@ def _rgl(colour: str) -> MeasuredDataset:
 def _curet(sample: int, what: str, preset: str) -> MeasuredDataset:
     return MeasuredDataset(
         f"curet_{sample:02d}_{what}", f"CUReT sample {sample}, {what} (Dana et al. 1999)",
-        "curet", "curet/abrdf.dat", sample, preset, _SHARED_FREE, _SHARED_TIES)
+        "curet", "curet/abrdf.dat", sample, preset, _SHARED_FREE + ("rotation",), _SHARED_TIES)
 
 
 #: The measured datasets by name.
@@ -202,7 +202,7 @@ def measured_spec(name, fab=None):
     --------
     >>> spec, fab = measured_spec("curet_07_velvet")
     >>> spec.free, fab.name
-    (('eta1', 'kd1', 'gamma_s1', 'gamma_v1', 'area1'), 'velvet')
+    (('eta1', 'kd1', 'gamma_s1', 'gamma_v1', 'area1', 'rotation'), 'velvet')
     """
     d = _dataset(name)
     fab = fab if fab is not None else preset_fabric(d.preset)

@@ -8,7 +8,16 @@ Parameters are named by quantity and thread: ``eta1``, ``kd1``, ``gamma_s1``, ``
 ``area1``, ``albedo1_r``, ``albedo1_g``, ``albedo1_b``, the same with ``2`` (the scalar rows
 of :data:`brdf.schema.THREAD_PARAMS`, then the RGB one per channel), then
 ``tangent_scale1``/``tangent_scale2``, a factor on each thread's tangent offsets (clipped to
-[-90, 90] degrees). Search ranges, units and priors are the schema's (log-uniform where its
+[-90, 90] degrees), then ``rotation``, the rotation of both threads about the normal n in
+degrees (the fabric option :attr:`brdf.FabricOptions.rotation` is in radians; the fit's
+parameter, its results and the command line are in degrees: warp along (cos rho, sin rho, 0),
+counter-clockwise from +x toward +y). Its search range and prior are uniform on [-90, 90]
+degrees: a fabric whose tangent curves are symmetric (unchanged by negating and reversing
+the offsets: four presets' threads; not velvet's pile nor the satin back's first thread) is
+unchanged by a half turn, so [-90, 90] holds every orientation of it; rotating by 90 degrees
+swaps the roles of the two threads. Any finite angle is valid (a ``--spec`` file's
+``[bounds]`` may widen the range to [-180, 180] for an asymmetric fabric). Search ranges, units and priors
+are the schema's (log-uniform where its
 range spans decades); a thread parameter's plausible range is its row's (its typical range
 where the row gives none).
 
@@ -18,12 +27,14 @@ takes the gap term from one direction (``gap``).
 Examples
 --------
 >>> import brdf
->>> MODEL_PARAM_NAMES[:5], SCHEMA.names[-2:]
-(('eta1', 'kd1', 'gamma_s1', 'gamma_v1', 'area1'), ('tangent_scale1', 'tangent_scale2'))
+>>> MODEL_PARAM_NAMES[:5], SCHEMA.names[-3:]
+(('eta1', 'kd1', 'gamma_s1', 'gamma_v1', 'area1'), ('tangent_scale1', 'tangent_scale2', 'rotation'))
 >>> fab = brdf.fabric("velvet")
 >>> v = fab.values()
->>> v["gamma_s2"], v["tangent_scale1"]
-(6.0, 1.0)
+>>> v["gamma_s2"], v["tangent_scale1"], v["rotation"]
+(6.0, 1.0, 0.0)
+>>> round(fab.with_values({"rotation": 30.0}).options["rotation"], 6)    # radians inside
+0.523599
 >>> fab.with_values({"gamma_s2": 9.0, "tangent_scale2": 0.5}).threads[1].offsets
 (-45.0, -27.5, 27.5, 45.0)
 """
@@ -31,22 +42,30 @@ Examples
 from __future__ import annotations
 
 import copy
+import dataclasses
 from typing import ClassVar, Mapping
 
 import numpy as np
 
 from brdf import schema
 from brdf.paramschema import ParamSchema
+from brdf.prepared import Prepared
 from brdf.presettable import DEFAULT_PRESET, PRESETS, check_preset, preset_threads
 from brdf.shading import shade_dtype
 
 __all__ = ["MicrocylinderModel", "FabricForward", "SCHEMA", "MODEL_PARAM_NAMES", "ALIASES",
-           "DEFAULT_FREE", "DEFAULT_TIES", "TANGENT_SCALE", "thread_values"]
+           "DEFAULT_FREE", "DEFAULT_TIES", "TANGENT_SCALE", "ROTATION", "thread_values"]
 
 #: The fit's factor on a thread's tangent offsets (not a parameter of the paper).
 TANGENT_SCALE = schema.ParamInfo(
     "tangent_scale", "scalar", "1", 0.0, None, "s_t", "factor on the thread's tangent offsets "
     "(clipped to [-90, 90] degrees)", lo_open=True, typical=(0.25, 2.0), typical_value=1.0)
+
+#: The fit's rotation of both threads about n, degrees (the option ``rotation`` in radians).
+ROTATION = schema.ParamInfo(
+    "rotation", "scalar", "deg", None, None, "ρ", "rotation of both threads about the normal "
+    "n (warp along (cos ρ, sin ρ, 0))", typical=(-90.0, 90.0), typical_value=0.0,
+    note="a half turn leaves a fabric with symmetric tangent curves unchanged")
 
 _RGB = tuple(p.name for p in schema.THREAD_PARAMS if p.kind == "rgb")
 _ROWS = tuple(schema.THREAD[n] for n in schema.SCALAR_PARAMS + _RGB)
@@ -55,9 +74,9 @@ _THREADS = (1, 2)
 #: The parameters the shading takes (both threads).
 _SHADING = ParamSchema.from_rows(_ROWS, "1", plausible_fallback=True) \
     + ParamSchema.from_rows(_ROWS, "2", plausible_fallback=True)
-#: Every parameter of the model: the shading's, then the tangent scales.
+#: Every parameter of the model: the shading's, then the tangent scales and the rotation.
 SCHEMA = _SHADING + ParamSchema.from_rows([TANGENT_SCALE], "1") \
-    + ParamSchema.from_rows([TANGENT_SCALE], "2")
+    + ParamSchema.from_rows([TANGENT_SCALE], "2") + ParamSchema.from_rows([ROTATION])
 #: Names of the shading parameters, both threads (``Prepared.eval``'s, per thread).
 MODEL_PARAM_NAMES: tuple[str, ...] = _SHADING.names
 #: Group aliases: ``albedo1`` is its three channels.
@@ -128,12 +147,15 @@ class MicrocylinderModel:
         return cls(preset_threads(name), name=name, **dict(options or {}))
 
     def values(self) -> dict[str, float]:
-        """Every parameter by name: the threads' (:func:`thread_values`), tangent scales 1."""
-        return {**thread_values(self), "tangent_scale1": 1.0, "tangent_scale2": 1.0}
+        """Every parameter by name: the threads' (:func:`thread_values`), tangent scales 1,
+        the rotation in degrees."""
+        return {**thread_values(self), "tangent_scale1": 1.0, "tangent_scale2": 1.0,
+                "rotation": float(np.degrees(self.options["rotation"]))}
 
     def with_values(self, values: Mapping[str, float]):
         """This fabric with some parameters changed (names of :data:`SCHEMA`; a colour's
-        channels not given keep their values; a tangent scale multiplies the offsets).
+        channels not given keep their values; a tangent scale multiplies the offsets; the
+        rotation, degrees, replaces the option ``rotation``).
 
         Raises
         ------
@@ -161,13 +183,17 @@ class MicrocylinderModel:
                 threads.append(t.replace(**change))
             except ValueError as exc:
                 raise ValueError(f"thread {j}: {exc}") from None
+        if "rotation" in values:
+            return self.replace(threads=threads,
+                                rotation=float(np.radians(float(values["rotation"]))))
         return self.replace(threads=threads)
 
     @classmethod
     def batch_kwargs(cls, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """:meth:`brdf.Prepared.eval`'s keyword arguments from every shading parameter's
         values (B...): each scalar quantity (B..., 2), each RGB one (B..., 2, 3), both
-        threads; ``tangent_scale`` (B..., 2) when both tangent scales are given."""
+        threads; ``tangent_scale`` (B..., 2) when both tangent scales are given; ``rotation``
+        (B...) in degrees when given."""
         kw = {}
         for q in schema.SCALAR_PARAMS:
             kw[q] = np.stack([values[f"{q}{j}"] for j in _THREADS], axis=-1)
@@ -176,6 +202,8 @@ class MicrocylinderModel:
                                        axis=-1) for j in _THREADS], axis=-2)
         if all(f"tangent_scale{j}" in values for j in _THREADS):
             kw["tangent_scale"] = np.stack([values[f"tangent_scale{j}"] for j in _THREADS], -1)
+        if "rotation" in values:
+            kw["rotation"] = np.asarray(values["rotation"], dtype=np.float64)
         return kw
 
     def forward(self, wi, wo) -> "FabricForward":
@@ -209,20 +237,32 @@ class FabricForward:
         other.dtype = shade_dtype(dtype)
         return other
 
-    def __call__(self, tangent_scale=None, **kw) -> np.ndarray:
+    def __call__(self, tangent_scale=None, rotation=None, **kw) -> np.ndarray:
         kw["dtype"] = self.dtype
-        if tangent_scale is None or np.all(np.asarray(tangent_scale) == 1.0):
+        rot0 = float(np.degrees(self.fab.options["rotation"]))
+        same_ts = tangent_scale is None or np.all(np.asarray(tangent_scale) == 1.0)
+        same_rot = rotation is None or np.all(np.asarray(rotation) == rot0)
+        if same_ts and same_rot:
             return self.prep.eval(**kw)
-        ts = np.asarray(tangent_scale, dtype=np.float64)
+        ts = (np.ones(np.shape(rotation) + (2,)) if tangent_scale is None
+              else np.asarray(tangent_scale, dtype=np.float64))
         batch = ts.shape[:-1]
+        rot = np.broadcast_to(rot0 if rotation is None else
+                              np.asarray(rotation, dtype=np.float64), batch).reshape(-1)
         flat_kw = {k: np.asarray(v).reshape((-1,) + np.shape(v)[len(batch):])
                    for k, v in kw.items() if k != "dtype"}
         out = np.empty((int(np.prod(batch)), self.wi.shape[0], 3))
         ts = ts.reshape(-1, 2)
         for b in range(ts.shape[0]):
-            threads = tuple(
-                th.replace(offsets=tuple(np.clip(np.asarray(th.offsets) * ts[b, j], -90, 90)))
-                for j, th in enumerate(self.fab.threads))
-            prep = self.fab.replace(threads=threads).prepare(self.wi, self.wo)
+            if np.all(ts[b] == 1.0):            # the plan's threads as they are: rotate it
+                plan = self.prep.plan
+                plan = dataclasses.replace(plan, options=dataclasses.replace(
+                    plan.options, rotation=float(np.radians(rot[b]))))
+                prep = Prepared(plan, self.wi, self.wo)
+            else:
+                threads = tuple(th.replace(offsets=_scaled_offsets(th.offsets, ts[b, j]))
+                                for j, th in enumerate(self.fab.threads))
+                prep = self.fab.replace(threads=threads, rotation=float(np.radians(rot[b]))
+                                        ).prepare(self.wi, self.wo)
             out[b] = prep.eval(dtype=self.dtype, **{k: v[b] for k, v in flat_kw.items()})
         return out.reshape(batch + out.shape[1:])

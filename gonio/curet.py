@@ -59,6 +59,23 @@ def read_curet(folder, sample: int) -> Table:
         of R, G, B) repeated to 3 channels. CUReT values are **relative** reflectance, not
         f_r in 1/sr: ``meta["units"] = "relative"``; fit with a free scale.
 
+    Notes
+    -----
+    The angles: CUReT's BRDF page (https://www.cs.columbia.edu/CAVE/software/curet/html/
+    brdfm.html) and Dana et al. 1999 (ACM TOG 18(1), "Reflectance and texture of real-world
+    surfaces") give one table of (viewing, illumination) directions for the 205
+    measurements, polar angle from the sample's normal and azimuth about it, both in the
+    sample's frame; ``table.txt`` holds them in the order index, theta_v, phi_v, theta_i,
+    phi_i, radians. They are read as this project's angles (theta from n = +z, phi from +x
+    toward +y) unchanged. The data agree: on the shiny polyester (sample 2) the largest value
+    lies at an exact mirror pair (theta_v = theta_i = 79 degrees, phi_v = phi_i + 180) and the
+    next three within 15 degrees of the mirror direction, as they must when both azimuths
+    are measured in one frame and one sense.
+    What the files do not give is where the sample's warp points in that frame, nor
+    whether phi turns counter-clockwise seen from above: a fit frees the fabric's
+    ``rotation`` for that (a turned frame moves the fitted rotation by the turn; a mirrored
+    one changes its sign; neither changes how well the model fits).
+
     Raises
     ------
     ValueError

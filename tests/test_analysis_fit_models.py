@@ -58,12 +58,16 @@ def test_default_free_sets_are_identifiable_on_grey_and_relative_tables(name):
     assert set(ties) == {f"{q}_{c}={q}_r" for q in rgb for c in "gb"}
     assert set(free) == set(fam.model_names) - {f"{q}_{c}" for q in rgb for c in "gb"}
     assert "grey table" in notes[0]
-    # relative: the base colour is fixed (the scale carries the level); grey: and tied
+    # relative: the scale carries the level; the base is fixed (Lambert) or 1 - the sheen's
+    # share (a sheen model); grey: all three channels, RGB: the red one
     free, ties, notes = fam.default_free(grey=True, relative=True)
     assert "scale" in free and not any(n.startswith("base_") for n in free)
-    assert not any(t.startswith("base_") for t in ties)
-    free, _, _ = fam.default_free(relative=True)
+    mixed = {f"base_{c}=1-sheen_r" for c in "rgb"} if "sheen" in rgb else set()
+    assert {t for t in ties if t.startswith("base_")} == mixed
+    free, ties, _ = fam.default_free(relative=True)
     assert "base_r" not in free and {"base_g", "base_b", "scale"} <= set(free)
+    assert {t for t in ties if t.startswith("base_")} == ({"base_r=1-sheen_r"} if mixed
+                                                          else set())
     # every choice leaves a valid spec, whose values follow the ties
     for grey in (False, True):
         for relative in (False, True):
@@ -73,6 +77,8 @@ def test_default_free_sets_are_identifiable_on_grey_and_relative_tables(name):
             if grey:
                 for q in rgb:
                     assert v[f"{q}_g"] == v[f"{q}_b"] == v[f"{q}_r"]
+            if relative and mixed:
+                assert v["base_r"] == pytest.approx(1.0 - v["sheen_r"])
 
 
 def _table(brdf_obj, n=120, seed=0, rel=0.05, meta=None, grey=False):
@@ -128,6 +134,25 @@ def test_the_posterior_is_proper_on_a_grey_relative_lambert_table():
     med = r.summary["scale"]["median"]
     assert med == pytest.approx(2.0, rel=0.03)
     assert r.summary["scale"]["hi95"] / r.summary["scale"]["lo95"] < 1.1
+
+
+def test_a_sheen_five_times_its_base_is_not_boxed_in_on_a_relative_table():
+    """Ashikhmin's plain sum: scale (sheen L + base / pi) is linear, so a relative table
+    tells the ratio sheen / base alone. Truth 0.75 / 0.15 = 5, beyond the ratio 2 that a base
+    fixed at 0.5 allowed: with base = 1 - sheen the sheen is the share 0.75 / 0.9 = 0.833
+    and the scale the sum 0.9, neither at a bound."""
+    truth = MODELS["ashikhmin"](base=0.15, sheen=0.75, roughness=0.5)
+    t = _table(truth, n=150, grey=True, meta={"source": "s", "relative": True}, seed=4)
+    start = MODELS["ashikhmin"]()
+    spec = fit_spec(start, table=t)
+    assert spec.ties["base_r"][0] == "sheen_r" and spec.ties["base_r"][1] != "equal"
+    r = fit(t, spec, forward_model(start, t.wi, t.wo), max_steps=300, check_every=50,
+            progress=False, seed=2)
+    sheen, scale = r.summary["sheen_r"], r.summary["scale"]
+    assert sheen["lo95"] <= 0.75 / 0.9 <= sheen["hi95"], sheen
+    assert sheen["hi95"] < 0.95                                 # far from the bound 1
+    assert scale["lo95"] <= 0.9 <= scale["hi95"], scale
+    assert not [w for w in r.warnings if w["kind"] == "at_bound"]
 
 
 def _fit_all(table, starts, out):

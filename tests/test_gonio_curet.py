@@ -60,3 +60,14 @@ def test_old_names_warn_and_give_the_same_table(shared_data):
                for x in w)
     new = gonio.read_curet(shared_data / "curet", 7)
     np.testing.assert_array_equal(old.values, new.values)
+
+
+def test_azimuths_are_in_one_frame_and_sense(shared_data):
+    """The shiny polyester's brightest value is at an exact mirror pair (phi_v = phi_i + 180
+    degrees, theta_v = theta_i): both azimuths measured from one axis in one sense, as read
+    (a wrong sign of one of them would put it elsewhere)."""
+    t = gonio.read_curet(shared_data / "curet", 2)
+    k = int(np.argmax(t.values[:, 0]))
+    mirror = t.wi[k] * np.array([-1.0, -1.0, 1.0])
+    np.testing.assert_allclose(t.wo[k], mirror, atol=1e-6)
+    assert t.wi[k, 0] ** 2 + t.wi[k, 1] ** 2 > 0.5        # away from the normal: phi matters

@@ -26,6 +26,14 @@ suggested free set is chosen forward: the candidates in order of their own infor
 taken when, freed together with those taken before (the others fixed), all of them stay
 informed and no two of them are confounded; so of a confounded pair (which the marginal sds
 show both not informed) one is kept.
+
+One rule overrides the information: on an RGB table whose mean (albedo) colour the start
+contradicts (CIEDE2000 above :data:`analysis.fit.trust.COLOUR_DE_MAX` between the table's
+colour and the start's, the start's scaled to the table's luminance so that only hue and
+chroma count), every candidate colour channel is suggested. The information at a start of
+the wrong colour is no guide there: a colour the data contradict, held fixed, pulls every
+other parameter to make up for it
+(:func:`analysis.fit.quality.start_colour_difference`).
 """
 
 from __future__ import annotations
@@ -39,6 +47,8 @@ import gonio
 from analysis.families import family_of
 from analysis.fit.driver import with_nuisance
 from analysis.fit.posterior import LogPosterior, forward_model
+from analysis.fit.quality import start_colour_difference
+from analysis.fit.trust import COLOUR_DE_MAX
 from analysis.fit.workflow import fit_spec
 from analysis.likelihood import Likelihood, is_grey
 from analysis.params import ParamSpec
@@ -275,7 +285,8 @@ def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
     :func:`analysis.fit.fit_spec` takes them when given; otherwise for a model with a default
     free set of its own (``DEFAULT_FREE``: the microcylinder's) that set and its ties plus its
     colours for an RGB table (a grey table cannot tell the channels apart: the
-    microcylinder's two albedos), for any other model its default free set for the table
+    microcylinder's two albedos) and its ``rotation`` (degrees; where the table cannot tell
+    it, the Fisher test leaves it out), for any other model its default free set for the table
     (every parameter, with :meth:`analysis.families.ModelFamily.default_free`'s
     identifiability choices)."""
     fam = family_of(fabric)
@@ -287,6 +298,7 @@ def candidate_spec(table, fabric, free=None, ties=None, toml=None) -> ParamSpec:
         ties = list(default_ties) if ties is None else ties
         if not is_grey(np.asarray(table.values, dtype=np.float64)):
             free += list(fam.schema.colours)
+        free += [n for n in ("rotation",) if n in fam.schema]
     return fit_spec(fabric, free, ties, toml)
 
 
@@ -302,6 +314,11 @@ def suggest_free(table, fabric, model, free=None, ties=None, toml=None, *,
     """
     spec = candidate_spec(table, fabric, free, ties, toml)
     report = table_information(table, spec, model, likelihood=likelihood, nu=nu)
+    colours = [n for names in spec.family.aliases.values() for n in names if n in spec.free]
+    if colours and start_colour_difference(table, spec, model) > COLOUR_DE_MAX:
+        keep = set(report.suggested) | set(colours)
+        report = dataclasses.replace(report, suggested=tuple(n for n in report.names
+                                                             if n in keep))
     kept = {t: (src if kind == "equal" else f"1-{src}")
             for t, (src, kind) in spec.ties.items() if src in report.suggested}
     return report, kept

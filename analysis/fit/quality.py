@@ -2,7 +2,9 @@ r"""How well a fit explains its table: residuals at the posterior median, and th
 of the table against the fit's (CIEDE2000, colour-science; :func:`albedo_colours` and
 :func:`albedo_delta_e` live in :mod:`analysis.colour` and are re-exported here). A grey table
 (the same value in R, G and B at every point: CUReT, a one-column CSV) has no colour: its
-colour difference is None, with the reason. Whether the model describes the data at all is
+colour difference is None, with the reason. :func:`start_colour_difference` measures the same
+difference before a fit, at its start, in hue and chroma alone. Whether the model describes
+the data at all is
 :mod:`analysis.fit.adequacy`.
 """
 
@@ -10,10 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.colour import albedo_colours, albedo_delta_e
+from analysis.colour import albedo_colours, albedo_delta_e, luminance
 from analysis.likelihood import is_grey
 
-__all__ = ["residuals", "albedo_colours", "albedo_delta_e", "fit_quality"]
+__all__ = ["residuals", "albedo_colours", "albedo_delta_e", "fit_quality",
+           "start_colour_difference"]
 
 
 def residuals(result, prediction=None) -> dict:
@@ -64,3 +67,35 @@ def fit_quality(result, table) -> dict:
     else:
         out["albedo_delta_e2000"] = albedo_delta_e(meas, prd)
     return out
+
+
+def start_colour_difference(table, spec, model) -> float:
+    """CIEDE2000 (unitless) between ``table``'s mean albedo colour and that of ``spec``'s start
+    (an :class:`analysis.params.ParamSpec`; ``model`` its forward model at the table's pairs)
+    (:func:`albedo_colours`), the start's colour scaled to the table's
+    luminance (only hue and chroma count); 0 for a grey table.
+
+    Examples
+    --------
+    >>> import brdf
+    >>> from analysis.fit import FabricModel
+    >>> from analysis.params import defaults_from_fabric
+    >>> from gonio import measure, Instrument
+    >>> linen = brdf.fabric("linen_plain")
+    >>> warm = linen.with_values({f"albedo{j}_{c}": a for j in (1, 2)
+    ...                           for c, a in zip("rgb", (0.8, 0.45, 0.2))})
+    >>> t = measure(warm, "full:30:60", Instrument(snr=50), seed=1, progress=False)
+    >>> from analysis.params import ParamSpec
+    >>> spec = ParamSpec("kd1", defaults=defaults_from_fabric(linen))
+    >>> start_colour_difference(t, spec, FabricModel(linen, t.wi, t.wo)) > 10
+    True
+    """
+    if is_grey(np.asarray(table.values, dtype=np.float64)):
+        return 0.0
+    values = spec.values(spec.start()[None])
+    pred = np.asarray(model(**spec.model_kwargs(values)))[0]
+    measured, predicted = albedo_colours(table, pred)
+    lum = float(luminance(predicted))
+    if not lum > 0:
+        return float("inf")
+    return float(albedo_delta_e(measured, predicted * float(luminance(measured)) / lum))

@@ -15,6 +15,12 @@ Each warning is ``{"kind", "parameters", "message"}``, computed from the posteri
   fibres), else its :attr:`~brdf.schema.ParamInfo.typical` range (the fit's default bounds,
   so only a fit whose bounds were widened can leave it).
 - ``misfit``: the model does not describe the data (:func:`analysis.fit.adequacy.adequacy`).
+- ``colour_fixed``: the CIEDE2000 difference between the table's mean (albedo) colour and the
+  fit's exceeds :data:`COLOUR_DE_MAX` while a colour's channels are held fixed: the fixed
+  colour, not the data, decides the fit's colour, and the other parameters are pulled to
+  make up for it. The warning names the channels to free. It needs the fit's quality
+  figures (:func:`analysis.fit.quality.fit_quality`), so :func:`colour_warnings` is run after
+  them (:func:`analysis.fit.workflow.fit_fabric`), not among :data:`CHECKS`.
 
 :data:`CHECKS` lists the checks, each ``check(result) -> list of warnings``;
 :func:`fit_warnings` runs them in order, so another kind is one more function appended there.
@@ -33,8 +39,12 @@ from analysis.families import family
 from analysis.params import INTERNAL_LIMIT
 
 __all__ = ["warning", "fit_warnings", "assess", "CHECKS", "prior_sd", "flat_values",
-           "BOUND_ZONE", "SD_RATIO", "CORR_MAX", "PRIOR_DRAWS"]
+           "colour_warnings", "fixed_colour_channels", "COLOUR_DE_MAX", "BOUND_ZONE",
+           "SD_RATIO", "CORR_MAX", "PRIOR_DRAWS"]
 
+#: colour_fixed: the CIEDE2000 difference of mean colours above which a fit with a colour
+#: held fixed is warned (about 1 is just noticeable; 5 is plainly another colour).
+COLOUR_DE_MAX = 5.0
 #: at_bound: the 95% interval reaches into this share of the prior range at either end.
 BOUND_ZONE = 0.01
 #: not_informed: posterior sd above this share of the prior sd.
@@ -179,6 +189,43 @@ def misfit(result) -> list[dict]:
     if a.get("adequate") is not False:
         return []
     return [warning("misfit", [], "the model does not describe the data: " + a["reason"])]
+
+
+def fixed_colour_channels(spec) -> tuple[str, ...]:
+    """The channels of ``spec``'s colours that are neither free nor tied to a free one."""
+    moving = set(spec.free) | {t for t, (src, _) in spec.ties.items() if src in spec.free}
+    return tuple(n for names in spec.family.aliases.values() for n in names
+                 if n not in moving)
+
+
+def colour_warnings(result, max_delta_e: float = COLOUR_DE_MAX) -> list[dict]:
+    """A ``colour_fixed`` warning when ``result.quality``'s ``albedo_delta_e2000`` exceeds
+    ``max_delta_e`` (CIEDE2000, unitless) and some colour channel is fixed (see the module
+    notes); none for a grey table (no colour difference) or with every colour free.
+
+    Examples
+    --------
+    >>> import types, brdf
+    >>> from analysis.params import ParamSpec, defaults_from_fabric
+    >>> spec = ParamSpec("kd1", defaults=defaults_from_fabric(brdf.fabric("linen_plain")))
+    >>> r = types.SimpleNamespace(spec=spec, quality={"albedo_delta_e2000": 16.5})
+    >>> [w["parameters"][:3] for w in colour_warnings(r)]
+    [['albedo1_r', 'albedo1_g', 'albedo1_b']]
+    >>> r.quality["albedo_delta_e2000"] = 0.7
+    >>> colour_warnings(r)
+    []
+    """
+    de = (getattr(result, "quality", None) or {}).get("albedo_delta_e2000")
+    fixed = fixed_colour_channels(result.spec)
+    if de is None or not np.isfinite(de) or de <= max_delta_e or not fixed:
+        return []
+    groups = [g for g, names in result.spec.family.aliases.items()
+              if any(n in fixed for n in names)]
+    return [warning("colour_fixed", list(fixed), (
+        f"the fitted mean colour differs from the table's by CIEDE2000 {de:.1f} (above "
+        f"{max_delta_e:g}) while {', '.join(groups)} are held fixed: the fixed colour, not "
+        f"the data, sets the fit's colour and the other parameters are pulled to make up "
+        f"for it; free {', '.join(fixed)} (--free ...,{','.join(groups)})"))]
 
 
 #: The checks :func:`fit_warnings` runs, in order: ``check(result) -> list of warnings``.

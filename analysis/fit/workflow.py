@@ -16,8 +16,9 @@ from analysis.fit.outputs import (PLOT_FILES, STATE_FILES, check_fit_folder, cla
                                   release_fit_folder)
 from analysis.families import family_of
 from analysis.fit.posterior import forward_model
-from analysis.fit.quality import fit_quality
+from analysis.fit.quality import fit_quality, start_colour_difference
 from analysis.fit.results import FitResult, write_results
+from analysis.fit.trust import COLOUR_DE_MAX, colour_warnings, fixed_colour_channels
 from analysis.folderlock import output_lock
 from analysis.likelihood import is_grey, is_relative
 from analysis.params import ParamSpec
@@ -38,7 +39,9 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
         file. Default the family's default free set
         (:meth:`analysis.families.ModelFamily.default_free`: the microcylinder's
         :data:`analysis.params.DEFAULT_FREE`; every parameter of a baseline, with the
-        identifiability choices for a grey or relative ``table``).
+        identifiability choices for a grey or relative ``table``); on an RGB ``table``
+        whose mean colour the start contradicts, every colour channel besides (a note in
+        the spec says so).
     ties : sequence of str, optional
         ``"a=b"`` / ``"a=1-b"`` ties (each item may hold several, comma-separated; ``"none"``
         is dropped). Default the family's default ties when neither ``free`` nor ``toml`` is
@@ -76,9 +79,33 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
         free, default_ties, notes = fam.default_free(grey=grey, relative=relative)
         if ties is None:
             ties = list(default_ties)
+        if table is not None and not grey and fam.cls.DEFAULT_FREE is not None:
+            return _with_table_colour(fabric, table, free, ties, notes, defaults)
     if toml is not None:
         return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties, family=fam)
     return ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes)
+
+
+def _with_table_colour(fabric, table, free, ties, notes, defaults) -> ParamSpec:
+    """The default spec on an RGB table of a model with a default free set of its own (the
+    microcylinder's; a baseline's frees its colours already), with every colour channel freed
+    when the start's
+    hue and chroma contradict the table's mean colour (CIEDE2000 above
+    :data:`analysis.fit.trust.COLOUR_DE_MAX`, :func:`analysis.fit.quality.start_colour_difference`):
+    a fixed colour the data contradict pulls every other parameter to make up for it."""
+    fam = family_of(fabric)
+    spec = ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes)
+    fixed = fixed_colour_channels(spec)
+    if not fixed:
+        return spec
+    de = start_colour_difference(table, spec, forward_model(fabric, table.wi, table.wo))
+    if not de > COLOUR_DE_MAX:
+        return spec
+    groups = [g for g, names in fam.aliases.items() if any(n in fixed for n in names)]
+    note = (f"RGB table whose mean colour the start contradicts (CIEDE2000 {de:.1f} in hue "
+            f"and chroma, above {COLOUR_DE_MAX:g}): {', '.join(groups)} freed")
+    return ParamSpec(list(free) + list(fixed), defaults=defaults, ties=ties or (), family=fam,
+                     notes=(*notes, note))
 
 
 def check_fit_size(path, spec: ParamSpec, walkers: int | None = None, **read_options) -> None:
@@ -111,7 +138,9 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
     listed in the folder's marker first (:func:`~analysis.fit.outputs.claim_fit_folder`), so
     the next fit there, a resume, takes them for its own. Then the
     quality figures are computed (:func:`analysis.fit.quality.fit_quality`: residuals, albedo
-    colours and their CIEDE2000 difference), the PSIS-LOO (:func:`analysis.fit.loo.psis_loo`:
+    colours and their CIEDE2000 difference; a ``colour_fixed`` warning when it is large with a
+    colour held fixed, :func:`analysis.fit.trust.colour_warnings`), the PSIS-LOO
+    (:func:`analysis.fit.loo.psis_loo`:
     ``loo`` in the results, its pointwise values in ``loo.npz``, the LOO-PIT test in
     ``quality["loo_pit"]``, a ``pareto_k`` warning when values have a high Pareto k), the
     plots drawn when ``plots`` is given, and ``results.json`` / ``results.csv`` written, once,
@@ -155,6 +184,7 @@ def fit_fabric(table, fabric, spec, out_dir, *, plots: Callable | None = None,
             release_fit_folder(out)     # refused before its first file: the folder as it was
             raise
         result.quality = fit_quality(result, table)
+        result.warnings = [*result.warnings, *colour_warnings(result)]
         t0 = time.perf_counter()
         result.loo = psis_loo(result, table_digest(table))
         result.timing["loo_s"] = time.perf_counter() - t0

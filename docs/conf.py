@@ -34,10 +34,13 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    # MathJax 3 served from the build (_static/mathjax), not a CDN: equations render offline
+    "sphinx-mathjax-offline",
     "sphinx.ext.intersphinx",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
     "microcyl_docs",
+    "microcyl_offline",      # figures link to their full size; the build fails on remote loads
 ]
 
 exclude_patterns = ["_build", "**/GALLERY_HEADER.rst", "tutorials_src", "gallery_src"]

@@ -89,4 +89,18 @@ sphinx_gallery_conf = {
     "abort_on_example_error": False,
     "only_warn_on_example_error": False,
     "min_reported_time": 0,
+    # the execution-time tables load jQuery and DataTables from CDNs (pages that would not
+    # work offline, microcyl_offline.py); the build's own timing is not a page for users
+    "write_computation_times": False,
+}
+
+# Thumbnails of figures of several panels, cut from the figure (microcyl_offline.py): the
+# page's figure number and the box (left, top, right, bottom as fractions of its width and
+# height); at thumbnail size the whole figure shows its panels as empty frames.
+microcyl_thumbnail_crops = {
+    "gallery/plot_01_lobes": (1, (0.0, 0.0, 0.34, 0.34)),
+    "gallery/plot_02_slices": (1, (0.0, 0.0, 0.5, 0.5)),
+    "gallery/plot_07_table": (1, (0.0, 0.0, 0.36, 0.92)),
+    "gallery/plot_08_variants": (1, (0.0, 0.0, 0.34, 1.0)),
+    "gallery/plot_10_fit_lobes": (1, (0.0, 0.0, 0.36, 1.0)),
 }

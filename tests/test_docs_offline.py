@@ -85,3 +85,29 @@ def test_built_site_loads_nothing_from_another_host():
         pytest.skip("no built site (docs/_build/html): `make docs` builds it and checks it")
     assert offline.offline_resources(html) == {}
     assert (html / "_static" / "mathjax" / "tex-chtml.js").is_file()
+
+
+def test_thumbnail_cut_from_one_panel(tmp_path):
+    """A thumbnail named in microcyl_thumbnail_crops is remade from its box of the figure, at
+    sphinx-gallery's thumbnail size; a figure a script skipped is left alone."""
+    from PIL import Image
+    images = tmp_path / "gallery" / "images"
+    (images / "thumb").mkdir(parents=True)
+    figure = Image.new("RGB", (900, 600), "white")
+    figure.paste(Image.new("RGB", (300, 300), "red"), (0, 0))      # the first panel
+    figure.save(images / "sphx_glr_plot_x_001.png")
+
+    class App:
+        srcdir = str(tmp_path)
+
+        class config:
+            sphinx_gallery_conf = {"thumbnail_size": (400, 280)}
+            microcyl_thumbnail_crops = {"gallery/plot_x": (1, (0, 0, 1 / 3, 0.5)),
+                                        "gallery/plot_skipped": (1, (0, 0, 0.5, 0.5))}
+
+    offline.crop_thumbnails(App())
+    with Image.open(images / "thumb" / "sphx_glr_plot_x_thumb.png") as thumb:
+        assert thumb.size == (400, 280)
+        r, g, b, a = thumb.convert("RGBA").getpixel((200, 140))
+        assert (r, g, b, a) == (255, 0, 0, 255)
+    assert not (images / "thumb" / "sphx_glr_plot_skipped_thumb.png").exists()

@@ -7,6 +7,8 @@
   (the ``build-finished`` hook below), and tests/test_docs_offline.py checks the scanner.
 - sphinx-gallery's figures (its ``imgsgnode``) are wrapped in a link to the image itself, so
   that a figure shown narrower than its pixels opens at full size in the browser.
+- ``microcyl_thumbnail_crops`` (conf.py): the gallery thumbnail of a figure of several panels
+  is cut from one panel of it, so that it does not show as empty frames.
 """
 
 from __future__ import annotations
@@ -130,7 +132,32 @@ def _visit_linked(original):
     return visit
 
 
+def crop_thumbnails(app):
+    """Remake the thumbnails named in ``microcyl_thumbnail_crops`` from a box of their figure
+    (after sphinx-gallery has run the scripts), at sphinx-gallery's thumbnail size."""
+    from PIL import Image
+    src = Path(app.srcdir)
+    size = app.config.sphinx_gallery_conf.get("thumbnail_size", (400, 280))
+    for page, (number, (left, top, right, bottom)) in app.config.microcyl_thumbnail_crops.items():
+        folder, name = page.rsplit("/", 1)
+        figure = src / folder / "images" / f"sphx_glr_{name}_{number:03d}.png"
+        thumb = src / folder / "images" / "thumb" / f"sphx_glr_{name}_thumb.png"
+        if not figure.is_file():          # the script skipped its figure (no data, no LLVM)
+            continue
+        with Image.open(figure) as im:
+            w, h = im.size
+            panel = im.convert("RGBA").crop((round(left * w), round(top * h),
+                                             round(right * w), round(bottom * h)))
+        panel.thumbnail(size, Image.LANCZOS)
+        canvas = Image.new("RGBA", size, (255, 255, 255, 0))
+        canvas.paste(panel, ((size[0] - panel.width) // 2, (size[1] - panel.height) // 2))
+        canvas.save(thumb)
+
+
 def setup(app):
+    app.add_config_value("microcyl_thumbnail_crops", {}, "env")
+    # after sphinx-gallery's own builder-inited hook, which runs the scripts (priority 500)
+    app.connect("builder-inited", crop_thumbnails, priority=800)
     from sphinx_gallery import directives as sgd
     app.add_node(sgd.imgsgnode, override=True,
                  html=(_visit_linked(sgd.visit_imgsg_html), sgd.depart_imgsg_html),

@@ -58,7 +58,12 @@ html_title = "microcyl"
 html_theme_options = {
     "navigation_depth": 2,
     "show_toc_level": 2,
-    "secondary_sidebar_items": ["page-toc"],
+    # the tutorials' and gallery's scripts give the right-hand column to their figures (pages
+    # named one by one: a page matching two wildcard patterns is a warning)
+    "secondary_sidebar_items": {"**": ["page-toc"], **{
+        f"{out}/{script.stem}": [] for src, out in (("tutorials_src", "tutorials"),
+                                                    ("gallery_src", "gallery"))
+        for script in sorted((DOCS / src).glob("plot_*.py"))}},
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
@@ -98,9 +103,9 @@ sphinx_gallery_conf = {
 # page's figure number and the box (left, top, right, bottom as fractions of its width and
 # height); at thumbnail size the whole figure shows its panels as empty frames.
 microcyl_thumbnail_crops = {
-    "gallery/plot_01_lobes": (1, (0.0, 0.0, 0.34, 0.34)),
+    "gallery/plot_01_lobes": (1, (0.0, 0.0, 0.34, 0.31)),
     "gallery/plot_02_slices": (1, (0.0, 0.0, 0.5, 0.5)),
-    "gallery/plot_07_table": (1, (0.0, 0.0, 0.36, 0.92)),
+    "gallery/plot_07_table": (1, (0.0, 0.04, 0.335, 0.92)),
     "gallery/plot_08_variants": (1, (0.0, 0.0, 0.34, 1.0)),
     "gallery/plot_10_fit_lobes": (1, (0.0, 0.0, 0.36, 1.0)),
 }

@@ -3,9 +3,9 @@ A Mitsuba 3 scene
 =================
 
 The ``microcylinder`` BSDF in a Mitsuba 3 scene written by hand: a ball covered in shot silk
-(the warp along the sphere's tangent turned 30 degrees about the normal; its colour shifts with the angle, as
-shot silk does) on a velvet floor, a square area lamp and a grey sky, rendered with the
-``direct`` integrator at 360 x 240 and 16 samples per pixel. It runs in
+(the warp along the sphere's tangent, turned 30 degrees about the normal; its colour shifts
+with the angle, as shot silk's does) on a velvet floor, a square area lamp and a grey sky,
+rendered with the ``direct`` integrator at 360 x 240 and 16 samples per pixel. It runs in
 ``llvm_ad_rgb`` where Dr.Jit finds a usable LLVM (``DRJIT_LIBLLVM_PATH``, see
 :doc:`../getting_started`) and is skipped with a note otherwise.
 """

@@ -21,7 +21,8 @@ builds in seconds; a real fit runs to convergence, with the default free set.
 # per channel, which the fit uses as the noise of each value (a table without it gets a free
 # noise level). The values were made by the virtual gonioreflectometer from the preset
 # ``linen_plain`` (1-degree detector cone, signal-to-noise ratio 30), so that the truth is
-# known: :download:`lab_linen.csv <../tutorials_src/lab_linen.csv>`.
+# known. The script reads :download:`lab_linen.csv <../tutorials_src/lab_linen.csv>` from the
+# folder it runs in.
 import json
 import os
 import shutil
@@ -36,7 +37,7 @@ from reports.cli import main
 work = Path(os.environ.get("MICROCYL_DOCS_WORK", ".")) / "tutorial_fit"
 work.mkdir(parents=True, exist_ok=True)
 csv = work / "linen.csv"
-shutil.copyfile(Path(__file__).with_name("lab_linen.csv"), csv)
+shutil.copyfile("lab_linen.csv", csv)        # the file beside this script
 lines = csv.read_text().splitlines()
 print("\n".join(lines[:14] + [f"... ({len(lines) - 14} more lines)"]))
 truth = brdf.fabric("linen_plain")
@@ -114,7 +115,8 @@ print(f"PSIS-LOO: elpd {loo['elpd']:.1f} +- {loo['se']:.1f}, p_loo {loo['p_loo']
 print("warnings:", [w.get("message", w) for w in results.get("warnings", [])] or "none")
 
 # %%
-# The plots are written beside it: the corner plot of the posterior,
+# The plots are written beside it (click a figure for its full size): the corner plot of
+# the posterior,
 show_png(fit_dir / "corner.png")
 
 # %%
@@ -126,9 +128,9 @@ show_png(fit_dir / "lobes.png")
 show_png(fit_dir / "adequacy.png")
 
 # %%
-# The table against the fit: ``microcyl plot table linen.csv linen_plain --fit fit/``.
+# The table against the fit: ``microcyl plot table linen.csv linen_plain --fit fit/ --dpi 110``.
 assert main(["plot", "table", str(csv), "linen_plain", "--fit", str(fit_dir),
-             "-o", str(work / "table.png")]) == 0
+             "--dpi", "110", "-o", str(work / "table.png")]) == 0
 show_png(work / "table.png")
 
 # %%

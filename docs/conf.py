@@ -105,7 +105,7 @@ sphinx_gallery_conf = {
 microcyl_thumbnail_crops = {
     "gallery/plot_01_lobes": (1, (0.0, 0.0, 0.34, 0.31)),
     "gallery/plot_02_slices": (1, (0.0, 0.0, 0.5, 0.5)),
-    "gallery/plot_07_table": (1, (0.0, 0.04, 0.335, 0.92)),
+    "gallery/plot_07_table": (1, (0.0, 0.07, 0.33, 0.92)),
     "gallery/plot_08_variants": (1, (0.0, 0.0, 0.34, 1.0)),
     "gallery/plot_10_fit_lobes": (1, (0.0, 0.0, 0.36, 1.0)),
 }

@@ -34,10 +34,13 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    # MathJax 3 served from the build (_static/mathjax), not a CDN: equations render offline
+    "sphinx-mathjax-offline",
     "sphinx.ext.intersphinx",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
     "microcyl_docs",
+    "microcyl_offline",      # figures link to their full size; the build fails on remote loads
 ]
 
 exclude_patterns = ["_build", "**/GALLERY_HEADER.rst", "tutorials_src", "gallery_src"]
@@ -55,7 +58,12 @@ html_title = "microcyl"
 html_theme_options = {
     "navigation_depth": 2,
     "show_toc_level": 2,
-    "secondary_sidebar_items": ["page-toc"],
+    # the tutorials' and gallery's scripts give the right-hand column to their figures (pages
+    # named one by one: a page matching two wildcard patterns is a warning)
+    "secondary_sidebar_items": {"**": ["page-toc"], **{
+        f"{out}/{script.stem}": [] for src, out in (("tutorials_src", "tutorials"),
+                                                    ("gallery_src", "gallery"))
+        for script in sorted((DOCS / src).glob("plot_*.py"))}},
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
@@ -86,4 +94,18 @@ sphinx_gallery_conf = {
     "abort_on_example_error": False,
     "only_warn_on_example_error": False,
     "min_reported_time": 0,
+    # the execution-time tables load jQuery and DataTables from CDNs (pages that would not
+    # work offline, microcyl_offline.py); the build's own timing is not a page for users
+    "write_computation_times": False,
+}
+
+# Thumbnails of figures of several panels, cut from the figure (microcyl_offline.py): the
+# page's figure number and the box (left, top, right, bottom as fractions of its width and
+# height); at thumbnail size the whole figure shows its panels as empty frames.
+microcyl_thumbnail_crops = {
+    "gallery/plot_01_lobes": (1, (0.0, 0.0, 0.34, 0.31)),
+    "gallery/plot_02_slices": (1, (0.0, 0.0, 0.5, 0.5)),
+    "gallery/plot_07_table": (1, (0.0, 0.07, 0.33, 0.92)),
+    "gallery/plot_08_variants": (1, (0.0, 0.0, 0.34, 1.0)),
+    "gallery/plot_10_fit_lobes": (1, (0.0, 0.0, 0.36, 1.0)),
 }

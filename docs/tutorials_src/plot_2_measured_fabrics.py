@@ -25,6 +25,16 @@ work.mkdir(parents=True, exist_ok=True)
 have_data = (data / "rgl").is_dir() and (data / "curet").is_dir()
 print("data folder:", data, "(found)" if have_data else "(absent: the steps below are skipped)")
 
+
+def show_png(path):
+    """A PNG written by microcyl, shown at its own size (one image pixel a screen pixel)."""
+    image = plt.imread(path)
+    fig = plt.figure(figsize=(image.shape[1] / 100, image.shape[0] / 100), dpi=100)
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.imshow(image, interpolation="none")
+    ax.set_axis_off()
+
+
 # %%
 # The datasets
 # ------------
@@ -42,12 +52,9 @@ if have_data:
     felt = analysis.load_measured("rgl_pink_felt", data)
     print(repr(felt))
     felt_file = data / "rgl" / "acrylic_felt_pink_rgb.bsdf"
-    assert main(["plot", "table", str(felt_file), "linen_plain", "--dpi", "80",
+    assert main(["plot", "table", str(felt_file), "linen_plain", "--dpi", "120",
                  "-o", str(work / "felt.png")]) == 0
-    image = plt.imread(work / "felt.png")
-    fig, ax = plt.subplots(figsize=(10, 10 * image.shape[0] / image.shape[1]))
-    ax.imshow(image)
-    ax.set_axis_off()
+    show_png(work / "felt.png")
 
 # %%
 # A CUReT fabric, and a short fit
@@ -58,11 +65,13 @@ if have_data:
 # quick: the verdict says whether that was enough.
 if have_data:
     from analysis.fit import fit_fabric
+    from reports.plots.fit_diagnostics import write_fit_plots
 
     linen = analysis.load_measured("curet_44_linen", data)
     print(repr(linen))
     spec, start = analysis.measured_spec("curet_44_linen")
-    result = fit_fabric(linen, start, spec, work / "curet_44", max_steps=300, progress=False)
+    result = fit_fabric(linen, start, spec, work / "curet_44", max_steps=300, progress=False,
+                        plots=write_fit_plots)
     print(repr(result))
     for w in result.warnings:
         print("warning:", w.get("message", w))
@@ -74,3 +83,15 @@ if have_data:
     from reports.plots import fit_diagnostics as fitplots
 
     fig = fitplots.corner_plot(result)
+
+# %%
+# The fit writes its plots beside ``results.json``, as ``microcyl fit-measured`` does for each
+# dataset (the measured page of ``microcyl report --measured`` shows them): ``lobes.png``,
+# the posterior-predictive lobes over the data (click a figure for its full size),
+if have_data:
+    show_png(work / "curet_44" / "lobes.png")
+
+# %%
+# and ``adequacy.png``, the standardized residuals against angle with the adequacy verdict.
+if have_data:
+    show_png(work / "curet_44" / "adequacy.png")

@@ -23,7 +23,7 @@ def test_old_file_kept_when_writer_fails(tmp_path, monkeypatch):
     before = p.read_bytes()
 
     calls = {"n": 0}
-    real = gonio.csvtable.format_numbers
+    real = gonio.csvwrite.format_numbers
 
     def boom(x, *a, **k):  # fails after some rows were written (100 rows, 10 columns a time)
         calls["n"] += 1
@@ -31,8 +31,8 @@ def test_old_file_kept_when_writer_fails(tmp_path, monkeypatch):
             raise KeyboardInterrupt
         return real(x, *a, **k)
 
-    monkeypatch.setattr("gonio.csvtable.format_numbers", boom)
-    monkeypatch.setattr("gonio.csvtable._WRITE_ROWS", 100)
+    monkeypatch.setattr("gonio.csvwrite.format_numbers", boom)
+    monkeypatch.setattr("gonio.csvwrite._WRITE_ROWS", 100)
     with pytest.raises(KeyboardInterrupt):
         gonio.write(random_table(1, n=500), p)
     monkeypatch.undo()

@@ -66,12 +66,14 @@ def _pairs_key(wi: np.ndarray, wo: np.ndarray) -> bytes:
 
 def batch_kwargs(model_name: str, values: Mapping) -> dict:
     """The keyword arguments of ``prepare(...).eval`` from slider values (scalars or arrays
-    of a batch shape B...). The microcylinder's tangent scales are not among them: they
-    change the tangent curves, which the base fabric holds (``prepare`` is made of it)."""
+    of a batch shape B...). The microcylinder's tangent scales and rotation are not among
+    them: they change the tangent curves and the frame, which the base fabric holds
+    (``prepare`` is made of it; the explorer's own rotation control rebuilds it)."""
     fam = family(model_name)
     kw = fam.model_kwargs({k: np.asarray(values[k], float) for k in fam.model_names
                            if k in values})
-    kw.pop("tangent_scale", None)
+    for name in ("tangent_scale", "rotation"):   # the base fabric's (its curves, its frame)
+        kw.pop(name, None)
     return kw
 
 

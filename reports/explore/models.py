@@ -117,10 +117,17 @@ class ExploreModel:
         return base.replace(threads=tuple(threads), **dict(options or {}))
 
 
+#: Parameters the app controls itself, not as a shading slider: the fabric's rotation (its
+#: own control, which rebuilds the prepared frame) and the tangent scales (the base curves).
+APP_CONTROLLED = ("rotation", "tangent_scale1", "tangent_scale2")
+
+
 def _sliders(name: str) -> tuple:
     fam = family(name)
     out = []
     for n in fam.model_names:
+        if n in APP_CONTROLLED:
+            continue
         lo, hi, _prior, unit, default = fam.entry(n)
         out.append(Slider(n, float(lo), float(hi), _step(lo, hi), unit, float(default)))
     return tuple(out)

@@ -75,7 +75,8 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
                  initial: int = 0):
     """A tqdm bar (``tqdm.auto``: a widget in notebooks) on stderr that vanishes when closed;
     on a pipe or a file (not :func:`interactive`) one line at the start, one every
-    :data:`PIPE_INTERVAL` seconds and one at the end (:class:`LineStream`).
+    :data:`PIPE_INTERVAL` seconds and one at the end (:class:`LineStream`), each whole: no
+    width is given to tqdm, which then cuts nothing (a log has no columns to fit).
 
     Parameters
     ----------
@@ -99,7 +100,6 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
     # looked up on each call (not bound at import), so a patched tqdm.auto.tqdm is used
     if enabled and not interactive():
         return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=True,
-                              file=LineStream(sys.stderr), mininterval=PIPE_INTERVAL,
-                              ncols=80)
+                              file=LineStream(sys.stderr), mininterval=PIPE_INTERVAL)
     return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=False,
                           file=sys.stderr, disable=not enabled)

@@ -149,3 +149,33 @@ def test_floor_noise_falls_when_each_path_samples_both_lights(jit):
     assert noise(new) < noise(old) / 4, (noise(new), noise(old))
     diff = luminance(sum(new) / 2)[lit].mean() - luminance(sum(old) / 2)[lit].mean()
     assert abs(diff) < 4 * noise(old) / np.sqrt(lit.sum()) + 0.01 * luminance(old[0])[lit].mean()
+
+
+def test_a_first_pass_that_compiles_writes_heartbeat_lines_on_a_pipe(monkeypatch):
+    """The first pass of a scene compiles the kernel and updates nothing for minutes: on a
+    pipe a line still comes every PIPE_INTERVAL (here 0.05 s), saying what runs; the later
+    passes write none."""
+    import io
+    import time as _time
+
+    import gonio.progress as gp
+    from reports.mitsuba import render as mr
+
+    out = io.StringIO()
+    monkeypatch.setattr(gp.sys, "stderr", out)
+    monkeypatch.setattr(gp, "PIPE_INTERVAL", 0.05)
+
+    class FakeMi:
+        calls = 0
+
+        def render(self, scene, seed, spp):
+            FakeMi.calls += 1
+            _time.sleep(0.3 if FakeMi.calls == 1 else 0.0)
+            return np.ones((2, 3, 3))
+
+    img = mr._render_passes(FakeMi(), ["scene"], [1, 1, 1], 0, (2, 3), True, desc="demo")
+    assert img.shape == (2, 3, 3)
+    lines = out.getvalue().splitlines()
+    beats = [s for s in lines if "compiles the kernel" in s]
+    assert len(beats) >= 3 and all(s.startswith("demo:") for s in beats)
+    assert "compiles the kernel" not in lines[-1] and "3/3" in lines[-1]

@@ -21,6 +21,7 @@ Mitsuba is optional: this module imports it on use.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.util
 import os
@@ -30,7 +31,7 @@ import sys
 import numpy as np
 
 from brdf.fabric import Fabric
-from gonio.progress import progress_bar
+from gonio.progress import heartbeat, progress_bar
 from reports.mitsuba import plugin
 from reports.mitsuba.plugin import RGB_VARIANTS
 from reports.render.checks import check_size, resolve_fabric, scene_of
@@ -224,8 +225,13 @@ def _render_passes(mi, mscenes, passes, seed, shape, progress, desc) -> np.ndarr
                       desc=desc) as bar:
         for j, mscene in enumerate(mscenes):
             for k, n in enumerate(passes):
-                img = mi.render(mscene, seed=(int(seed) * 1000003 + 1009 * j + k) % 2**32,
-                                spp=n)
+                # the first pass compiles the kernel (up to minutes, with no update): a
+                # line every 10 s on a pipe says it is still running
+                beat = (heartbeat(bar, "the first pass compiles the kernel") if k == 0
+                        else contextlib.nullcontext())
+                with beat:
+                    img = mi.render(mscene, seed=(int(seed) * 1000003 + 1009 * j + k) % 2**32,
+                                    spp=n)
                 total += np.asarray(img, dtype=np.float64)[..., :3] * n
                 bar.update()
     return (total / sum(passes)).astype(np.float32)

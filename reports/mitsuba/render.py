@@ -36,7 +36,7 @@ from reports.mitsuba import plugin
 from reports.mitsuba.plugin import RGB_VARIANTS
 from reports.render.checks import check_size, resolve_fabric, scene_of
 
-__all__ = ["render_mitsuba", "pick_variant", "variant_works", "have_mitsuba", "MISSING",
+__all__ = ["render_mitsuba", "auto_engine", "pick_variant", "variant_works", "have_mitsuba", "MISSING",
            "PASS_SAMPLES"]
 
 #: The error of a Mitsuba render without Mitsuba installed.
@@ -76,6 +76,15 @@ def variant_works(variant: str) -> tuple[bool, str]:
         return True, ""
     lines = p.stderr.strip().splitlines() or [f"exit status {p.returncode}"]
     return False, next((ln for ln in lines if "LLVM" in ln or "CUDA" in ln), lines[-1])
+
+
+def auto_engine(fabric) -> str:
+    """The engine ``--engine auto`` means for ``fabric`` (every verb that renders):
+    ``mitsuba`` where Mitsuba is installed, ``llvm_ad_rgb`` runs and ``fabric`` is a
+    :class:`brdf.fabric.Fabric`, else ``builtin``."""
+    usable = (isinstance(fabric, Fabric) and have_mitsuba()
+              and variant_works("llvm_ad_rgb")[0])
+    return "mitsuba" if usable else "builtin"
 
 
 def pick_variant(variant: str | None = None) -> str:

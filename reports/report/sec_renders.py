@@ -118,7 +118,7 @@ def render_engine(fabric, choice: str = "auto") -> str:
     if choice == "mitsuba" and not is_fabric:
         raise ValueError("render engine mitsuba renders a brdf.Fabric only")
     if choice == "auto":
-        return "mitsuba" if is_fabric and _mitsuba_usable() else "builtin"
+        return mitsuba_render.auto_engine(fabric)
     return choice
 
 

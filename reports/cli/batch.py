@@ -36,7 +36,8 @@ def register(sub):
     cliutil.add_model_arguments(p)
     cliutil.add_fit_options(p)
     p.add_argument("--sample", default=None, metavar="all|N,N,...",
-                   help="CUReT samples of an abrdf.dat input")
+                   help="CUReT samples of an abrdf.dat input: all, or numbers or dataset "
+                        "names (curet_07_velvet), comma-separated")
     p.add_argument("--rgl-step", type=float, default=None, metavar="DEG",
                    help="outgoing-direction step for RGL .bsdf inputs (default the reader's)")
     cliutil.add_cluster_options(p)

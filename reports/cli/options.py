@@ -26,7 +26,7 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "add_model_arguments", "start_model", "check_tangent_samples", "reader_options", "read_table",
            "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES", "add_engine_option", "ENGINE_CHOICES",
-           "DEFAULT_ENGINE"]
+           "DEFAULT_ENGINE", "curet_sample_arg"]
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
 MAX_TANGENT_SAMPLES = brdf.MAX_TANGENT_SAMPLES
@@ -155,6 +155,16 @@ def add_engine_option(parser: argparse.ArgumentParser, what: str = "the render",
     for old in deprecated:
         parser.add_argument(old, dest="engine", new="--engine",
                             action=_DeprecatedAlias, help=argparse.SUPPRESS)
+
+
+def curet_sample_arg(text: str) -> int:
+    """``--sample``'s type: a CUReT sample number or a CUReT dataset's name
+    (``curet_07_velvet``: :func:`analysis.measured.curet_sample`)."""
+    from analysis.measured import curet_sample
+    try:
+        return curet_sample(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def progress(args: argparse.Namespace) -> bool:

@@ -179,3 +179,14 @@ def test_a_first_pass_that_compiles_writes_heartbeat_lines_on_a_pipe(monkeypatch
     beats = [s for s in lines if "compiles the kernel" in s]
     assert len(beats) >= 3 and all(s.startswith("demo:") for s in beats)
     assert "compiles the kernel" not in lines[-1] and "3/3" in lines[-1]
+
+
+def test_the_top_row_of_a_cylinder_render_is_not_black(jit):
+    """The cylinder's camera sees the floor up to 140 units away in its top row, past the
+    100-scale rectangle that stood for the infinite floor: that row was black at 640 x 360
+    (all of it; half at 320 x 180). Now it is lit as the rows below it are, as the built-in
+    renderer's infinite plane is."""
+    lum = luminance(mitsuba_render.render_mitsuba("cylinder", "velvet", 640, 360, 1,
+                                                  variant=jit, progress=False))
+    assert np.all(lum[0] > 0)
+    assert lum[0].mean() > 0.9 * lum[2].mean()

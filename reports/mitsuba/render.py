@@ -36,8 +36,8 @@ from reports.mitsuba import plugin
 from reports.mitsuba.plugin import RGB_VARIANTS
 from reports.render.checks import check_size, resolve_fabric, scene_of
 
-__all__ = ["render_mitsuba", "auto_engine", "pick_variant", "variant_works", "have_mitsuba", "MISSING",
-           "PASS_SAMPLES"]
+__all__ = ["render_mitsuba", "auto_engine", "pick_variant", "variant_works", "have_mitsuba",
+           "MISSING", "PASS_SAMPLES"]
 
 #: The error of a Mitsuba render without Mitsuba installed.
 MISSING = "--engine mitsuba needs mitsuba (pip install mitsuba)"

@@ -52,7 +52,7 @@ from analysis.measuredmodels import fit_folder, models_entry, parse_models, verd
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write, meta_text, plain
-from gonio.curet import read_curet
+from gonio.curet import N_SAMPLES, read_curet
 from gonio.io import read
 from gonio.rgl import load_rgl
 
@@ -132,7 +132,6 @@ def curet_sample(text) -> int:
     >>> curet_sample("curet_07_velvet"), curet_sample("7"), curet_sample(42)
     (7, 7, 42)
     """
-    from gonio.curet import N_SAMPLES
     key = str(text).strip()
     d = MEASURED.get(key.lower())
     if d is not None and d.sample is not None:

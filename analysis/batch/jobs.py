@@ -133,26 +133,23 @@ def read_job_table(job: BatchJob):
 
 
 def parse_samples(text) -> tuple[int, ...] | None:
-    """``"all"`` -> 1..61, ``"1,2,7"`` -> (1, 2, 7), None -> None (CUReT sample numbers, or
-    the CUReT datasets' names: :func:`analysis.measured.curet_sample`).
+    """``"all"`` -> 1..61, ``"1,2,7"`` -> (1, 2, 7), None -> None (CUReT sample numbers).
 
     Examples
     --------
-    >>> parse_samples("2,curet_07_velvet"), len(parse_samples("all"))
+    >>> parse_samples("2,7"), len(parse_samples("all"))
     ((2, 7), 61)
     """
     if text is None:
         return None
     if isinstance(text, str) and text.strip().lower() == "all":
         return tuple(range(1, N_SAMPLES + 1))
-    from analysis.measured import curet_sample   # (analysis.measured imports this package)
     items = text.split(",") if isinstance(text, str) else list(text)
     try:
-        out = tuple(curet_sample(s) for s in items if str(s).strip())
+        out = tuple(int(str(s).strip()) for s in items if str(s).strip())
     except ValueError:
-        raise ValueError(f"--sample must be 'all' or comma-separated sample numbers in "
-                         f"1..{N_SAMPLES} or CUReT dataset names (curet_07_velvet); got "
-                         f"{text!r}") from None
+        raise ValueError(f"--sample must be 'all' or comma-separated integers in 1..{N_SAMPLES}"
+                         f"; got {text!r}") from None
     bad = [s for s in out if not 1 <= s <= N_SAMPLES]
     if bad or not out:
         raise ValueError(f"--sample must be 'all' or integers in 1..{N_SAMPLES}; got {text!r}")

@@ -60,7 +60,8 @@ def run(args) -> int:
     free = args.free.split(",") if args.free and not args.free.endswith(".toml") else args.free
     jobs = jobs_from_inputs(
         args.inputs, preset=args.fabric, free=free, ties=cliutil.split_ties(args.tie),
-        spec=args.spec, samples=args.sample, fit=cliutil.fit_kwargs(args),
+        spec=args.spec, samples=cliutil.curet_samples_text(args.sample),
+        fit=cliutil.fit_kwargs(args),
         fabric_options=getattr(fab, "options", {}), model=args.model,
         read_options={} if args.rgl_step is None else {"step": args.rgl_step},
         plots=plots)

@@ -137,3 +137,14 @@ def test_the_checks_catch_a_page_that_breaks_them(tmp_path, browser):
     res = browser.execute_script(CHECK, MIN_PX)
     assert res["overflow"] > 0 and res["broken"] == ["missing.png"]
     assert [t[1] for t in res["small_text"]] == ["tiny"]
+
+
+def test_the_checks_catch_a_table_that_scrolls_inside_itself(tmp_path, browser):
+    """A table the stylesheet lets scroll (display:block, overflow-x:auto) hides its last
+    columns without scrolling the page: the check counts it as overflow."""
+    cells = "".join(f"<td>a_long_unbroken_cell_{k}</td>" for k in range(40))
+    (tmp_path / "table.html").write_text(
+        '<!DOCTYPE html><html><body><table style="display:block;max-width:100%;'
+        f'overflow-x:auto;white-space:nowrap"><tr>{cells}</tr></table></body></html>')
+    _load(browser, tmp_path / "table.html")
+    assert browser.execute_script(CHECK, MIN_PX)["overflow"] > 0

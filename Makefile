@@ -22,7 +22,7 @@ test: $(STAMP)
 
 # the report includes the measured-data fits when `make fits` has made them
 report: $(STAMP)
-	$(VENV)/bin/microcyl report $(if $(wildcard fits/measured.json),--measured fits)
+	$(VENV)/bin/microcyl report --engine auto $(if $(wildcard fits/measured.json),--measured fits)
 
 # fits of the RGL felts and CUReT fabrics (about 17 min on 2 cores; resumable: run it again)
 fits: $(STAMP)

@@ -52,12 +52,12 @@ from analysis.measuredmodels import fit_folder, models_entry, parse_models, verd
 from analysis.params import ParamSpec, defaults_from_fabric
 from brdf.presets import fabric as preset_fabric
 from gonio import atomic_write, meta_text, plain
-from gonio.curet import read_curet
+from gonio.curet import N_SAMPLES, read_curet
 from gonio.io import read
 from gonio.rgl import load_rgl
 
 __all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir",
-           "fit_measured", "SUMMARY_FILE"]
+           "fit_measured", "SUMMARY_FILE", "curet_sample"]
 
 #: The summary written beside the per-dataset folders by :func:`fit_measured`.
 SUMMARY_FILE = "measured.json"
@@ -120,6 +120,31 @@ MEASURED: dict[str, MeasuredDataset] = {d.name: d for d in (
     _curet(7, "velvet", "velvet"), _curet(42, "corduroy", "velvet"),
     _curet(44, "linen", "linen_plain"), _curet(46, "cotton", "linen_plain"),
 )}
+
+
+def curet_sample(text) -> int:
+    """A CUReT sample number from what a user gives for one: the number (``7``, ``"07"``) or
+    the name of a CUReT dataset of :data:`MEASURED` (``"curet_07_velvet"``, the name
+    ``fit-measured`` prints).
+
+    Examples
+    --------
+    >>> curet_sample("curet_07_velvet"), curet_sample("7"), curet_sample(42)
+    (7, 7, 42)
+    """
+    key = str(text).strip()
+    d = MEASURED.get(key.lower())
+    if d is not None and d.sample is not None:
+        return d.sample
+    try:
+        n = int(key)
+    except ValueError:
+        n = None
+    if n is None or not 1 <= n <= N_SAMPLES or isinstance(text, bool):
+        names = ", ".join(k for k, v in MEASURED.items() if v.sample is not None)
+        raise ValueError(f"CUReT sample {key!r}: must be a number in 1..{N_SAMPLES} or one "
+                         f"of {names}")
+    return n
 
 
 def default_data_dir() -> Path:

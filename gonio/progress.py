@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
+import threading
 
 import tqdm.auto
 
 from gonio.terminal import shown
 
-__all__ = ["progress_bar", "interactive", "progress_line", "LineStream", "PIPE_INTERVAL"]
+__all__ = ["progress_bar", "interactive", "progress_line", "LineStream", "PIPE_INTERVAL",
+           "heartbeat"]
 
 
 def interactive(stream=None) -> bool:
@@ -75,7 +78,8 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
                  initial: int = 0):
     """A tqdm bar (``tqdm.auto``: a widget in notebooks) on stderr that vanishes when closed;
     on a pipe or a file (not :func:`interactive`) one line at the start, one every
-    :data:`PIPE_INTERVAL` seconds and one at the end (:class:`LineStream`).
+    :data:`PIPE_INTERVAL` seconds and one at the end (:class:`LineStream`), each whole: no
+    width is given to tqdm, which then cuts nothing (a log has no columns to fit).
 
     Parameters
     ----------
@@ -99,7 +103,46 @@ def progress_bar(total: int | None, *, desc: str, unit: str, enabled: bool = Tru
     # looked up on each call (not bound at import), so a patched tqdm.auto.tqdm is used
     if enabled and not interactive():
         return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=True,
-                              file=LineStream(sys.stderr), mininterval=PIPE_INTERVAL,
-                              ncols=80)
+                              file=LineStream(sys.stderr), mininterval=PIPE_INTERVAL)
     return tqdm.auto.tqdm(total=total, initial=initial, desc=desc, unit=unit, leave=False,
                           file=sys.stderr, disable=not enabled)
+
+
+@contextlib.contextmanager
+def heartbeat(bar, note: str, interval: float | None = None):
+    """Redraw ``bar`` every ``interval`` seconds (default :data:`PIPE_INTERVAL` on a pipe or
+    a file, 1 s on a terminal) with ``note`` as its postfix while the block runs: a long
+    call that updates nothing (Mitsuba compiling its kernel in the first pass) still
+    writes a line every 10 s on a pipe, its elapsed time in it. Nothing for a disabled bar.
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> bar = tqdm.auto.tqdm(total=1, desc="demo", file=LineStream(out), mininterval=10)
+    >>> import time
+    >>> with heartbeat(bar, "compiling", interval=0.05):
+    ...     time.sleep(0.18)
+    >>> bar.close()
+    >>> sum("compiling" in s for s in out.getvalue().splitlines()) >= 2
+    True
+    """
+    if getattr(bar, "disable", False):
+        yield
+        return
+    if interval is None:
+        interval = PIPE_INTERVAL if not interactive() else 1.0
+    stop = threading.Event()
+    bar.set_postfix_str(shown(note), refresh=False)
+
+    def beat():
+        while not stop.wait(interval):
+            bar.refresh()
+    thread = threading.Thread(target=beat, name="microcyl-heartbeat", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        bar.set_postfix_str("", refresh=False)

@@ -124,3 +124,37 @@ def test_microcyl_fit_to_a_pipe_writes_lines_not_carriage_returns(tmp_path):
         list(range(25, steps + 1, 25))
     assert steps == 75 or "converged" in checks[-1]
     assert all("expected total" in s for s in checks[:-1])
+
+
+def test_a_pipe_line_carries_the_time_a_step_took_measured(monkeypatch, small_fit):
+    """The start's estimate of a step is one batch timed before the run; on a pipe each
+    check's line says the time a step took over the steps run (here made 0.5 s a step by a
+    clock that advances 10 s between the start and the first check of 20 steps)."""
+    lines = []
+    clock = iter([100.0, 110.0, 130.0])
+    monkeypatch.setattr(fit_progress_module, "interactive", lambda: False)
+    monkeypatch.setattr(fit_progress_module, "progress_line", lines.append)
+    monkeypatch.setattr(fit_progress_module.time, "perf_counter", lambda: next(clock))
+    from analysis.fit.driver import FitOptions
+    opts = FitOptions(max_steps=1000, check_every=20)
+    with fit_progress_module.fit_progress(True, opts) as (tick, postfix):
+        postfix({}, _diag(20, 4, [2.0]), False)
+        postfix({}, _diag(40, 8, [2.0]), False)
+    assert "0.5 s a step (measured)" in lines[0]
+    assert "0.75 s a step (measured)" in lines[1]       # 30 s over 40 steps
+    total = int(lines[1].split("expected total ")[1].split(" ")[0])
+    from analysis.budget import format_seconds
+    assert f"about {format_seconds(0.75 * (total - 40))} left" in lines[1]
+
+
+def test_a_bar_on_a_pipe_writes_whole_lines(monkeypatch):
+    """On a pipe tqdm is given no width: a long description is not cut at 80 columns."""
+    import gonio.progress as gp
+    out = io.StringIO()
+    monkeypatch.setattr(gp.sys, "stderr", out)
+    desc = "render cylinder (mitsuba llvm_ad_rgb) with a long name " + "x" * 60
+    with gp.progress_bar(4, desc=desc, unit="section") as bar:
+        bar.update(4)
+    lines = out.getvalue().splitlines()
+    assert lines and all(desc in s for s in lines)
+    assert max(map(len, lines)) > 120 and lines[-1].rstrip().endswith("section/s]")

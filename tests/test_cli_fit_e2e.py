@@ -212,3 +212,27 @@ def test_fit_measured_with_progress_killed_and_resumed(tmp_path, shared_data):
     res = json.loads((out / "curet_07_velvet" / "results.json").read_text())
     assert res["quality"]["albedo_delta_e2000"] == e["albedo_delta_e2000"]
     assert (out / "curet_07_velvet" / "lobes.png").stat().st_size > 1000
+
+
+def test_fit_takes_a_curet_dataset_name_for_sample(tmp_path, shared_data):
+    """``fit abrdf.dat --sample curet_07_velvet`` (the name fit-measured prints) fits sample
+    7, as ``--sample 7`` would: fit_config.json records the number; a name that is no CUReT
+    dataset is refused in one line naming --sample."""
+    table = shared_data / "curet" / "abrdf.dat"
+    out = tmp_path / "fit"
+    p = subprocess.run([sys.executable, "-m", "reports", "fit", str(table), "--sample",
+                        "curet_07_velvet", "--fabric", "velvet", "--free", "gamma_s1",
+                        "--tie", "none", "--max-steps", "20", "--check-every", "10",
+                        "--ensembles", "2", "--no-plots", "--quiet", "-o", str(out)],
+                       cwd=REPO, env=dict(os.environ, PYTHONPATH=str(REPO)),
+                       capture_output=True, timeout=600)
+    assert p.returncode == 0, p.stderr.decode()[-2000:]
+    assert (out / "results.json").is_file()
+    config = json.loads((out / "fit_config.json").read_text())["config"]
+    assert config["extra"]["sample"] == 7
+    bad = subprocess.run([sys.executable, "-m", "reports", "fit", str(table), "--sample",
+                          "curet_07_felt", "--fabric", "velvet", "-o", str(tmp_path / "b")],
+                         cwd=REPO, env=dict(os.environ, PYTHONPATH=str(REPO)),
+                         capture_output=True, timeout=600)
+    err = bad.stderr.decode().strip().splitlines()
+    assert bad.returncode == 2 and "--sample" in err[-1] and "curet_07_velvet" in err[-1]

@@ -234,7 +234,7 @@ def test_a_killed_report_leaves_what_the_next_report_removes(tmp_path):
     the lock over, removes the build folder and writes its own."""
     out = tmp_path / "R"
     proc = subprocess.Popen([sys.executable, "-m", "reports", "report", "--fabric", "velvet",
-                             "--quality", "fast", "--render-engine", "builtin", "--quiet",
+                             "--quality", "fast", "--engine", "builtin", "--quiet",
                              "-o", str(out)], cwd=REPO, env=ENV, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     try:

@@ -133,7 +133,7 @@ def test_interrupt_leaves_no_file(tmp_path, capsys, monkeypatch, workers):
 
 # -- --engine mitsuba ----------------------------------------------------------------------
 @pytest.mark.parametrize("argv, match", [
-    (["--engine", "povray"], "--engine 'povray': must be one of builtin, mitsuba"),
+    (["--engine", "povray"], "--engine 'povray': must be one of auto, builtin, mitsuba"),
     (["--variant", "scalar_rgb"], "--variant: only with --engine mitsuba"),
     (["--max-depth", "3"], "--max-depth: only with --engine mitsuba"),
     (["--engine", "mitsuba", "--max-depth", "0"], "--max-depth 0: must be -1"),
@@ -329,3 +329,44 @@ def test_bad_exposure_is_one_line(tmp_path, capsys, given):
                    "-o", str(tmp_path / "x.exr")])
     assert "--exposure" in _one_line_error(capsys, status)
     assert list(tmp_path.iterdir()) == []
+
+
+# -- one option name, one default: --engine (render and report) ---------------------------
+def _parsed(argv):
+    import argparse
+
+    from reports.cli import model as model_cli, render as render_cli
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers()
+    render_cli.register(sub)
+    model_cli.register(sub)
+    return parser, parser.parse_args(argv)
+
+
+def test_render_and_report_name_the_engine_alike_with_one_default(capsys):
+    from reports.cli.options import DEFAULT_ENGINE
+    _, r = _parsed(["render", "cylinder", "velvet", "-o", "x.png"])
+    _, q = _parsed(["report"])
+    assert r.engine == q.engine == DEFAULT_ENGINE
+    _, q = _parsed(["report", "--engine", "mitsuba"])
+    assert q.engine == "mitsuba"
+
+
+def test_report_render_engine_is_a_hidden_deprecated_alias(capsys):
+    parser, q = _parsed(["report", "--render-engine", "builtin"])
+    assert q.engine == "builtin"
+    assert "--render-engine is deprecated; use --engine" in capsys.readouterr().err
+    sub = next(a for a in parser._actions if a.choices and "report" in a.choices)
+    text = sub.choices["report"].format_help()
+    assert "--engine" in text and "--render-engine" not in text
+
+
+def test_render_engine_auto_takes_the_rule_of_auto_engine(tmp_path, monkeypatch):
+    """``--engine auto`` is resolved by reports.mitsuba.render.auto_engine (here: no
+    Mitsuba, so the built-in engine, which renders)."""
+    from reports.mitsuba import render as mr
+    monkeypatch.setattr(mr, "have_mitsuba", lambda: False)
+    assert mr.auto_engine(__import__("brdf").fabric("velvet")) == "builtin"
+    out = tmp_path / "x.png"
+    assert main(["render", "patch", "velvet", *SMALL, "--engine", "auto", "-o", str(out)]) == 0
+    assert out.is_file()

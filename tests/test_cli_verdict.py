@@ -132,7 +132,7 @@ def test_compare_has_adequacy_and_the_words_of_the_measured_page(measured):
 
 def test_report_of_a_fit_folder_shows_its_fit_section(measured, tmp_path):
     out, _, _ = measured
-    r = microcyl("report", "--fabric", out / VELVET, "--quality", "fast", "--render-engine",
+    r = microcyl("report", "--fabric", out / VELVET, "--quality", "fast", "--engine",
                  "builtin", "-q", "-o", tmp_path / "rep")
     assert r.returncode == 0, r.stderr
     page = (tmp_path / "rep" / f"{VELVET}.html").read_text()

@@ -39,6 +39,9 @@ CHECK = """
 const min = arguments[0], out = {overflow: 0, broken: [], small_text: [], small_fig: []};
 const de = document.documentElement;
 out.overflow = de.scrollWidth - de.clientWidth;
+for (const t of document.querySelectorAll('table')) {   // a table scrolling inside itself
+  if (t.scrollWidth - t.clientWidth > 1) out.overflow = Math.max(out.overflow, t.scrollWidth - t.clientWidth);
+}
 for (const img of document.images) {
   if (!(img.complete && img.naturalWidth > 0)) {
     out.broken.push(img.getAttribute('src')); continue;
@@ -61,13 +64,15 @@ return out;
 """
 
 
-@pytest.fixture(scope="module")
-def report(tmp_path_factory):
+@pytest.fixture(scope="module", params=["default dpi", "fast dpi"])
+def report(request, tmp_path_factory):
     """The pages as the default quality lays them out (its dpi: figure text size), drawn
-    from the fast quality's few samples."""
+    from the fast quality's few samples; and as ``--quality fast`` itself (the quality the
+    tests build: its low dpi must not shrink the figures' text below the limit)."""
     out = tmp_path_factory.mktemp("browser") / "report"
     with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(QUALITIES["fast"], "dpi", QUALITIES["default"]["dpi"])
+        if request.param == "default dpi":
+            mp.setitem(QUALITIES["fast"], "dpi", QUALITIES["default"]["dpi"])
         rep.build_report(["velvet", "polyester_satin_charmeuse",
                           "polyester_satin_charmeuse_back"], out, quality="fast",
                          progress=False, command="microcyl report --quality fast")
@@ -132,3 +137,14 @@ def test_the_checks_catch_a_page_that_breaks_them(tmp_path, browser):
     res = browser.execute_script(CHECK, MIN_PX)
     assert res["overflow"] > 0 and res["broken"] == ["missing.png"]
     assert [t[1] for t in res["small_text"]] == ["tiny"]
+
+
+def test_the_checks_catch_a_table_that_scrolls_inside_itself(tmp_path, browser):
+    """A table the stylesheet lets scroll (display:block, overflow-x:auto) hides its last
+    columns without scrolling the page: the check counts it as overflow."""
+    cells = "".join(f"<td>a_long_unbroken_cell_{k}</td>" for k in range(40))
+    (tmp_path / "table.html").write_text(
+        '<!DOCTYPE html><html><body><table style="display:block;max-width:100%;'
+        f'overflow-x:auto;white-space:nowrap"><tr>{cells}</tr></table></body></html>')
+    _load(browser, tmp_path / "table.html")
+    assert browser.execute_script(CHECK, MIN_PX)["overflow"] > 0

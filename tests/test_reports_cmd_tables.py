@@ -59,6 +59,13 @@ def test_curet_info(shared_data, capsys):
     assert "CUReT sample 44" in out and "rows: 205" in out and "relative" in out
 
 
+def test_curet_info_takes_the_dataset_name(shared_data, capsys):
+    """``--sample curet_44_linen`` (fit-measured's name) reads sample 44."""
+    assert main(["info", str(shared_data / "curet" / "abrdf.dat"), "--sample",
+                 "curet_44_linen"]) == 0
+    assert "CUReT sample 44" in capsys.readouterr().out
+
+
 def test_errors_are_one_line(tmp_path, capsys):
     bad = tmp_path / "bad.csv"
     bad.write_text("theta_i,phi_i,theta_o,phi_o,value\n0,0,0,0,1\n1,2,3\n")

@@ -149,3 +149,44 @@ def test_floor_noise_falls_when_each_path_samples_both_lights(jit):
     assert noise(new) < noise(old) / 4, (noise(new), noise(old))
     diff = luminance(sum(new) / 2)[lit].mean() - luminance(sum(old) / 2)[lit].mean()
     assert abs(diff) < 4 * noise(old) / np.sqrt(lit.sum()) + 0.01 * luminance(old[0])[lit].mean()
+
+
+def test_a_first_pass_that_compiles_writes_heartbeat_lines_on_a_pipe(monkeypatch):
+    """The first pass of a scene compiles the kernel and updates nothing for minutes: on a
+    pipe a line still comes every PIPE_INTERVAL (here 0.05 s), saying what runs; the later
+    passes write none."""
+    import io
+    import time as _time
+
+    import gonio.progress as gp
+    from reports.mitsuba import render as mr
+
+    out = io.StringIO()
+    monkeypatch.setattr(gp.sys, "stderr", out)
+    monkeypatch.setattr(gp, "PIPE_INTERVAL", 0.05)
+
+    class FakeMi:
+        calls = 0
+
+        def render(self, scene, seed, spp):
+            FakeMi.calls += 1
+            _time.sleep(0.3 if FakeMi.calls == 1 else 0.0)
+            return np.ones((2, 3, 3))
+
+    img = mr._render_passes(FakeMi(), ["scene"], [1, 1, 1], 0, (2, 3), True, desc="demo")
+    assert img.shape == (2, 3, 3)
+    lines = out.getvalue().splitlines()
+    beats = [s for s in lines if "compiles the kernel" in s]
+    assert len(beats) >= 3 and all(s.startswith("demo:") for s in beats)
+    assert "compiles the kernel" not in lines[-1] and "3/3" in lines[-1]
+
+
+def test_the_top_row_of_a_cylinder_render_is_not_black(jit):
+    """The cylinder's camera sees the floor up to 140 units away in its top row, past the
+    100-scale rectangle that stood for the infinite floor: that row was black at 640 x 360
+    (all of it; half at 320 x 180). Now it is lit as the rows below it are, as the built-in
+    renderer's infinite plane is."""
+    lum = luminance(mitsuba_render.render_mitsuba("cylinder", "velvet", 640, 360, 1,
+                                                  variant=jit, progress=False))
+    assert np.all(lum[0] > 0)
+    assert lum[0].mean() > 0.9 * lum[2].mean()

@@ -117,3 +117,20 @@ def test_sensor_rays_are_the_builtin_camera_rays(scalar, name):
         # Mitsuba starts the ray at the near clip plane: the origin is on the built-in ray
         off = o_mi - o[0]
         assert np.linalg.norm(off - (off @ d[0]) * d[0]) < 1e-4 * scene.scale, (u, v)
+
+
+@pytest.mark.parametrize("width, height", [(640, 360), (1280, 720), (64, 36)])
+def test_a_floor_reaches_every_point_the_camera_sees_of_it(scalar, width, height):
+    """The rectangle standing for the cylinder scene's infinite floor holds every point the
+    camera's rays through the image's edges hit (the top row's, 140 units away, were past
+    its 100-scale edge: black)."""
+    from reports.render.primitives import Plane
+    scene = make_scene("cylinder")
+    floor = next(p for p in scene.primitives if isinstance(p, Plane))
+    half = scalar._plane_half(floor, scene.camera, width, height, scene.scale)
+    k = np.linspace(0.0, 1.0, 33)
+    o, d = scene.camera.rays(k * width, np.zeros_like(k), width, height)   # the top edge
+    t = (floor.offset - o[:, floor.axis]) / d[:, floor.axis]
+    p = o + t[:, None] * d
+    assert np.all(t > 0) and np.abs(p[:, [0, 2]]).max() > 100 * scene.scale
+    assert np.abs(p[:, [0, 2]]).max() <= half <= scalar.PLANE_REACH

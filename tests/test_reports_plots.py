@@ -417,3 +417,39 @@ def test_lobe_figures_evaluate_each_curve_once():
     assert Counted.pairs == 2 * 7
     y = Lambert().eval(np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]))[0] @ W
     assert np.allclose(axes[1].get_lines()[0].get_ydata()[1:-1], y)
+
+
+def test_hemisphere_x_label_clears_its_colour_bar():
+    """In the report's row of three hemispheres (11 in wide) each disc's x label stays
+    clear of every colour bar (on one line it ran under its own)."""
+    import brdf as _brdf
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from analysis.views import compute_hemisphere
+    from reports.plots.hemisphere import draw_hemisphere
+    from reports.report.page import new_figure
+    fab = _brdf.fabric("velvet")
+    fig, axes = new_figure(3, 1, figsize=(11.0, 3.6))
+    for ax, (ti, phi) in zip(axes, ((45.0, 0.0), (45.0, 90.0), (60.0, 45.0))):
+        draw_hemisphere(compute_hemisphere(fab, ti, phi, 15), ax=ax)
+    FigureCanvasAgg(fig).draw()
+    r = fig.canvas.get_renderer()
+    bars = [a for a in fig.axes if a not in list(axes)]
+    assert len(bars) == 3
+    for ax in axes:
+        label = ax.xaxis.label.get_window_extent(r)
+        assert not any(label.overlaps(b.get_window_extent(r)) for b in bars)
+
+
+def test_a_half_disc_legend_sits_under_the_disc():
+    """The lobes' legend below a half-disc polar plot: within 60 pt of the disc's flat edge,
+    not under the empty lower half of the axes' box."""
+    import brdf as _brdf
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from reports.plots.lobes import plot_lobe_comparison
+    fabs = {n: _brdf.fabric(n) for n in ("velvet", "polyester_satin_charmeuse")}
+    fig, ax = plot_lobe_comparison(fabs, 30, 0, resolution=19)
+    FigureCanvasAgg(fig).draw()
+    r = fig.canvas.get_renderer()
+    edge_y = ax.transData.transform((0.0, 0.0))[1]          # the disc's centre, display px
+    top = ax.get_legend().get_window_extent(r).y1
+    assert 0 < (edge_y - top) * 72.0 / fig.dpi < 60.0

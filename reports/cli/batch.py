@@ -36,7 +36,8 @@ def register(sub):
     cliutil.add_model_arguments(p)
     cliutil.add_fit_options(p)
     p.add_argument("--sample", default=None, metavar="all|N,N,...",
-                   help="CUReT samples of an abrdf.dat input")
+                   help="CUReT samples of an abrdf.dat input: all, or numbers or dataset "
+                        "names (curet_07_velvet), comma-separated")
     p.add_argument("--rgl-step", type=float, default=None, metavar="DEG",
                    help="outgoing-direction step for RGL .bsdf inputs (default the reader's)")
     cliutil.add_cluster_options(p)
@@ -59,7 +60,8 @@ def run(args) -> int:
     free = args.free.split(",") if args.free and not args.free.endswith(".toml") else args.free
     jobs = jobs_from_inputs(
         args.inputs, preset=args.fabric, free=free, ties=cliutil.split_ties(args.tie),
-        spec=args.spec, samples=args.sample, fit=cliutil.fit_kwargs(args),
+        spec=args.spec, samples=cliutil.curet_samples_text(args.sample),
+        fit=cliutil.fit_kwargs(args),
         fabric_options=getattr(fab, "options", {}), model=args.model,
         read_options={} if args.rgl_step is None else {"step": args.rgl_step},
         plots=plots)

@@ -48,8 +48,9 @@ def register(sub):
                                                   ".bsdf, CUReT abrdf.dat with --sample)")
     cliutil.add_model_arguments(p)
     cliutil.add_fit_options(p)
-    p.add_argument("--sample", type=int, default=None, metavar="N",
-                   help="CUReT sample number (for abrdf.dat)")
+    p.add_argument("--sample", type=cliutil.curet_sample_arg, default=None, metavar="N|NAME",
+                   help="CUReT sample (for abrdf.dat): its number (7) or its dataset's name "
+                        "(curet_07_velvet, as fit-measured names it)")
     p.add_argument("--no-plots", action="store_true", help="skip the plots")
     cliutil.add_quiet_options(p)
     p.add_argument("--suggest", action="store_true",

@@ -62,9 +62,7 @@ def register(sub):
                    help="figure and render resolution: default (renders 448 x 252 at 16 "
                         "spp, Mitsuba's 640 x 360), high (1280 x 720, finer figures, "
                         "slower) or fast (previews)")
-    p.add_argument("--render-engine", choices=("auto", "builtin", "mitsuba"), default="auto",
-                   help="renders by Mitsuba 3 (path tracing; auto: where it runs in "
-                        "llvm_ad_rgb) or the built-in renderer (direct light) (auto)")
+    cliutil.add_engine_option(p, "the renders", deprecated=("--render-engine",))
     p.add_argument("--fit", action="append", metavar="FABRIC=RESULTS",
                    help="show a fit's results.json in FABRIC's page (repeatable)")
     p.add_argument("--measured", default=None, metavar="DIR",
@@ -152,7 +150,7 @@ def run_report(args):
     index = build_report(fabrics, args.output, progress=cliutil.progress(args),
                          quality=args.quality,
                          fit_results=fits, measured=args.measured,
-                         render_engine=args.render_engine,
+                         render_engine=args.engine,
                          command=shlex.join(["microcyl", *sys.argv[1:]]))
     labels = [g[0] for g in STANDARD_GEOMETRIES]
     print(f"{'luminance f_r (1/sr)':31s} " + " ".join(f"{lab:>19s}" for lab in labels))

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 import tempfile
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from analysis.families import MICROCYLINDER, family, model_names
 from analysis.fit.driver import MAX_ENSEMBLES, FitOptions  # MAX_ENSEMBLES: re-exported
 from analysis.folderlock import missing_folders, remove_empty_folders
 from analysis.likelihood import KINDS
-from analysis.measured import default_data_dir
+from analysis.measured import curet_sample, default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
 
 __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabric_argument",
@@ -25,7 +26,8 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
            "check_output_suffix", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "add_model_arguments", "start_model", "check_tangent_samples", "reader_options", "read_table",
-           "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES"]
+           "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES", "add_engine_option", "ENGINE_CHOICES",
+           "DEFAULT_ENGINE", "curet_sample_arg", "curet_samples_text"]
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
 MAX_TANGENT_SAMPLES = brdf.MAX_TANGENT_SAMPLES
@@ -119,6 +121,70 @@ def add_quiet_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-q", "--quiet", action="store_true",
                         help="no progress bar and no messages on stderr (warnings and "
                              "errors still)")
+
+
+#: The renderers ``--engine`` names (``render`` and ``report``).
+ENGINE_CHOICES = ("auto", "builtin", "mitsuba")
+#: ``--engine``'s default, the same for every verb that renders.
+DEFAULT_ENGINE = "builtin"
+
+
+class _DeprecatedAlias(argparse.Action):
+    """An old spelling of an option, hidden from --help: sets the new option's value and
+    says on stderr which name to use."""
+
+    def __init__(self, option_strings, dest, new, **kw):
+        self.new = new
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"microcyl: {option_string} is deprecated; use {self.new}", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def add_engine_option(parser: argparse.ArgumentParser, what: str = "the render",
+                      deprecated: tuple[str, ...] = ()) -> None:
+    """``--engine auto|builtin|mitsuba`` (default :data:`DEFAULT_ENGINE`): one name and one
+    default for every verb that renders; ``deprecated`` old spellings still work, hidden."""
+    # no argparse choices: each verb refuses another name in its own one line
+    parser.add_argument("--engine", default=DEFAULT_ENGINE, metavar="ENGINE",
+                        help=f"the engine of {what}: builtin (direct light, NumPy), mitsuba "
+                             f"(Mitsuba 3 path tracing) or auto (mitsuba where it runs in "
+                             f"llvm_ad_rgb and the model is a microcylinder fabric, else "
+                             f"builtin) ({DEFAULT_ENGINE})")
+    for old in deprecated:
+        parser.add_argument(old, dest="engine", new="--engine",
+                            action=_DeprecatedAlias, help=argparse.SUPPRESS)
+
+
+def curet_sample_arg(text: str) -> int:
+    """``--sample``'s type: a CUReT sample number or a CUReT dataset's name
+    (``curet_07_velvet``: :func:`analysis.measured.curet_sample`)."""
+    try:
+        return curet_sample(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def curet_samples_text(text: str | None) -> str | None:
+    """``fit-batch --sample``: ``all`` or comma-separated numbers, the CUReT datasets' names
+    (``curet_07_velvet``) turned into their numbers; anything else passed on as given, for
+    :func:`analysis.batch.jobs.parse_samples` to refuse.
+
+    Examples
+    --------
+    >>> curet_samples_text("2,curet_07_velvet")
+    '2,7'
+    """
+    if text is None or text.strip().lower() == "all":
+        return text
+    out = []
+    for item in text.split(","):
+        try:
+            out.append(str(curet_sample(item)) if item.strip() else item)
+        except ValueError:
+            out.append(item)
+    return ",".join(out)
 
 
 def progress(args: argparse.Namespace) -> bool:

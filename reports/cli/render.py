@@ -62,9 +62,7 @@ def register(sub):
     p.add_argument("--light-radius", type=float, default=None, metavar="R",
                    help="turn the scene's point light into a disc of this radius")
     p.add_argument("--workers", type=int, default=None, help="processes (all cores)")
-    p.add_argument("--engine", default="builtin", metavar="ENGINE",
-                   help="builtin (direct light, NumPy) or mitsuba (Mitsuba 3 path tracing) "
-                        "(builtin)")
+    cliutil.add_engine_option(p)
     p.add_argument("--variant", default=None, metavar="V",
                    help="Mitsuba variant: llvm_ad_rgb, scalar_rgb or cuda_ad_rgb (llvm_ad_rgb "
                         "where LLVM works, else scalar_rgb); --engine mitsuba only")
@@ -77,15 +75,18 @@ def register(sub):
     p.set_defaults(func=run)
 
 
-#: The engines of ``--engine``.
-ENGINES = ("builtin", "mitsuba")
+#: The engines of ``--engine`` (auto: mitsuba where it runs, else builtin).
+ENGINES = cliutil.ENGINE_CHOICES
 
 
 def _engine_options(args, fabric):
-    """Check ``--engine``, ``--variant`` and ``--max-depth``; return the Mitsuba variant and
-    depth (None, None for the built-in engine)."""
+    """Check ``--engine``, ``--variant`` and ``--max-depth`` (``auto`` resolved to an engine,
+    in ``args.engine``, by :func:`reports.mitsuba.render.auto_engine`); return the Mitsuba variant and depth (None,
+    None for the built-in engine)."""
     if args.engine not in ENGINES:
         raise ValueError(f"--engine {args.engine!r}: must be one of {', '.join(ENGINES)}")
+    if args.engine == "auto":
+        args.engine = mitsuba_render.auto_engine(fabric)
     if args.engine == "builtin":
         for name in ("variant", "max_depth"):
             if getattr(args, name) is not None:

@@ -39,7 +39,9 @@ def register(sub):
 
 
 def _reader_options(p):
-    p.add_argument("--sample", type=int, help="CUReT sample number 1..61 (for abrdf.dat)")
+    p.add_argument("--sample", type=cliutil.curet_sample_arg, metavar="N|NAME",
+                   help="CUReT sample (for abrdf.dat): its number 1..61 or its dataset's "
+                        "name (curet_07_velvet)")
     p.add_argument("--step", type=float, help="RGL .bsdf: outgoing grid step in degrees")
     p.add_argument("--stride", type=int, help="MERL .binary: take every STRIDE-th bin")
 

@@ -21,6 +21,7 @@ Mitsuba is optional: this module imports it on use.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.util
 import os
@@ -30,13 +31,13 @@ import sys
 import numpy as np
 
 from brdf.fabric import Fabric
-from gonio.progress import progress_bar
+from gonio.progress import heartbeat, progress_bar
 from reports.mitsuba import plugin
 from reports.mitsuba.plugin import RGB_VARIANTS
 from reports.render.checks import check_size, resolve_fabric, scene_of
 
-__all__ = ["render_mitsuba", "pick_variant", "variant_works", "have_mitsuba", "MISSING",
-           "PASS_SAMPLES"]
+__all__ = ["render_mitsuba", "auto_engine", "pick_variant", "variant_works", "have_mitsuba",
+           "MISSING", "PASS_SAMPLES"]
 
 #: The error of a Mitsuba render without Mitsuba installed.
 MISSING = "--engine mitsuba needs mitsuba (pip install mitsuba)"
@@ -75,6 +76,15 @@ def variant_works(variant: str) -> tuple[bool, str]:
         return True, ""
     lines = p.stderr.strip().splitlines() or [f"exit status {p.returncode}"]
     return False, next((ln for ln in lines if "LLVM" in ln or "CUDA" in ln), lines[-1])
+
+
+def auto_engine(fabric) -> str:
+    """The engine ``--engine auto`` means for ``fabric`` (every verb that renders):
+    ``mitsuba`` where Mitsuba is installed, ``llvm_ad_rgb`` runs and ``fabric`` is a
+    :class:`brdf.fabric.Fabric`, else ``builtin``."""
+    usable = (isinstance(fabric, Fabric) and have_mitsuba()
+              and variant_works("llvm_ad_rgb")[0])
+    return "mitsuba" if usable else "builtin"
 
 
 def pick_variant(variant: str | None = None) -> str:
@@ -224,8 +234,13 @@ def _render_passes(mi, mscenes, passes, seed, shape, progress, desc) -> np.ndarr
                       desc=desc) as bar:
         for j, mscene in enumerate(mscenes):
             for k, n in enumerate(passes):
-                img = mi.render(mscene, seed=(int(seed) * 1000003 + 1009 * j + k) % 2**32,
-                                spp=n)
+                # the first pass compiles the kernel (up to minutes, with no update): a
+                # line every 10 s on a pipe says it is still running
+                beat = (heartbeat(bar, "the first pass compiles the kernel") if k == 0
+                        else contextlib.nullcontext())
+                with beat:
+                    img = mi.render(mscene, seed=(int(seed) * 1000003 + 1009 * j + k) % 2**32,
+                                    spp=n)
                 total += np.asarray(img, dtype=np.float64)[..., :3] * n
                 bar.update()
     return (total / sum(passes)).astype(np.float32)

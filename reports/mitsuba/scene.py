@@ -13,12 +13,13 @@ Mitsuba's first tangent ``dp_du``, which the ``microcylinder`` BSDF takes as the
 - curtain: ``u`` along x over the height field, ``dp_du`` along ``(1, 0, z_x)``;
 - rectangle: Mitsuba's ``rectangle`` turned so that its local +x (its ``dp_du``) is the warp.
 
-Planes become rectangles 100 scene scales across. Cloth is the ``microcylinder`` BSDF, wrapped
-in ``twosided`` on open surfaces (curtain, rectangle: the built-in renderer's cloth is
-two-sided) and one-sided on closed ones (cylinder, sphere), whose inside no ray sees: Mitsuba's
-``twosided`` calls its BSDF once per side, which doubles the kernel that LLVM compiles. (On a
-back face ``twosided`` mirrors the frame to (s, t, -n) where the built-in renderer turns it to
-(warp, -t, -n); the two agree for fabrics symmetric under y -> -y, every preset among them.)
+Planes become rectangles 100 scene scales across, or as far as the camera sees them (up to 5000
+units). Cloth is the ``microcylinder`` BSDF, wrapped in ``twosided`` on open surfaces (curtain,
+rectangle: the built-in renderer's cloth is two-sided) and one-sided on closed ones (cylinder,
+sphere), whose inside no ray sees: Mitsuba's ``twosided`` calls its BSDF once per side, which
+doubles the kernel that LLVM compiles. (On a back face ``twosided`` mirrors the frame to (s, t,
+-n) where the built-in renderer turns it to (warp, -t, -n); the two agree for fabrics symmetric
+under y -> -y, every preset among them.)
 Diffuse surfaces are a two-sided ``diffuse``. Lights: a point light of the same intensity
 (W/sr), a disc light as a ``disk`` area emitter of radiance ``I / (pi r^2)`` facing its
 target, a ``directional`` emitter of the same irradiance. The sky
@@ -189,8 +190,37 @@ def _frame_transform(center, x, y, z):
     return mi.ScalarTransform4f(m.tolist())
 
 
-def _flat(prim, scale):
-    """A Mitsuba ``rectangle`` dictionary for a Rectangle or a (100 scales wide) Plane."""
+#: The farthest a plane's rectangle reaches (scene units): half the sensor's far clip.
+PLANE_REACH = 5e3
+
+
+def _plane_half(prim, camera, width, height, scale) -> float:
+    """Half the side of the rectangle that stands for an infinite Plane: 100 scene scales, or
+    beyond, up to :data:`PLANE_REACH`, far enough to hold every point of the plane the
+    camera sees through the edges of its image (a pinhole looking down at a floor sees it
+    up to near the horizon: the cylinder scene's top row meets it 140 units away, past 100
+    scales, and showed the black beyond its edge)."""
+    half = 100.0 * scale
+    if not isinstance(camera, PinholeCamera):
+        return half
+    k = np.linspace(0.0, 1.0, 65)
+    sx = np.concatenate([k * width, k * width, np.zeros_like(k), np.full_like(k, width)])
+    sy = np.concatenate([np.zeros_like(k), np.full_like(k, height), k * height, k * height])
+    o, d = camera.rays(sx, sy, width, height)
+    dn = d[:, prim.axis]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (prim.offset - o[:, prim.axis]) / dn
+    hit = np.isfinite(t) & (t > 0)
+    if hit.any():
+        p = o[hit] + t[hit, None] * d[hit]
+        p[:, prim.axis] = 0.0
+        half = max(half, 1.05 * float(np.abs(p).max()))
+    return min(half, PLANE_REACH)
+
+
+def _flat(prim, scale, half=None):
+    """A Mitsuba ``rectangle`` dictionary for a Rectangle or a Plane (``half`` the half side
+    of its square, default 100 scales: :func:`_plane_half`)."""
     if isinstance(prim, Plane):
         n = np.zeros(3)
         n[prim.axis] = prim.sign
@@ -198,7 +228,7 @@ def _flat(prim, scale):
         u[(prim.axis + 1) % 3] = 1.0
         c = np.zeros(3)
         c[prim.axis] = prim.offset
-        hx = hy = 100.0 * scale
+        hx = hy = 100.0 * scale if half is None else float(half)
     else:
         c, n, u, _ = prim._axes()
         hx, hy = prim.half_size
@@ -333,7 +363,9 @@ def scene_dict(scene, fabric, width, height, spp, *, seed=0, max_depth=8,
         bsdf = _bsdf(prim, fabric)
         arrays = meshes(prim)
         if arrays is None:
-            out[f"shape{k}"] = {**_flat(prim, scene.scale), "bsdf": bsdf}
+            half = (_plane_half(prim, scene.camera, width, height, scene.scale)
+                    if isinstance(prim, Plane) else None)
+            out[f"shape{k}"] = {**_flat(prim, scene.scale, half), "bsdf": bsdf}
         else:
             out[f"shape{k}"] = _mesh(f"shape{k}", arrays, mi.load_dict(bsdf))
     if scene.environment is not None and lights != "key":

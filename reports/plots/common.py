@@ -84,8 +84,14 @@ def legend_outside(ax, where="right", *, ncol=1, below_pt=34.0, **kw):
     if where == "right":
         return ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=FONT["small"],
                          ncol=ncol, frameon=False, **kw)
-    shift = ax.transAxes + ScaledTranslation(0.0, -below_pt / 72.0, ax.figure.dpi_scale_trans)
-    return ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=shift,
+    anchor, base = (0.5, 0.0), ax.transAxes
+    if ax.name == "polar" and ax.get_thetamax() - ax.get_thetamin() <= 180.0 + 1e-9:
+        # a half disc fills the middle of its square box: under the disc's centre (the
+        # bottom of its flat edge), not under the box, which would leave a gap as high as
+        # the disc's radius between them
+        anchor, base = (0.0, 0.0), ax.transData
+    shift = base + ScaledTranslation(0.0, -below_pt / 72.0, ax.figure.dpi_scale_trans)
+    return ax.legend(loc="upper center", bbox_to_anchor=anchor, bbox_transform=shift,
                      fontsize=FONT["small"], ncol=ncol, frameon=False, **kw)
 
 

@@ -102,7 +102,8 @@ def draw_hemisphere(view: HemisphereView, *, quantity="luminance", log=True, dec
     ax.set_xlim(-1.05, 1.05)
     ax.set_ylim(-1.05, 1.05)
     ax.set_aspect("equal")
-    ax.set_xlabel("x: warp (equal-area disc, 1 = horizon)", fontsize=FONT["label"])
+    # two lines: on one, the label is wider than the disc and runs under the colour bar
+    ax.set_xlabel("x: warp\n(equal-area disc, 1 = horizon)", fontsize=FONT["label"])
     ax.set_ylabel("y: weft", fontsize=FONT["label"])
     ax.tick_params(labelsize=FONT["small"])
     legend_outside(ax, "below", ncol=2)

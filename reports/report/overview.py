@@ -100,7 +100,8 @@ def _masking(p: Page) -> Markup:
                 "{}</section>",
                 p.figure(fig, "masking_terms.png", "M(φ) = max(cos φ, 0) (and P(ψ), the same "
                          "form), the blend u with σu = 20°, and the paired weight M(wi, wo) "
-                         "against φo for φi = 0°, 30°, 60° (MODEL.md)."))
+                         "against φo for φi = 0°, 30°, 60° (the model page of the documentation, "
+                         "docs/guide/model.rst)."))
 
 
 def _reciprocity(reports: list[FabricReport]) -> Markup:

@@ -121,9 +121,11 @@ def png_size(path) -> tuple[int, int]:
 
 def display_width(natural_px: int, font_px: float) -> int:
     """The width (CSS px) a figure is shown at: its smallest text at least
-    :data:`MIN_TEXT_PX` high, and never above its natural size; at most
-    :data:`MAX_DISPLAY_PX`, the width of a page's column at 1400 px (a figure wider than
-    that with text too small shows it below the limit, which the browser test catches).
+    :data:`MIN_TEXT_PX` high (a low-dpi preview, ``--quality fast``, scaled up: blurred
+    but readable, and laid out as the default quality lays it out), and no less than 0.6
+    of its natural size; at most :data:`MAX_DISPLAY_PX`, the width of a page's column at
+    1400 px (a figure wider than that with text too small shows it below the limit, which
+    the browser test catches).
 
     Examples
     --------
@@ -131,8 +133,10 @@ def display_width(natural_px: int, font_px: float) -> int:
     1320
     >>> display_width(920, 22.2)         # one panel: 8 pt text shown at 13.3 px
     552
+    >>> display_width(230, 5.56)         # the same panel at 50 dpi: shown as large
+    538
     """
-    scale = min(1.0, max(MIN_TEXT_PX / font_px, 0.6) if font_px > 0 else 0.6)
+    scale = max(MIN_TEXT_PX / font_px, 0.6) if font_px > 0 else 0.6
     return int(min(round(natural_px * scale), MAX_DISPLAY_PX))
 
 

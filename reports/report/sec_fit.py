@@ -11,6 +11,11 @@ from reports.report.markup import Markup, fmt, html, table
 from reports.report.page import Page
 from reports.report.settings import Section, Unavailable
 
+#: Why the fit section is not built when no fit was given for the fabric (the usual case:
+#: the overview's cards leave it out).
+NO_FIT = ("no fitting results for this fabric (run `microcyl fit` and pass its results.json "
+          "with --fit)")
+
 __all__ = ["FitData", "section_fit"]
 
 _COLUMNS = ("median", "lo68", "hi68", "lo95", "hi95", "tau", "rhat", "ess")
@@ -37,8 +42,7 @@ def section_fit(p: Page) -> Section:
         When no ``results.json`` was given for the fabric, or it cannot be read.
     """
     if p.fit_results is None:
-        raise Unavailable("no fitting results for this fabric (run `microcyl fit` and pass its "
-                          "results.json)")
+        raise Unavailable(NO_FIT)
     try:
         data = read_results(p.fit_results)
     except ValueError as exc:

@@ -37,7 +37,7 @@ from reports.report.page import Page, figure_html
 from reports.report.sec_figures import can_unmask
 from reports.report.settings import Section
 
-__all__ = ["RendersData", "RENDERS", "ENGINES", "section_renders", "render_engine",
+__all__ = ["RendersData", "RENDERS", "ENGINES", "section_renders", "render_engine", "png_bytes",
            "check_engine"]
 
 #: Renders in the report: (file stem, scene, masking, caption).
@@ -62,6 +62,8 @@ class RendersData:
     exposure_reference : float
         The first render's exposure reference: the 99th percentile of max(R, G, B) over its
         cloth's pixels, shown at 0.9.
+    thumbnail : ndarray or None
+        The first render's linear image (the overview's card).
     renders : dict
         File stem -> scene, masking, engine, width, height, spp, sky_spp (built-in),
         exposure (stops), exposure_reference, mean_luminance.
@@ -69,6 +71,9 @@ class RendersData:
 
     exposure_reference: float
     renders: dict
+    #: The first render's linear RGB (height, width, 3) float32, for the overview's card
+    #: (re-exposed there with the other fabrics' at one exposure); not in the summary.
+    thumbnail: Any = dataclasses.field(default=None, compare=False, repr=False)
 
     def summary(self) -> dict[str, Any]:
         """``renders``: the exposure reference and each render's settings."""
@@ -79,6 +84,11 @@ class RendersData:
 def _cloth_mask(scene: str, width: int, height: int) -> np.ndarray:
     """The cloth's coverage of a scene at a size: the same for every fabric."""
     return cloth_coverage(scene, width, height)
+
+
+def png_bytes(img: np.ndarray, exposure: float) -> bytes:
+    """An sRGB PNG of a linear RGB image at ``exposure`` stops (colour-science's sRGB)."""
+    return _png(img, exposure)
 
 
 def _png(img: np.ndarray, exposure: float) -> bytes:
@@ -118,7 +128,7 @@ def render_engine(fabric, choice: str = "auto") -> str:
     if choice == "mitsuba" and not is_fabric:
         raise ValueError("render engine mitsuba renders a brdf.Fabric only")
     if choice == "auto":
-        return "mitsuba" if is_fabric and _mitsuba_usable() else "builtin"
+        return mitsuba_render.auto_engine(fabric)
     return choice
 
 
@@ -140,7 +150,7 @@ def section_renders(p: Page) -> Section:
     engine = render_engine(p.fabric, choice)
     width, height, spp = p.q.get("render_mitsuba" if engine == "mitsuba" else "render") \
         or p.q["render"]
-    out, stats, per_scene = [], {}, {}
+    out, stats, per_scene, thumb = [], {}, {}, None
     for stem, scene, masking, caption in RENDERS:
         fab = p.fabric
         if not masking:
@@ -148,6 +158,8 @@ def section_renders(p: Page) -> Section:
                 continue
             fab = fab.replace(masking=False)
         img = _render(engine, scene, fab, width, height, spp)
+        if thumb is None:
+            thumb = img.astype(np.float32)
         if scene not in per_scene:  # one exposure per scene: masking on and off compare
             per_scene[scene] = auto_exposure(img, _cloth_mask(scene, width, height))
         expo = per_scene[scene]
@@ -165,7 +177,7 @@ def section_renders(p: Page) -> Section:
                        "exposure": expo.stops, "exposure_reference": expo.reference,
                        "mean_luminance": float(luminance(img).mean())}
     first = next(iter(per_scene.values()), None)
-    return Section(join(out), RendersData(first.reference if first else 1.0, stats))
+    return Section(join(out), RendersData(first.reference if first else 1.0, stats, thumb))
 
 
 def _exposure_words(expo, metered="cloth") -> str:

@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import json
 import os
 import re
 import shutil
@@ -31,8 +32,9 @@ import stat
 from pathlib import Path
 
 from gonio.atomic import TEMP_PREFIX, is_temporary, temporary_stem
+from gonio.safeopen import read_bytes
 
-__all__ = ["output_lock", "FolderBusy", "remove_stale_temporaries", "LOCK_NAME",
+__all__ = ["marker_files", "output_lock", "FolderBusy", "remove_stale_temporaries", "LOCK_NAME",
            "REPORT_MARKER", "lock_name", "missing_folders", "remove_empty_folders",
            "refuse_report_folder"]
 
@@ -302,3 +304,18 @@ def output_lock(path, what: str, *, inside: bool = True):
         os.close(dfd)
         if not done:
             remove_empty_folders(created)
+
+
+def marker_files(path, kind: str, max_bytes: int) -> set | None:
+    """The files a folder's marker ``path`` lists (JSON ``{"kind": kind, "files": [...]}``,
+    written by a fit or a report of microcyl); None when it lists none: missing, a link, not
+    a regular file, over ``max_bytes`` bytes, not JSON, or another kind (a marker of an
+    older microcyl, or damaged). Opened once (:func:`gonio.safeopen.read_bytes`)."""
+    try:
+        doc = json.loads(read_bytes(path, max_bytes=max_bytes, what="a marker"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    files = doc.get("files") if isinstance(doc, dict) and doc.get("kind") == kind else None
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+        return None
+    return set(files)

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from analysis.fit.checkpoint import CHECKPOINT_FILE, CONFIG_FILE
 from analysis.fit.loo import LOO_FILE
-from analysis.folderlock import LOCK_NAME, refuse_report_folder
+from analysis.folderlock import LOCK_NAME, marker_files, refuse_report_folder
 from gonio.atomic import atomic_write, is_temporary
 from gonio.terminal import shown
 
@@ -43,20 +43,7 @@ FIT_FILES = STATE_FILES + PLOT_FILES
 
 def _listed(folder: Path) -> set | None:
     """The files the marker of ``folder`` lists; None without a readable marker."""
-    try:
-        fd = os.open(folder / FIT_MARKER, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError:
-        return None
-    try:
-        with os.fdopen(fd, "rb") as fh:
-            data = fh.read(_MARKER_MAX + 1)
-        doc = json.loads(data) if len(data) <= _MARKER_MAX else None
-    except (OSError, ValueError, RecursionError):
-        return None
-    files = doc.get("files") if isinstance(doc, dict) and doc.get("kind") == _KIND else None
-    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
-        return None
-    return set(files)
+    return marker_files(folder / FIT_MARKER, _KIND, _MARKER_MAX)
 
 
 def fit_folder_files(folder) -> set:

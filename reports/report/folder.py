@@ -14,9 +14,8 @@ import os
 import shutil
 from pathlib import Path
 
-from analysis.folderlock import LOCK_NAME, REPORT_MARKER
+from analysis.folderlock import LOCK_NAME, REPORT_MARKER, marker_files
 from gonio.atomic import atomic_write, make_temporary_folder
-from gonio.safeopen import read_bytes
 
 __all__ = ["MARKER", "check_output_dir", "check_report_folder", "swap_into_place",
            "write_file", "write_marker"]
@@ -80,14 +79,7 @@ def _entries(folder: Path) -> tuple[set, set]:
 def _listed(folder: Path) -> set | None:
     """The files the marker of ``folder`` lists; None when it lists none (a marker of an
     older microcyl, or damaged)."""
-    try:            # opened once: no link, FIFO or device; at most _MARKER_MAX bytes
-        doc = json.loads(read_bytes(folder / MARKER, max_bytes=_MARKER_MAX, what="a marker"))
-    except (OSError, ValueError, RecursionError):
-        return None
-    files = doc.get("files") if isinstance(doc, dict) and doc.get("kind") == _KIND else None
-    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
-        return None
-    return set(files)
+    return marker_files(folder / MARKER, _KIND, _MARKER_MAX)
 
 
 def _names(items) -> str:

@@ -30,6 +30,7 @@ from typing import Mapping
 import numpy as np
 
 from analysis.families import family
+from reports.explore.models import APP_CONTROLLED
 
 __all__ = ["PreparedCache", "FastBRDF", "batch_kwargs"]
 
@@ -68,13 +69,11 @@ def batch_kwargs(model_name: str, values: Mapping) -> dict:
     """The keyword arguments of ``prepare(...).eval`` from slider values (scalars or arrays
     of a batch shape B...). The microcylinder's tangent scales and rotation are not among
     them: they change the tangent curves and the frame, which the base fabric holds
-    (``prepare`` is made of it; the explorer's own rotation control rebuilds it)."""
+    (``prepare`` is made of it; the explorer's own rotation control rebuilds it):
+    :data:`reports.explore.models.APP_CONTROLLED`."""
     fam = family(model_name)
-    kw = fam.model_kwargs({k: np.asarray(values[k], float) for k in fam.model_names
-                           if k in values})
-    for name in ("tangent_scale", "rotation"):   # the base fabric's (its curves, its frame)
-        kw.pop(name, None)
-    return kw
+    return fam.model_kwargs({k: np.asarray(values[k], float) for k in fam.model_names
+                             if k in values and k not in APP_CONTROLLED})
 
 
 class FastBRDF:

@@ -89,6 +89,8 @@ class ThreadConsts:
     gv_c: object        # (1 - kd) / (sqrt(2 pi) gamma_v)
     inv_sig: tuple      # 1 / (2 gamma_s), 1 / (2 gamma_v): the sampler's Gaussians, 1/rad
     lobe_p: tuple       # surface, volume, isotropic: the sampler's lobes within the thread
+    inv_eta: object = None   # 1 / eta, 1 / eta^2: the double-precision Fresnel's scales
+    inv_eta2: object = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -155,7 +157,8 @@ def _thread_consts(c, lobe_p, t: Types) -> ThreadConsts:
         tuple(f(a) for a in c.albedo),
         f(shading.gaussian_exponent(gs)), f(shading.gaussian_norm(gs)),
         f(shading.gaussian_exponent(gv)), f(shading.f_rv_coefficients(kd, gv)),
-        (f(0.5 / gs), f(0.5 / gv)), tuple(f(p) for p in lobe_p))
+        (f(0.5 / gs), f(0.5 / gv)), tuple(f(p) for p in lobe_p),
+        f(1.0 / _clamped(c.eta)), f(1.0 / eta2))
 
 
 def _components(plan, thread_p, lobe_p) -> list:

@@ -49,6 +49,14 @@ __all__ = ["SampleGeometry", "sample_geometry", "sample_shading", "thread_axes",
 _K_U = -0.5 / SIGMA_U**2            # u(x) = exp(_K_U x^2)
 _TINY = 2.0 ** -500                 # as brdf.kernel: squares below this may underflow
 _BIG, _SMALL = 2.0 ** 600, 2.0 ** -600
+# Dr.Jit's exp in double precision (drjit/math.h, from Cephes): its least argument, log2(e),
+# ln 2 in two parts, and its rational approximation's coefficients
+_EXP_LO = float.fromhex("-0x1.62b7d369a5aa7p+9")
+_LOG2E = float.fromhex("0x1.71547652b82fep+0")
+_LN2_HI, _LN2_LO = float.fromhex("-0x1.62e4p-1"), float.fromhex("-0x1.7f7d1cf79abcap-20")
+_EXP_P = (float.fromhex("0x1.089cdd5e44be8p-13"), float.fromhex("0x1.f06d10cca2c7ep-6"))
+_EXP_Q = (float.fromhex("0x1.92eb6bc365fap-19"), float.fromhex("0x1.4ae39b508b6cp-9"),
+          float.fromhex("0x1.d17099887e074p-3"))
 
 
 def at(table, i, kind):
@@ -199,15 +207,91 @@ def _fresnel(eta2, eta2m1, c, wide_float: bool):
     return 0.5 * (rs * rs + rp * rp), 2.0 * c * g * (ia * ia + eta2 * (ib * ib))
 
 
+def _exp_parts(x):
+    """(N, D) with exp(x) = N / D, for x <= 0, in double precision: Dr.Jit's own ``exp``
+    (Cody and Waite's reduction x = n ln 2 + r, then the rational approximation
+    e^r = (Q + P) / (Q - P)) without its division, so that several quotients share one
+    (:func:`_quotients`); N = 0 below its least argument (exp would be below 2^-1023)."""
+    xc = dr.maximum(x, _EXP_LO)
+    n = dr.floor(dr.fma(xc, _LOG2E, 0.5))
+    r = dr.fma(n, _LN2_LO, dr.fma(n, _LN2_HI, xc))
+    r2 = r * r
+    r4 = r2 * r2
+    p = r * dr.fma(r4, _EXP_P[0], dr.fma(r2, _EXP_P[1], 1.0))
+    q = dr.fma(r4, dr.fma(r2, _EXP_Q[0], _EXP_Q[1]), dr.fma(r2, _EXP_Q[2], 2.0))
+    kind = type(x)
+    ints = dr.int64_array_t(kind)
+    scale = dr.reinterpret_array(kind, (ints(n) + 1023) << 52)      # 2^n, n >= -1023
+    return dr.select(x < _EXP_LO, 0.0, (q + p) * scale), q - p
+
+
+def _quotients(nums, dens):
+    """nums[i] / dens[i] for every i with one division (of the product of the
+    denominators, each within about [1e-8, 4] here: the product neither over- nor
+    underflows); a few ulps from the quotients taken one by one."""
+    before = [1.0]
+    for d in dens[:-1]:
+        before.append(before[-1] * d)
+    inv = 1.0 / (before[-1] * dens[-1])
+    out, after = [None] * len(nums), inv
+    for i in range(len(nums) - 1, -1, -1):
+        out[i] = nums[i] * before[i] * after
+        after = after * dens[i]
+    return out
+
+
+def _fresnel_parts(th, c):
+    """The numerators and denominators of r_s and r_p at incidence cosine c, scaled by
+    1/eta and 1/eta^2 so that each denominator lies within [1e-8, 2] for any eta > 1
+    (the eta of :data:`brdf.shading.PARAM_CLAMP` included)."""
+    g = dr.sqrt(th.eta2m1 + c * c)
+    gi = g * th.inv_eta2
+    return ((c - g) * th.inv_eta, c - gi), ((c + g) * th.inv_eta, c + gi)
+
+
+def _transmission(rs, rp, c):
+    """1 - F_r from r_s and r_p; exactly 0 at c = 0 (r_s = r_p = -1 there, as NumPy forms
+    them)."""
+    return dr.select(c > 0.0, 1.0 - 0.5 * (rs * rs + rp * rp), 0.0)
+
+
+def _shading_double(th, g: SampleGeometry, transmission: Transmission):
+    """:func:`sample_shading` in double precision with one division a sample: the
+    Fresnel quotients and the two Gaussians' exponentials share it (:func:`_quotients`;
+    the divider is what bounds this kernel)."""
+    cosines = (g.cg,) if transmission is Transmission.HALF_ANGLE else (g.cg, g.ci, g.cr)
+    nums, dens = [], []
+    for c in cosines:
+        n, d = _fresnel_parts(th, c)
+        nums += n
+        dens += d
+    for k in (th.gs_k, th.gv_k):
+        n, d = _exp_parts(g.th2 * k)
+        nums.append(n)
+        dens.append(d)
+    q = _quotients(nums, dens)
+    rs, rp = q[0], q[1]
+    fr = 0.5 * (rs * rs + rp * rp)
+    if transmission is Transmission.HALF_ANGLE:
+        tr = 1.0 - fr
+        ft = dr.select(g.cg > 0.0, tr * tr, 0.0)
+    else:
+        ft = _transmission(q[2], q[3], g.ci) * _transmission(q[4], q[5], g.cr)
+    es, ev = q[-2], q[-1]
+    return fr * (es * th.gs_c) * g.ks, ft * (ev * th.gv_c + th.kd) * g.kv
+
+
 def sample_shading(th, g: SampleGeometry, transmission: Transmission):
     r"""(surface, volume / A) of one tangent sample: :math:`f_{rs}\, k` and
     :math:`(f_{rv}/A)\, k` with k = cos(theta_i) M P / cos^2(theta_d) (1/sr).
 
     ``th`` holds the thread's optical constants (:class:`brdf.jit.consts.ThreadConsts`'
-    ``eta2``, ``eta2m1``, ``kd``, ``gs_k``, ``gs_c``, ``gv_k``, ``gv_c``): opaque values,
-    or one per lane for a batch of parameter sets.
+    ``eta2``, ``eta2m1``, ``inv_eta``, ``inv_eta2``, ``kd``, ``gs_k``, ``gs_c``, ``gv_k``,
+    ``gv_c``): opaque values, or one per lane for a batch of parameter sets.
     """
     wide_float = not dr.is_jit_v(g.cg) or dr.type_v(g.cg) == dr.VarType.Float64
+    if wide_float and dr.is_jit_v(g.cg):
+        return _shading_double(th, g, transmission)
     fr, tr = _fresnel(th.eta2, th.eta2m1, g.cg, wide_float)
     if transmission is Transmission.HALF_ANGLE:
         ft = tr * tr

@@ -159,6 +159,7 @@ class _RowConsts:
         cast = Float32 if single else (lambda v: v)
         self.eta2 = cast(eta * eta)
         self.eta2m1 = cast(eta * eta - 1.0)
+        self.inv_eta, self.inv_eta2 = 1.0 / eta, 1.0 / (eta * eta)
         self.kd = cast(kd)
         self.gs_k, self.gs_c = cast(-0.125 / (gs * gs)), cast(GAUSS_NORM / gs)
         self.gv_k, self.gv_c = cast(-0.125 / (gv * gv)), cast((1.0 - kd) * GAUSS_NORM / gv)
@@ -247,11 +248,12 @@ class PreparedJit:
         out["albedo"] = [tuple(col(par.albedo[:, j], ch) for ch in range(3)) for j in range(2)]
         return out
 
-    def shade(self, x: dict, nb: int, single: bool = False) -> Array3f64:
+    def shade(self, x: dict, nb: int, single: bool = False) -> tuple[Array3f64, UInt32]:
         """f_r (1/sr) of every (pair, parameter set), a lane each (pair-major: the lanes of
         a vector share their pair, and so the geometry they read), from the Dr.Jit arrays
-        ``x`` of :meth:`inputs` (unevaluated: AD may flow through it). With ``single`` the
-        samples are shaded and summed in float32, the threads combined in float64."""
+        ``x`` of :meth:`inputs` (unevaluated: AD may flow through it), and each lane's
+        index (b, c) in the (nb, C) result. With ``single`` the samples are
+        shaded and summed in float32, the threads combined in float64."""
         k, nbo = self.k, opaque(nb, UInt32)
         idx = dr.arange(UInt32, nb * self.size)
         c = idx // nbo
@@ -273,7 +275,7 @@ class PreparedJit:
         zi, zo = dr.gather(Float64, self._zi, c), dr.gather(Float64, self._zo, c)
         a1, a2 = parts[0][0], parts[1][0]
         q = fabric_q(k, sums, zi, zo, (a1, a2, 1.0 - a1 - a2))
-        return _rgb(parts, _inverse_denominator(q, zi))
+        return _rgb(parts, _inverse_denominator(q, zi)), b * self._n + c
 
     def eval(self, par, single: bool = False) -> np.ndarray:
         """f_r (1/sr), shape (nb, C, 3), of the batch ``par`` (checked, gammas in radians);
@@ -281,17 +283,16 @@ class PreparedJit:
         nb = par.eta.shape[0]
         if not self.size:
             return np.zeros((nb, 0, 3))
-        out = self.shade(self.inputs(par), nb, single)
-        dr.eval(out)
-        return self._to_numpy(out, nb)
+        return self._to_numpy(*self.shade(self.inputs(par), nb, single), nb)
 
-    def _to_numpy(self, x, nb) -> np.ndarray:
-        """An evaluated Array3f64 of the lanes (pair-major) as (nb, C, 3), one strided copy
-        a channel."""
-        res = np.empty((nb, self.size, 3))
-        for ch, comp in enumerate((x.x, x.y, x.z)):
-            res[:, :, ch] = np.asarray(comp.numpy()).reshape(self.size, nb).T
-        return res
+    def _to_numpy(self, x, dest, nb) -> np.ndarray:
+        """The Array3f64 ``x`` of :meth:`shade`'s lanes (pair-major), unevaluated, as (nb,
+        C, 3): scattered by the kernel itself (to ``dest``) into one buffer in that order,
+        which NumPy then reads without a transposing copy."""
+        buf = dr.empty(Float64, nb * self.size * 3)
+        dr.scatter(buf, x, dest)            # one packet of three a lane: (b, c, :)
+        dr.eval(buf)
+        return np.asarray(buf.numpy()).reshape(nb, self.size, 3)
 
     def eval_and_grad(self, par) -> tuple[np.ndarray, dict]:
         """f_r (nb, C, 3) and its derivatives by each of :data:`GRAD_PARAMS`, by Dr.Jit's
@@ -315,13 +316,11 @@ class PreparedJit:
                 var = x[name][j] if name == "albedo" else (x[name][j],)
                 for v in var:
                     dr.enable_grad(v)
-                out = self.shade(x, nb)
+                out, dest = self.shade(x, nb)
                 for v in var:
                     dr.set_grad(v, 1.0)
                 dr.forward_to(out)
-                g = dr.grad(out)
-                dr.eval(g)
-                cols.append(self._to_numpy(g, nb))
+                cols.append(self._to_numpy(dr.grad(out), dest, nb))
             scale = math.pi / 180.0 if name.startswith("gamma") else 1.0
             grads[name] = np.stack(cols, axis=-1) * scale
         return f, grads

@@ -276,3 +276,27 @@ def test_workers_get_a_steady_allocator(monkeypatch):
         faults = client.run(_churn_faults)
     assert set(env.values()) == {"65536"}               # the workers did inherit it
     assert max(faults.values()) < 2000, faults        # ~51,000 with Dask's default
+
+
+def _drjit_threads():
+    """In a worker: Dr.Jit's thread count once the brdf kernel has loaded it."""
+    from brdf import jit
+    if not jit.available()[0]:
+        return None
+    import drjit
+    return drjit.thread_count()
+
+
+def test_workers_share_the_cores_among_their_drjit_threads():
+    """N local workers on C cores give Dr.Jit C // N threads each (at least 1), applied when
+    the kernel loads Dr.Jit after the cap was set: N workers x threads <= the cores, where
+    Dr.Jit's default (a thread a core) would run N x C."""
+    from analysis.batch.engine import _client
+    cores = os.cpu_count() or 1
+    with _client(2, None) as client:
+        got = client.run(_drjit_threads)
+    assert len(got) == 2
+    if None in got.values():
+        pytest.skip("Dr.Jit does not run here")
+    assert set(got.values()) == {max(1, cores // 2)}
+    assert sum(got.values()) <= max(cores, 2)

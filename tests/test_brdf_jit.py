@@ -398,3 +398,20 @@ def test_threads_sharing_a_prepared(monkeypatch):
     for g, s in zip(got, serial):
         np.testing.assert_array_equal(g, s)
     assert not np.array_equal(serial[0], serial[2])
+
+
+@needs_drjit
+def test_thread_limit_applies_to_a_loaded_drjit():
+    """limit_threads caps the pool of a Dr.Jit already loaded; None gives back a thread a
+    core; share_cores(N) gives cores // N (at least 1)."""
+    import os
+    import drjit as dr
+    jit.compiled()
+    try:
+        jit.limit_threads(1)
+        assert dr.thread_count() == 1
+        assert jit.share_cores(1) == (os.cpu_count() or 1) == dr.thread_count()
+        assert jit.share_cores(4 * (os.cpu_count() or 1)) == 1 == dr.thread_count()
+    finally:
+        jit.limit_threads(None)
+    assert dr.thread_count() == (os.cpu_count() or 1)

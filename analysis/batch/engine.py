@@ -1,6 +1,7 @@
 """The batch on Dask: :func:`run_batch` submits one task per table and gathers the rows.
 
-By default a ``distributed.LocalCluster`` of one worker process per core, one thread each;
+By default a ``distributed.LocalCluster`` of one worker process per core, one thread each
+(and Dr.Jit's kernels on cores / workers threads each: :func:`brdf.jit.share_cores`);
 with ``scheduler`` the batch runs on an existing cluster (``dask scheduler`` and ``dask
 worker ADDRESS``). Dask reschedules the task of a worker that dies, and the fit resumes from
 the checkpoint in its folder; a task whose workers die three times (Dask's
@@ -25,6 +26,7 @@ from analysis.batch.summary import BatchSummary, check_not_batch_file
 from analysis.batch.worker import error_row, estimate_job, run_job
 from analysis.budget import format_seconds
 from analysis.folderlock import output_lock
+from brdf import jit
 from gonio.progress import progress_bar
 from gonio.safenames import check_component
 from gonio.terminal import shown
@@ -70,6 +72,7 @@ def _client(workers: int | None, scheduler: str | None):
             raise OSError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
         try:
             client.run(steady_allocator)
+            _share_cores(client)
             yield client
         finally:
             client.close()
@@ -81,9 +84,21 @@ def _client(workers: int | None, scheduler: str | None):
         with Client(cluster) as client:
             client.run(_ignore_sigint)
             client.run(steady_allocator)
+            client.run(jit.share_cores, n)
             yield client
     finally:
         cluster.close()
+
+
+def _share_cores(client) -> None:
+    """Each worker of a scheduler caps Dr.Jit's threads at its host's cores over the workers
+    on that host (:func:`brdf.jit.share_cores`): a worker runs one fit at a time, and N
+    workers each with a pool of every core would run N x cores threads."""
+    hosts: dict[str, list[str]] = {}
+    for addr, info in client.scheduler_info()["workers"].items():
+        hosts.setdefault(info.get("host", addr), []).append(addr)
+    for addrs in hosts.values():
+        client.run(jit.share_cores, len(addrs), workers=addrs)
 
 
 def steady_allocator() -> bool:

@@ -19,19 +19,22 @@ the NumPy kernel, so that both backends give the same f_r everywhere (at n . wi 
 flushed sample term had moved f_r by 5%).
 
 This package imports no Dr.Jit: :func:`compiled` loads it on first use (about a second).
+:func:`limit_threads` caps Dr.Jit's pool of worker threads (by default one a core) for a
+process that shares the cores with others: each of N batch workers on C cores takes C // N.
 """
 
 from __future__ import annotations
 
 import functools
 import os
+import sys
 import warnings
 
 import numpy as np
 
-__all__ = ["BackendWarning", "backend", "available", "compiled", "tiny_pairs", "use_jit", "MIN_ELEMENTS", "BACKENDS", "BACKEND_ENV",
-           "MIN_LLVM",
-           "TINY_COMPONENT"]
+__all__ = ["BackendWarning", "backend", "available", "compiled", "tiny_pairs", "use_jit",
+           "limit_threads", "thread_limit", "share_cores", "MIN_ELEMENTS", "BACKENDS",
+           "BACKEND_ENV", "MIN_LLVM", "TINY_COMPONENT"]
 
 #: The kernels ``MICROCYL_BACKEND`` chooses between.
 BACKENDS = ("numpy", "drjit")
@@ -46,6 +49,53 @@ TINY_COMPONENT = 2.0 ** -250
 #: there (velvet, one thread: 1 pair 0.48 ms NumPy against 0.68 ms Dr.Jit, 1,000 pairs
 #: 8.2 against 3.6 ms; 2026-12-07).
 MIN_ELEMENTS = 1 << 14
+_LIMIT: list[int | None] = [None]      # limit_threads' cap, applied when Dr.Jit loads
+
+
+def limit_threads(n: int | None) -> None:
+    """Cap Dr.Jit's worker threads in this process at ``n`` (None: its default, one a
+    core), now if Dr.Jit is loaded, else when :func:`compiled` loads it (this imports no
+    Dr.Jit).
+
+    Raises
+    ------
+    ValueError
+        ``n`` is not None nor an integer >= 1.
+
+    Examples
+    --------
+    >>> limit_threads(1); thread_limit()
+    1
+    >>> limit_threads(None)
+    >>> limit_threads(0)
+    Traceback (most recent call last):
+    ...
+    ValueError: Dr.Jit's thread count must be an integer >= 1 (or None); got 0
+    """
+    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
+        raise ValueError(f"Dr.Jit's thread count must be an integer >= 1 (or None); got {n!r}")
+    _LIMIT[0] = n
+    if "brdf.jit.llvm" in sys.modules:              # loaded already: apply now
+        sys.modules["brdf.jit.llvm"].apply_thread_limit()
+
+
+def thread_limit() -> int | None:
+    """The cap :func:`limit_threads` set (None: Dr.Jit's default)."""
+    return _LIMIT[0]
+
+
+def share_cores(workers: int) -> int:
+    """Run in each of ``workers`` worker processes sharing this machine's cores: caps
+    Dr.Jit's threads at cores // workers (at least 1), so that the workers' kernels do not
+    oversubscribe the cores; returns the cap.
+
+    >>> share_cores(10 ** 6)
+    1
+    >>> limit_threads(None)
+    """
+    n = max(1, (os.cpu_count() or 1) // max(1, int(workers)))
+    limit_threads(n)
+    return n
 
 
 def compiled():

@@ -20,6 +20,7 @@ Imports Dr.Jit at its top: it is imported only through :func:`brdf.jit.compiled`
 from __future__ import annotations
 
 import math
+import os
 import weakref
 
 import numpy as np
@@ -29,6 +30,7 @@ import drjit as dr
 from drjit.llvm.ad import Array3f64, Array4f64, Float32, Float64, UInt32
 from drjit.llvm.ad import Array4f as Array4f32
 
+from brdf import jit
 from brdf.combine import DENOM_MIN
 from brdf.jit.consts import GAUSS_NORM, Consts, Types, consts, opaque
 from brdf.jit.kernel import (SampleGeometry, at, fabric_q, fabric_sums, inverse_rho, loop,
@@ -36,7 +38,7 @@ from brdf.jit.kernel import (SampleGeometry, at, fabric_q, fabric_sums, inverse_
 from brdf.options import Transmission
 from brdf.shading import PARAM_CLAMP, PARAM_CLAMP_32
 
-__all__ = ["TYPES", "probe", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS",
+__all__ = ["TYPES", "probe", "apply_thread_limit", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS",
            "CHUNK_PAIRS"]
 
 #: The kernel's types here: float64 throughout, on the LLVM backend.
@@ -65,6 +67,16 @@ def probe(min_llvm: int) -> tuple[bool, str]:
     if float(dr.sum(x)[0]) != 3.5:
         return False, "a test kernel gave a wrong answer"
     return True, ""
+
+
+def apply_thread_limit() -> None:
+    """Dr.Jit's thread count from :func:`brdf.jit.thread_limit` (None: one a core, Dr.Jit's
+    default)."""
+    n = jit.thread_limit()
+    dr.set_thread_count(n if n is not None else (os.cpu_count() or 1))
+
+
+apply_thread_limit()
 
 
 def plan_consts(plan) -> tuple[Consts, Float64, Float64]:

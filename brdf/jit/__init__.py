@@ -76,7 +76,7 @@ def limit_threads(n: int | None) -> None:
         raise ValueError(f"Dr.Jit's thread count must be an integer >= 1 (or None); got {n!r}")
     _LIMIT[0] = n
     if "brdf.jit.llvm" in sys.modules:              # loaded already: apply now
-        sys.modules["brdf.jit.llvm"].apply_thread_limit()
+        sys.modules["brdf.jit.llvm"].apply_thread_limit(restore=True)
 
 
 def thread_limit() -> int | None:

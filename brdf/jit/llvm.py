@@ -69,11 +69,12 @@ def probe(min_llvm: int) -> tuple[bool, str]:
     return True, ""
 
 
-def apply_thread_limit() -> None:
-    """Dr.Jit's thread count from :func:`brdf.jit.thread_limit` (None: one a core, Dr.Jit's
-    default)."""
+def apply_thread_limit(restore: bool = False) -> None:
+    """Dr.Jit's thread count from :func:`brdf.jit.thread_limit`, where one is set; else,
+    with ``restore``, one a core (Dr.Jit's default), else left as it is."""
     n = jit.thread_limit()
-    dr.set_thread_count(n if n is not None else (os.cpu_count() or 1))
+    if n is not None or restore:
+        dr.set_thread_count(n if n is not None else (os.cpu_count() or 1))
 
 
 apply_thread_limit()

@@ -204,5 +204,12 @@ def tiny_pairs(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     >>> tiny_pairs(w[:1], w[:1]).tolist()
     [False]
     """
-    sub = lambda w: ((w != 0.0) & (np.abs(w) < TINY_COMPONENT)).any(axis=-1)  # noqa: E731
-    return sub(wi) | sub(wo)
+    def sub(w):
+        a = np.abs(w)
+        flag = (a < TINY_COMPONENT) & (a != 0.0)
+        return (flag[:, 0] | flag[:, 1] | flag[:, 2]) if flag.any() else None
+
+    out = [f for f in (sub(wi), sub(wo)) if f is not None]
+    if not out:                     # the usual case, at the cost of one pass
+        return np.zeros(wi.shape[0], dtype=bool)
+    return out[0] | out[-1]

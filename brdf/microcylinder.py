@@ -216,9 +216,11 @@ class FabricForward:
 
     Wraps ``fab.prepare(wi, wo)``; the call takes the keyword arguments of ``prep.eval``
     (each (B..., 2), albedo (B..., 2, 3)) and optionally ``tangent_scale`` (B..., 2), a factor
-    on each thread's tangent offsets, and returns f_r (B..., n, 3) in 1/sr, float64. Scaled
-    curves cannot be prepared once: that slow path rebuilds the fabric and its preparation
-    for every batch row whose factors differ from 1.
+    on each thread's tangent offsets, and ``rotation`` (B..., degrees), and returns f_r
+    (B..., n, 3) in 1/sr, float64. Rotations alone go to :meth:`brdf.Prepared.eval_rotated`
+    (on Dr.Jit one fused kernel, shading in float64 whatever ``dtype``). Scaled curves
+    cannot be prepared once: that slow path rebuilds the fabric and its preparation for
+    every batch row whose factors differ from 1.
 
     ``dtype`` is the precision of the shading (:meth:`brdf.Prepared.eval`): float64 by
     default; :meth:`with_dtype` gives the same model shading in float32.
@@ -244,6 +246,8 @@ class FabricForward:
         same_rot = rotation is None or np.all(np.asarray(rotation) == rot0)
         if same_ts and same_rot:
             return self.prep.eval(**kw)
+        if same_ts:                     # the plan's threads, each set under its rotation
+            return self.prep.eval_rotated(rot0 if rotation is None else rotation, **kw)
         ts = (np.ones(np.shape(rotation) + (2,)) if tangent_scale is None
               else np.asarray(tangent_scale, dtype=np.float64))
         batch = ts.shape[:-1]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -126,6 +127,76 @@ class Prepared:
         out[:, self._bad] = np.nan
         return out.reshape(batch + self.shape + (3,))
 
+    def eval_rotated(self, rotation, *, dtype=np.float64, **params) -> np.ndarray:
+        r"""f_r (1/sr) as :meth:`eval`, each parameter set under its own rotation of both
+        threads about n (the fabric option ``rotation``, here in degrees).
+
+        Parameters
+        ----------
+        rotation : array_like, shape (B...)
+            Degrees, finite; broadcast with the batch of ``params``.
+        dtype : {numpy.float64, numpy.float32}
+            The shading's precision on the NumPy kernel; the Dr.Jit kernel shades these
+            in float64 either way (one fused kernel forms each set's geometry: nothing is
+            prepared per rotation).
+        **params
+            :meth:`eval`'s parameters.
+
+        Returns
+        -------
+        ndarray, shape (B..., n..., 3)
+
+        Raises
+        ------
+        ValueError
+            As :meth:`eval`; or ``rotation`` is not finite or does not broadcast.
+
+        Examples
+        --------
+        >>> import brdf
+        >>> fab = brdf.fabric("velvet")
+        >>> wi = brdf.directions.from_angles(np.radians([10, 40]), 0.3)
+        >>> wo = brdf.directions.from_angles(np.radians([20, 60]), 2.0)
+        >>> f = fab.prepare(wi, wo).eval_rotated([0.0, 30.0])
+        >>> np.allclose(f[1], fab.replace(rotation=np.radians(30.0)).eval(wi, wo), rtol=1e-12)
+        True
+        """
+        dtype = shade_dtype(dtype)
+        par, batch = self._params(*(params.pop(k, None) for k in
+                                    ("eta", "albedo", "kd", "gamma_s", "gamma_v", "area")))
+        if params:
+            raise TypeError(f"eval_rotated got unexpected parameters {sorted(params)}")
+        rot = np.asarray(rotation, dtype=np.float64)
+        if not np.all(np.isfinite(rot)):
+            raise ValueError(f"rotation must be finite (degrees); got {rotation!r}")
+        try:
+            shape = np.broadcast_shapes(batch, rot.shape)
+        except ValueError:
+            raise ValueError(f"rotation of shape {rot.shape} does not broadcast with the "
+                             f"parameters' batch {batch}") from None
+        nb = math.prod(shape)
+        par = ShadeParams(*(np.broadcast_to(a.reshape(batch + a.shape[1:]),
+                                            shape + a.shape[1:]).reshape((nb,) + a.shape[1:])
+                            for a in _arrays(par)))
+        rad = np.radians(np.broadcast_to(rot, shape).reshape(-1))
+        out = np.zeros((nb, self._ok.size, 3))
+        if self._jit is not None and self._exact is None and self._zi.size:
+            out[:, self._ok] = jit.compiled().eval_rotated(self.plan, *self._pairs, par, rad)
+        else:                       # each set's pairs prepared under its rotation
+            for b in range(nb):
+                row = ShadeParams(*(a[b:b + 1] for a in _arrays(par)))
+                plan = dataclasses.replace(self.plan, options=dataclasses.replace(
+                    self.plan.options, rotation=float(rad[b])))
+                out[b:b + 1, self._ok] = Prepared(plan, *self._pairs)._eval_par(row, dtype)
+        out[:, self._bad] = np.nan
+        return out.reshape(shape + self.shape + (3,))
+
+    def _eval_par(self, par: ShadeParams, dtype) -> np.ndarray:
+        """f_r (nb, pairs above the horizon, 3) of the checked batch ``par``."""
+        if self._jit is not None:
+            return self._jit_eval(par, dtype)
+        return self._numpy_eval(par, dtype, None).copy()
+
     def eval_and_grad(self, *, eta=None, albedo=None, kd=None, gamma_s=None, gamma_v=None,
                       area=None) -> tuple[np.ndarray, dict]:
         r"""f_r (1/sr) of the prepared pairs for a batch of parameter sets, as :meth:`eval`
@@ -245,6 +316,11 @@ class Prepared:
             self._geoms32 = [ThreadGeometry(*(None if a is None else _to_float32(a) for a in g))
                              for g in self._geoms]
         return self._geoms32
+
+
+def _arrays(par: ShadeParams) -> list[np.ndarray]:
+    """The arrays of ``par`` in its fields' order (uncopied)."""
+    return [getattr(par, f.name) for f in dataclasses.fields(par)]
 
 
 def _normal(w: np.ndarray) -> np.ndarray:

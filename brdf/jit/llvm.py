@@ -19,6 +19,7 @@ Imports Dr.Jit at its top: it is imported only through :func:`brdf.jit.compiled`
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import weakref
@@ -38,8 +39,8 @@ from brdf.jit.kernel import (SampleGeometry, at, fabric_q, fabric_sums, inverse_
 from brdf.options import Transmission
 from brdf.shading import PARAM_CLAMP, PARAM_CLAMP_32
 
-__all__ = ["TYPES", "probe", "apply_thread_limit", "plan_consts", "eval_pairs", "PreparedJit", "GRAD_PARAMS",
-           "CHUNK_PAIRS"]
+__all__ = ["TYPES", "probe", "apply_thread_limit", "plan_consts", "eval_pairs",
+           "eval_rotated", "PreparedJit", "GRAD_PARAMS", "CHUNK_PAIRS"]
 
 #: The kernel's types here: float64 throughout, on the LLVM backend.
 TYPES = Types(Float64, Float64, UInt32, Array3f64, Array3f64)
@@ -160,11 +161,49 @@ def _eval_chunk(plan, wi, wo, split):
     return np.stack([_numpy(o) for o in outs], axis=1)
 
 
+def eval_rotated(plan, wi: np.ndarray, wo: np.ndarray, par, rotation: np.ndarray):
+    """f_r (1/sr), (nb, C, 3), of unit (C, 3) pairs above the horizon for the batch ``par``
+    (checked, gammas in radians), parameter set b under its own ``rotation[b]`` (radians)
+    of both threads: one fused kernel, a lane a pair and a set (pair-major), its loop over
+    each thread's tangent samples forming the geometry under the lane's rotation and
+    shading it (what ``Fabric.eval`` runs, with a batch's parameters): a fit that frees the
+    rotation prepares nothing per set."""
+    k = plan_consts(plan)[0]
+    nb, size = par.eta.shape[0], wi.shape[0]
+    nbo = opaque(nb, UInt32)
+    idx = dr.arange(UInt32, nb * size)
+    c = idx // nbo
+    b = idx - c * nbo
+    x = PreparedJit.inputs(par)
+    row = lambda a: dr.gather(Float64, a, b)  # noqa: E731
+    light, view = (Array3f64(*(dr.gather(Float64, v, c) for v in _vector(w)))
+                   for w in (wi, wo))
+    rc, rs = (row(Float64(_aligned(f(rotation)))) for f in (np.cos, np.sin))
+    threads = []
+    for j, th in enumerate(k.threads):
+        rcj = _RowConsts(*(row(x[name][j]) for name in ("eta", "kd", "gamma_s", "gamma_v")))
+        threads.append(dataclasses.replace(
+            th, **{name: getattr(rcj, name) for name in _RowConsts.NAMES},
+            area=row(x["area"][j]), albedo=tuple(map(row, x["albedo"][j]))))
+    a1, a2 = threads[0].area, threads[1].area
+    k = dataclasses.replace(k, threads=tuple(threads), gap_area=1.0 - a1 - a2)
+    sums = fabric_sums(k, light, view, rc, rs)
+    inv = _inverse_denominator(fabric_q(k, sums, light.z, view.z), light.z)
+    out = _rgb([(th.area, th.albedo, s[0], s[1]) for th, s in zip(threads, sums)], inv)
+    buf = dr.empty(Float64, nb * size * 3)
+    dr.scatter(buf, out, b * opaque(size, UInt32) + c)
+    dr.eval(buf)
+    return np.asarray(buf.numpy()).reshape(nb, size, 3)
+
+
 class _RowConsts:
     """A thread's optical constants per lane (:class:`brdf.jit.consts.ThreadConsts`' names)
     from its raw parameters per lane (eta, kd, gammas in radians), clamped as the NumPy
     kernel clamps them (:data:`brdf.shading.PARAM_CLAMP`, or ``PARAM_CLAMP_32`` for float32
     shading: formed in float64, then rounded, as :func:`brdf.shading.thread_shade` does)."""
+
+    #: The names :func:`brdf.jit.kernel.sample_shading` reads.
+    NAMES = ("eta2", "eta2m1", "inv_eta", "inv_eta2", "kd", "gs_k", "gs_c", "gv_k", "gv_c")
 
     def __init__(self, eta, kd, gamma_s, gamma_v, single=False):
         clamp = PARAM_CLAMP_32 if single else PARAM_CLAMP

@@ -10,7 +10,7 @@ time; NumPy's kernel has one thread); and a batch with a rotation per set (a fit
 the rotation). The machine and its load average are printed with the figures.
 
 With ``--rst FILE`` the figures are also written as a reStructuredText fragment (the one
-``docs/benchmarks.rst`` includes: ``docs/bench_backend.rst``), its sentences made from the
+``docs/benchmarks.rst`` includes: ``docs/bench_backend.inc``), its sentences made from the
 measured values.
 
 Run: DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so \

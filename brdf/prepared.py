@@ -180,7 +180,7 @@ class Prepared:
                             for a in _arrays(par)))
         rad = np.radians(np.broadcast_to(rot, shape).reshape(-1))
         out = np.zeros((nb, self._ok.size, 3))
-        if self._jit is not None and self._exact is None and self._zi.size:
+        if self._fused(nb):
             out[:, self._ok] = jit.compiled().eval_rotated(self.plan, *self._pairs, par, rad)
         else:                       # each set's pairs prepared under its rotation
             for b in range(nb):
@@ -190,6 +190,16 @@ class Prepared:
                 out[b:b + 1, self._ok] = Prepared(plan, *self._pairs)._eval_par(row, dtype)
         out[:, self._bad] = np.nan
         return out.reshape(shape + self.shape + (3,))
+
+    def _fused(self, nb: int) -> bool:
+        """Whether :meth:`eval_rotated` of ``nb`` sets runs Dr.Jit's fused kernel: the
+        backend is drjit, the sets' (pair, sample) elements make a call worth it, and no
+        pair has a nearly zero component (:func:`brdf.jit.tiny_pairs`)."""
+        if not self._zi.size or self._exact is not None:
+            return False
+        if not jit.use_jit(self.plan, nb * self._zi.size):
+            return False
+        return self._jit is not None or not jit.tiny_pairs(*self._pairs).any()
 
     def _eval_par(self, par: ShadeParams, dtype) -> np.ndarray:
         """f_r (nb, pairs above the horizon, 3) of the checked batch ``par``."""

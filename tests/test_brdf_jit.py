@@ -442,3 +442,22 @@ def test_rotated_batches_agree_with_numpy(monkeypatch, pairs, preset, options):
             ref = with_backend(monkeypatch, "numpy", lambda: turned.prepare(
                 wi[rows], wo[rows]).eval(**row))
             assert_agree(got[b], ref, skip[rows])
+
+
+@needs_drjit
+def test_rotated_batches_of_few_pairs_run_fused(monkeypatch):
+    """A few pairs (too few for Dr.Jit alone, as a CUReT fit's 200) times many sets run the
+    fused kernel, and agree with the per-set NumPy path."""
+    monkeypatch.setattr(jit, "MIN_ELEMENTS", 1 << 14)
+    fab = brdf.fabric("velvet")
+    wi, wo = random_pairs(60, np.random.default_rng(4))
+    rot = np.linspace(-90.0, 90.0, 16)
+    calls = []
+    real = jit.compiled().eval_rotated
+    monkeypatch.setattr(jit.compiled(), "eval_rotated",
+                        lambda *a: calls.append(1) or real(*a))
+    prep = with_backend(monkeypatch, "drjit", lambda: fab.prepare(wi, wo))
+    got = with_backend(monkeypatch, "drjit", lambda: prep.eval_rotated(rot))
+    assert calls                                    # 60 pairs x 16 sets x 40 samples
+    ref = with_backend(monkeypatch, "numpy", lambda: fab.prepare(wi, wo).eval_rotated(rot))
+    assert_agree(got, ref)

@@ -211,10 +211,13 @@ class _RowConsts:
         cast = Float32 if single else (lambda v: v)
         self.eta2 = cast(eta * eta)
         self.eta2m1 = cast(eta * eta - 1.0)
-        self.inv_eta, self.inv_eta2 = 1.0 / eta, 1.0 / (eta * eta)
+        # three divisions a lane (the reciprocals; within PARAM_CLAMP their squares stay
+        # normal numbers), not six: a few ulps from NumPy's quotients
+        ieta, igs, igv = 1.0 / eta, 1.0 / gs, 1.0 / gv
+        self.inv_eta, self.inv_eta2 = ieta, ieta * ieta
         self.kd = cast(kd)
-        self.gs_k, self.gs_c = cast(-0.125 / (gs * gs)), cast(GAUSS_NORM / gs)
-        self.gv_k, self.gv_c = cast(-0.125 / (gv * gv)), cast((1.0 - kd) * GAUSS_NORM / gv)
+        self.gs_k, self.gs_c = cast(-0.125 * (igs * igs)), cast(GAUSS_NORM * igs)
+        self.gv_k, self.gv_c = cast(-0.125 * (igv * igv)), cast((1.0 - kd) * GAUSS_NORM * igv)
 
 
 class _ThreadGeom:

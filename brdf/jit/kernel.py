@@ -260,7 +260,7 @@ def _transmission(rs, rp, c):
 def _shading_double(th, g: SampleGeometry, transmission: Transmission):
     """:func:`sample_shading` in double precision with one division a sample: the
     Fresnel quotients and the two Gaussians' exponentials share it (:func:`_quotients`;
-    the divider is what bounds this kernel)."""
+    four divisions before, with Dr.Jit's own ``exp``)."""
     cosines = (g.cg,) if transmission is Transmission.HALF_ANGLE else (g.cg, g.ci, g.cr)
     nums, dens = [], []
     for c in cosines:

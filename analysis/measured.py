@@ -231,7 +231,8 @@ def measured_spec(name, fab=None):
     """
     d = _dataset(name)
     fab = fab if fab is not None else preset_fabric(d.preset)
-    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties), fab
+    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties,
+                     periods=fab.periods()), fab
 
 
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,

@@ -152,6 +152,22 @@ class MicrocylinderModel:
         return {**thread_values(self), "tangent_scale1": 1.0, "tangent_scale2": 1.0,
                 "rotation": float(np.degrees(self.options["rotation"]))}
 
+    def periods(self) -> dict[str, float]:
+        """The parameters that repeat (degrees): ``rotation``, 180 when every thread's
+        tangent curve is symmetric (unchanged by negating and reversing its offsets and
+        lengths, as linen's (-25, 25)): a half turn then leaves the fabric unchanged; 360
+        otherwise (velvet's pile, (-90, -50), leans one way).
+
+        Examples
+        --------
+        >>> import brdf
+        >>> brdf.fabric("linen_plain").periods(), brdf.fabric("velvet").periods()
+        ({'rotation': 180.0}, {'rotation': 360.0})
+        """
+        sym = all(tuple(-o for o in th.offsets[::-1]) == tuple(th.offsets)
+                  and tuple(th.lengths[::-1]) == tuple(th.lengths) for th in self.threads)
+        return {"rotation": 180.0 if sym else 360.0}
+
     def with_values(self, values: Mapping[str, float]):
         """This fabric with some parameters changed (names of :data:`SCHEMA`; a colour's
         channels not given keep their values; a tangent scale multiplies the offsets; the

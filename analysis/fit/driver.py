@@ -18,6 +18,7 @@ from threadpoolctl import threadpool_limits
 
 from analysis.budget import FIT_BYTES_PER_VALUE, check_memory, format_seconds
 from analysis.fit.checkpoint import FitFolder, table_digest
+from analysis.fit.circular import circular_natural
 from analysis.fit.convergence import Criteria
 from analysis.fit.optimize import optimize_start
 from analysis.fit.posterior import LogPosterior
@@ -147,7 +148,7 @@ def with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
                      defaults={n: p.default for n, p in spec.params.items()}, ties=spec.ties,
                      bounds={n: (p.lo, p.hi) for n, p in spec.params.items()},
                      priors={n: p.prior for n, p in spec.params.items()},
-                     family=spec.family, notes=spec.notes)
+                     family=spec.family, notes=spec.notes, periods=spec.periods)
 
 
 def _check_points(lik: Likelihood, ndim: int):
@@ -390,7 +391,8 @@ def _result(spec, lik, logpost, opts, sampler, out, best, best_logp, timing) -> 
                   evals_per_s=out.evals / out.sample_s if out.sample_s > 0 else float("nan"),
                   ess_per_s=ess_min / out.sample_s if out.sample_s > 0 else float("nan"))
     return FitResult(
-        names=spec.free, units=spec.units, chains=spec.to_natural(diag.chains),
+        names=spec.free, units=spec.units,
+        chains=circular_natural(spec, spec.to_natural(diag.chains)),
         chains_internal=diag.chains, log_prob=diag.log_prob, summary=summary,
         converged=out.converged, reason=out.reason, steps=diag.step, burn=diag.burn,
         walkers=opts.walkers, ensembles=opts.ensembles,

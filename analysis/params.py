@@ -268,6 +268,15 @@ class ParamSpec:
             new.params[k] = dataclasses.replace(new.params[k], default=float(v))
         return new
 
+    def with_free(self, names) -> "ParamSpec":
+        """A copy with ``names`` freed as well: bounds, priors, defaults, ties, notes and
+        periods kept."""
+        ps = self.params.values()
+        return ParamSpec(list(self.free) + list(names), defaults={p.name: p.default for p in ps},
+                         bounds={p.name: (p.lo, p.hi) for p in ps},
+                         priors={p.name: p.prior for p in ps}, ties=self.ties,
+                         family=self.family, notes=self.notes, periods=self.periods)
+
     def with_periods(self, periods: Mapping[str, float]) -> "ParamSpec":
         """A copy with the periods ``periods`` (name -> period, natural units) added."""
         new = object.__new__(ParamSpec)

@@ -14,8 +14,10 @@ parameter, its results and the command line are in degrees: warp along (cos rho,
 counter-clockwise from +x toward +y). Its search range and prior are uniform on [-90, 90]
 degrees: a fabric whose tangent curves are symmetric (unchanged by negating and reversing
 the offsets: four presets' threads; not velvet's pile nor the satin back's first thread) is
-unchanged by a half turn, so [-90, 90] holds every orientation of it; rotating by 90 degrees
-swaps the roles of the two threads. Any finite angle is valid (a ``--spec`` file's
+unchanged by a half turn, so [-90, 90] holds every orientation of it, once
+(:meth:`MicrocylinderModel.periods`; a fit summarizes such a rotation as an angle on a circle,
+:mod:`analysis.fit.circular`, so that -90 and +90 are one orientation, not two bounds);
+rotating by 90 degrees swaps the roles of the two threads. Any finite angle is valid (a ``--spec`` file's
 ``[bounds]`` may widen the range to [-180, 180] for an asymmetric fabric). Search ranges, units and priors
 are the schema's (log-uniform where its
 range spans decades); a thread parameter's plausible range is its row's (its typical range

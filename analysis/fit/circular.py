@@ -54,11 +54,11 @@ def unwrap(x, period: float, lo: float) -> np.ndarray:
     return y + (lo + np.mod(med - lo, period) - med)
 
 
-def circular_natural(spec, natural) -> np.ndarray:
-    """Natural draws (..., ndim) of ``spec``'s free parameters with every circular one
-    (``spec.period(name)`` not None) unwrapped over all its draws (:func:`unwrap`); the other
-    columns unchanged."""
-    out = np.array(natural, dtype=np.float64, copy=True)
+def circular_natural(spec, internal) -> np.ndarray:
+    """The natural values of internal draws (..., ndim) of ``spec``'s free parameters, every
+    circular one (``spec.period(name)`` not None) unwrapped over all its draws
+    (:func:`unwrap`); the other columns as ``spec.to_natural`` gives them."""
+    out = spec.to_natural(internal)
     for i, name in enumerate(spec.free):
         period = spec.period(name)
         if period is not None:

@@ -222,7 +222,7 @@ def _num(value) -> str:
 def summarize(spec, diag) -> dict:
     """Per free parameter: median, 68% / 95% intervals (natural units), tau, N/tau, R-hat, ESS
     and unit, from a :class:`~analysis.fit.convergence.Diagnosis`."""
-    natural = circular_natural(spec, spec.to_natural(diag.chains))   # one mode across a wrap
+    natural = circular_natural(spec, diag.chains)     # one mode across a wrap
     summ = diagnostics.interval_summary(natural)
     ess = diagnostics.ess(diag.chains, diag.taus)
     out = {}

@@ -9,7 +9,9 @@ exp(2 pi i x / period)) before anything is summarized: the median, the 68% and 9
 the sd, the correlations and the plots see one continuous mode. All draws are then shifted by
 the whole periods that bring the median into [lo, lo + period); the intervals go with it, so
 that an interval about a mode at the wrap may cross a bound by less than half a period
-(``rotation`` -89.5, 95% interval [-92.0, -87.1] degrees), and no bound is reported reached.
+(draws of N(-89.4, 1) degrees held in [-90, 90], 28% of them at the +90 end: median -89.42,
+95% interval [-91.34, -87.43], where the plain percentiles give -88.64 [-89.93, 89.93]), and
+no bound is reported reached.
 
 Examples
 --------

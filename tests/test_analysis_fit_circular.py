@@ -105,3 +105,12 @@ def test_a_satin_turned_to_the_wrap_is_recovered_without_a_bound_warning(tmp_pat
                 and "rotation" in w["parameters"]], r.warnings
     median = r.spec.to_natural(r.median_internal())[0]
     assert abs((median - 89.7 + 90.0) % 180.0 - 90.0) < 1.0
+
+
+def test_the_measured_datasets_rotation_is_circular_where_the_preset_repeats():
+    """polyester's satin is symmetric under a half turn (its -90 and +90 are one orientation);
+    velvet's pile is not, so its [-90, 90] is an interval with two real bounds."""
+    from analysis.measured import measured_spec
+    assert measured_spec("curet_02_polyester")[0].period("rotation") == 180.0
+    assert measured_spec("curet_44_linen")[0].period("rotation") == 180.0
+    assert measured_spec("curet_07_velvet")[0].period("rotation") is None

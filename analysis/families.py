@@ -121,6 +121,12 @@ class ModelFamily:
         """Every model parameter's value in the model object ``obj`` (natural units)."""
         return obj.values()
 
+    def periods(self, obj) -> dict[str, float]:
+        """The parameters of the model object ``obj`` that are angles repeating with a
+        period (natural units): its ``periods()`` (a fabric's ``rotation``), or none."""
+        get = getattr(obj, "periods", None)
+        return dict(get()) if callable(get) else {}
+
     def model_kwargs(self, values: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """The keyword arguments of the model's forward model from every parameter's
         natural values (arrays B...): the class's ``batch_kwargs``."""

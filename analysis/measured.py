@@ -46,7 +46,7 @@ import numpy as np
 from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
 from analysis.folderlock import output_lock
-from analysis.families import MICROCYLINDER
+from analysis.families import MICROCYLINDER, family_of
 from analysis.measuredjson import load_measured_json
 from analysis.measuredmodels import fit_folder, models_entry, parse_models, verdict_warnings
 from analysis.params import ParamSpec, defaults_from_fabric
@@ -231,7 +231,8 @@ def measured_spec(name, fab=None):
     """
     d = _dataset(name)
     fab = fab if fab is not None else preset_fabric(d.preset)
-    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties), fab
+    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties,
+                     periods=family_of(fab).periods(fab)), fab
 
 
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,

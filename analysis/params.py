@@ -143,6 +143,10 @@ class ParamSpec:
         and forward-model arguments. Default the microcylinder.
     notes : sequence of str, optional
         Sentences on the choices made for identifiability (written to ``results.json``).
+    periods : mapping name -> float, optional
+        Angles whose model repeats every ``period`` (natural units), from the model object
+        (:meth:`analysis.families.ModelFamily.periods`: a fabric's ``rotation``, 180 or 360
+        degrees); a parameter whose range holds a whole period is circular (:meth:`period`).
 
     Raises
     ------
@@ -167,10 +171,12 @@ class ParamSpec:
     def __init__(self, free, defaults: Mapping[str, float] | None = None, ties=None,
                  bounds: Mapping[str, Sequence[float]] | None = None,
                  priors: Mapping[str, str] | None = None,
-                 family: ModelFamily | str | None = None, notes: Sequence[str] = ()):
+                 family: ModelFamily | str | None = None, notes: Sequence[str] = (),
+                 periods: Mapping[str, float] | None = None):
         fam = _family(family)
         self.family = fam
         self.notes = tuple(notes)
+        self.periods = {str(k): float(v) for k, v in (periods or {}).items()}
         defaults = checked_defaults(defaults, fam)
         bounds, priors = checked_bounds(bounds, fam), checked_priors(priors, fam)
         free = list(parse_free(free, fam))
@@ -261,6 +267,39 @@ class ParamSpec:
                 raise unknown(k, cat=self.family)
             new.params[k] = dataclasses.replace(new.params[k], default=float(v))
         return new
+
+    def with_free(self, names) -> "ParamSpec":
+        """A copy with ``names`` freed as well: bounds, priors, defaults, ties, notes and
+        periods kept."""
+        ps = self.params.values()
+        return ParamSpec(list(self.free) + list(names), defaults={p.name: p.default for p in ps},
+                         bounds={p.name: (p.lo, p.hi) for p in ps},
+                         priors={p.name: p.prior for p in ps}, ties=self.ties,
+                         family=self.family, notes=self.notes, periods=self.periods)
+
+    def with_periods(self, periods: Mapping[str, float]) -> "ParamSpec":
+        """A copy with the periods ``periods`` (name -> period, natural units) added."""
+        new = object.__new__(ParamSpec)
+        new.__dict__.update(self.__dict__)
+        new.periods = {**self.periods, **{str(k): float(v) for k, v in periods.items()}}
+        return new
+
+    def period(self, name: str) -> float | None:
+        """The period of a circular parameter: its model repeats every ``periods[name]`` and
+        its range [lo, hi] holds at least one whole period (a fabric's ``rotation`` on [-90,
+        90] degrees, symmetric under a half turn); None otherwise, and for a log prior.
+
+        Examples
+        --------
+        >>> spec = ParamSpec("rotation", periods={"rotation": 180.0})
+        >>> spec.period("rotation"), spec.with_periods({"rotation": 360.0}).period("rotation")
+        (180.0, None)
+        """
+        period = self.periods.get(name)
+        p = self.params.get(name)
+        if period is None or p is None or p.is_log or not period > 0:
+            return None
+        return period if p.hi - p.lo >= period * (1.0 - 1e-9) else None
 
     def to_natural(self, theta) -> np.ndarray:
         """Internal (..., ndim) -> natural values of the free parameters (..., ndim)."""

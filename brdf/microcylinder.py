@@ -14,8 +14,10 @@ parameter, its results and the command line are in degrees: warp along (cos rho,
 counter-clockwise from +x toward +y). Its search range and prior are uniform on [-90, 90]
 degrees: a fabric whose tangent curves are symmetric (unchanged by negating and reversing
 the offsets: four presets' threads; not velvet's pile nor the satin back's first thread) is
-unchanged by a half turn, so [-90, 90] holds every orientation of it; rotating by 90 degrees
-swaps the roles of the two threads. Any finite angle is valid (a ``--spec`` file's
+unchanged by a half turn, so [-90, 90] holds every orientation of it, once
+(:meth:`MicrocylinderModel.periods`; a fit summarizes such a rotation as an angle on a circle,
+:mod:`analysis.fit.circular`, so that -90 and +90 are one orientation, not two bounds);
+rotating by 90 degrees swaps the roles of the two threads. Any finite angle is valid (a ``--spec`` file's
 ``[bounds]`` may widen the range to [-180, 180] for an asymmetric fabric). Search ranges, units and priors
 are the schema's (log-uniform where its
 range spans decades); a thread parameter's plausible range is its row's (its typical range
@@ -151,6 +153,22 @@ class MicrocylinderModel:
         the rotation in degrees."""
         return {**thread_values(self), "tangent_scale1": 1.0, "tangent_scale2": 1.0,
                 "rotation": float(np.degrees(self.options["rotation"]))}
+
+    def periods(self) -> dict[str, float]:
+        """The parameters that repeat (degrees): ``rotation``, 180 when every thread's
+        tangent curve is symmetric (unchanged by negating and reversing its offsets and
+        lengths, as linen's (-25, 25)): a half turn then leaves the fabric unchanged; 360
+        otherwise (velvet's pile, (-90, -50), leans one way).
+
+        Examples
+        --------
+        >>> import brdf
+        >>> brdf.fabric("linen_plain").periods(), brdf.fabric("velvet").periods()
+        ({'rotation': 180.0}, {'rotation': 360.0})
+        """
+        sym = all(tuple(-o for o in th.offsets[::-1]) == tuple(th.offsets)
+                  and tuple(th.lengths[::-1]) == tuple(th.lengths) for th in self.threads)
+        return {"rotation": 180.0 if sym else 360.0}
 
     def with_values(self, values: Mapping[str, float]):
         """This fabric with some parameters changed (names of :data:`SCHEMA`; a colour's

@@ -1,4 +1,14 @@
-"""CUReT BRDF measurements (Dana et al. 1999): ``abrdf.dat`` + ``table.txt``."""
+"""CUReT BRDF measurements (Dana et al. 1999): ``abrdf.dat`` + ``table.txt``.
+
+The geometry, as the files give it: camera and lamp lie in one plane with the sample, 22.5 to
+157.5 degrees apart in steps of 22.5; 31 pairs of configurations are each other's image in the
+mirror x -> -x with light and view exchanged (within 0.004 rad), where a reciprocal fabric
+symmetric under that mirror has equal values: over the 61 samples the log ratio of such pairs
+does not follow log(cos theta_i) (median slope 0.01), so the values are f_r up to a scale,
+without a cos(theta_i) factor. In this geometry a pair whose half vector leans to -x is one
+whose view is more oblique than its light (93 of 93), and to +x one whose light is more
+oblique (84 of 84) (tests/test_gonio_curet.py).
+"""
 
 from __future__ import annotations
 
@@ -71,6 +81,7 @@ def read_curet(folder, sample: int) -> Table:
     lies at an exact mirror pair (theta_v = theta_i = 79 degrees, phi_v = phi_i + 180) and the
     next three within 15 degrees of the mirror direction, as they must when both azimuths
     are measured in one frame and one sense.
+    The geometry the angles make is in the module notes.
     What the files do not give is where the sample's warp points in that frame, nor
     whether phi turns counter-clockwise seen from above: a fit frees the fabric's
     ``rotation`` for that (a turned frame moves the fitted rotation by the turn; a mirrored

@@ -100,6 +100,8 @@ def test_regions_split_by_geometry():
     # the specular pair's half vector is the normal: no plane, no side
     assert split("warp_weft") == [[False, True, True, False], [False, False, False, True]]
     assert split("left_right") == [[False, False, False, False], [False, True, True, False]]
+    # only the grazing pair has theta_i (70) and theta_o (20) apart
+    assert split("light_view") == [[False, False, True, False], [False, False, False, False]]
 
 
 def _fit(table, model_fab, free, seed=0, **kw):
@@ -139,7 +141,8 @@ def test_a_model_that_fits_is_adequate_and_a_wrong_one_is_misfit():
     a = good.adequacy
     assert a["adequate"] is True and a["alpha"] == ALPHA
     assert set(a["tests"]) == {"distribution", "chi_square", "region_forward_back",
-                               "region_warp_weft", "region_grazing_normal", "region_left_right"}
+                               "region_warp_weft", "region_grazing_normal", "region_left_right",
+                               "region_light_view"}
     assert all(v["p_holm"] >= ALPHA for v in a["tests"].values())
     assert 0.8 < a["rms_normal_score"] < 1.2
     assert not any(w["kind"] == "misfit" for w in good.warnings)

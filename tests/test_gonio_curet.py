@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+import brdf
 import gonio
 
 
@@ -71,3 +72,47 @@ def test_azimuths_are_in_one_frame_and_sense(shared_data):
     mirror = t.wi[k] * np.array([-1.0, -1.0, 1.0])
     np.testing.assert_allclose(t.wo[k], mirror, atol=1e-6)
     assert t.wi[k, 0] ** 2 + t.wi[k, 1] ** 2 > 0.5        # away from the normal: phi matters
+
+
+def _mirror_swap_pairs(t):
+    """(k, j): configuration j is k mirrored in x -> -x with light and view exchanged; k the
+    one whose half vector leans to -x."""
+    m = np.array([-1.0, 1.0, 1.0])
+    h = t.wi + t.wo
+    out = []
+    for k in range(len(t.wi)):
+        d = np.linalg.norm(t.wo - t.wi[k] * m, axis=1) + np.linalg.norm(t.wi - t.wo[k] * m, axis=1)
+        j = int(np.argmin(d))
+        if d[j] < 0.02 and k < j:
+            out.append((k, j) if h[k, 0] < h[j, 0] else (j, k))
+    return np.array(out)
+
+
+def test_left_right_is_light_against_view_and_the_values_are_reciprocal(shared_data):
+    """The docstring's account of CUReT's geometry, and the reason the left/right residual
+    pattern of the microcylinder's fits is its non-reciprocity (docs/guide/measured.rst)."""
+    t = gonio.read_curet(shared_data / "curet", 44)
+    ti, tv = np.arccos(t.wi[:, 2]), np.arccos(t.wo[:, 2])
+    h = t.wi + t.wo
+    h /= np.linalg.norm(h, axis=1, keepdims=True)
+    left, right = h[:, 0] <= -np.sin(np.radians(5)), h[:, 0] >= np.sin(np.radians(5))
+    assert (left.sum(), right.sum()) == (93, 84)
+    assert np.all(tv[left] > ti[left]) and np.all(ti[right] > tv[right])
+    phase = np.degrees(np.arccos(np.sum(t.wi * t.wo, axis=1)))
+    np.testing.assert_allclose(np.sort(np.unique(np.round(phase, 1))), 22.5 * np.arange(1, 8))
+    pairs = _mirror_swap_pairs(t)
+    assert len(pairs) == 31
+    # no cos(theta_i) factor in the values: the log ratio of a pair does not follow it
+    data = np.loadtxt(shared_data / "curet" / "abrdf.dat")[:, 1:]
+    k, j = pairs.T
+    x = np.log(t.wi[k, 2] / t.wi[j, 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        y = np.log(data[:, k] / data[:, j])
+    ok = np.all(np.isfinite(y), axis=1)
+    slopes = (y[ok] @ x) / (x @ x)
+    assert abs(np.median(slopes)) < 0.1            # 1 were the values f_r cos(theta_i)
+    # linen's pairs agree within 10% on average; the linen preset's differ by a factor 2.3
+    v = t.values[:, 0]
+    assert abs(np.mean(np.log(v[k] / v[j]))) < 0.1
+    f = brdf.fabric("linen_plain").eval(t.wi, t.wo).mean(axis=-1)
+    assert np.mean(np.log(f[k] / f[j])) < -0.8

@@ -26,8 +26,12 @@ with the distribution the likelihood (:mod:`analysis.likelihood`) assumes for th
   scatter (cos(phi_o - phi_i) < 0 or > 0, both directions at least 5 degrees off the normal),
   warp plane against weft plane (the half vector h nearer the x-z or the y-z plane), grazing
   against near-normal (theta_i or theta_o >= 60 degrees, or both below), left against right
-  (h_x < 0 or > 0). The warp/weft split leaves out pairs whose h is within 5 degrees of the
-  normal, the left/right split those within 5 degrees of the y-z plane. A split with fewer
+  (h_x < 0 or > 0), light against view more oblique (theta_i > theta_o + 2 degrees, or
+  theta_o > theta_i + 2 degrees: a model that is not reciprocal, as the microcylinder is
+  not, fitted to reciprocal data misses the two sides in opposite senses; in CUReT's
+  geometry this split and the left/right one are the same pairs). The warp/weft split leaves
+  out pairs whose h is within 5 degrees of the normal, the left/right split those within 5
+  degrees of the y-z plane. A split with fewer
   than :data:`MIN_REGION` points on a side is skipped.
 - ``noise``: where the noise is fitted, its level exp(log_noise) (median, 95% interval)
   against the table's own sigma in the same space (the median of sigma_y), as their ratio.
@@ -63,6 +67,8 @@ MIN_VALUES = 20
 POLE_DEG = 5.0
 #: Grazing: theta_i or theta_o at least this (degrees).
 GRAZING_DEG = 60.0
+#: Light or view "more oblique": theta_i and theta_o at least this far apart (degrees).
+OBLIQUE_DEG = 2.0
 
 
 def normal_scores(result, theta, table_sigma_only: bool = False) -> np.ndarray:
@@ -133,6 +139,8 @@ def regions(wi, wo) -> dict[str, tuple[str, str, np.ndarray, np.ndarray]]:
     h_off = np.hypot(h[:, 0], h[:, 1]) >= sin_pole      # a half vector with an azimuth
     hx, hy = np.abs(h[:, 0]), np.abs(h[:, 1])
     cos_graze = np.cos(np.radians(GRAZING_DEG))
+    ti, to = (np.arccos(np.clip(w[:, 2], -1.0, 1.0)) for w in (wi, wo))
+    tilt = np.radians(OBLIQUE_DEG)
     grazing = (wi[:, 2] <= cos_graze) | (wo[:, 2] <= cos_graze)
     return {
         "forward_back": ("forward scatter", "back scatter", off_pole & (dot < 0),
@@ -141,6 +149,8 @@ def regions(wi, wo) -> dict[str, tuple[str, str, np.ndarray, np.ndarray]]:
         "grazing_normal": ("grazing", "near-normal", grazing, ~grazing),
         "left_right": ("left (h_x < 0)", "right (h_x > 0)", h[:, 0] <= -sin_pole,
                        h[:, 0] >= sin_pole),
+        "light_view": ("light more oblique", "view more oblique", ti > to + tilt,
+                       to > ti + tilt),
     }
 
 

@@ -18,6 +18,7 @@ from threadpoolctl import threadpool_limits
 
 from analysis.budget import FIT_BYTES_PER_VALUE, check_memory, format_seconds
 from analysis.fit.checkpoint import FitFolder, table_digest
+from analysis.fit.circular import circular_natural
 from analysis.fit.convergence import Criteria
 from analysis.fit.optimize import optimize_start
 from analysis.fit.posterior import LogPosterior
@@ -143,11 +144,7 @@ def with_nuisance(spec: ParamSpec, lik: Likelihood) -> ParamSpec:
         extra.append("scale")
     if not extra:
         return spec
-    return ParamSpec(list(spec.free) + extra,
-                     defaults={n: p.default for n, p in spec.params.items()}, ties=spec.ties,
-                     bounds={n: (p.lo, p.hi) for n, p in spec.params.items()},
-                     priors={n: p.prior for n, p in spec.params.items()},
-                     family=spec.family, notes=spec.notes)
+    return spec.with_free(extra)
 
 
 def _check_points(lik: Likelihood, ndim: int):
@@ -331,7 +328,8 @@ def _for_sampling(logpost: LogPosterior, model, opts: FitOptions) -> LogPosterio
 def _check_start(spec: ParamSpec, best, best_logp: float, notify=None) -> None:
     """A point estimate the walkers can start from, or a ValueError saying what to change;
     ``notify`` is told of parameters that ended on a bound."""
-    at_bound = [n for n, u in zip(spec.free, best) if abs(u) >= 0.99 * INTERNAL_LIMIT]
+    at_bound = [n for n, u in zip(spec.free, best)      # a circular one has no bound
+                if abs(u) >= 0.99 * INTERNAL_LIMIT and spec.period(n) is None]
     if notify is not None and at_bound:
         notify(f"fit: the point estimate lies on the bound of {', '.join(at_bound)} "
                f"(log-posterior {best_logp:.4g}); if most are, the fabric may not match the "
@@ -390,7 +388,7 @@ def _result(spec, lik, logpost, opts, sampler, out, best, best_logp, timing) -> 
                   evals_per_s=out.evals / out.sample_s if out.sample_s > 0 else float("nan"),
                   ess_per_s=ess_min / out.sample_s if out.sample_s > 0 else float("nan"))
     return FitResult(
-        names=spec.free, units=spec.units, chains=spec.to_natural(diag.chains),
+        names=spec.free, units=spec.units, chains=circular_natural(spec, diag.chains),
         chains_internal=diag.chains, log_prob=diag.log_prob, summary=summary,
         converged=out.converged, reason=out.reason, steps=diag.step, burn=diag.burn,
         walkers=opts.walkers, ensembles=opts.ensembles,

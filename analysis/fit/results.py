@@ -40,6 +40,8 @@ from pathlib import Path
 import numpy as np
 
 from analysis import diagnostics
+from analysis.fit.circular import circular_natural
+from analysis.params import INTERNAL_LIMIT
 from analysis.fit.quality import residuals
 from gonio import atomic_write
 from gonio.csvcells import comment_text, text_cell
@@ -133,8 +135,17 @@ class FitResult:
         return self.chains.reshape(-1, len(self.names)) if flat else self.chains
 
     def median_internal(self) -> np.ndarray:
-        """Posterior median in internal coordinates (ndim,)."""
-        return np.median(self.chains_internal.reshape(-1, len(self.names)), axis=0)
+        """Posterior median in internal coordinates (ndim,); a circular parameter's is its
+        circular median (:mod:`analysis.fit.circular`), not the median of the internal values
+        (which, for draws across the wrap, lies half a period away)."""
+        med = np.median(self.chains_internal.reshape(-1, len(self.names)), axis=0)
+        for i, name in enumerate(self.names):
+            period = None if self.spec is None else self.spec.period(name)
+            if period is not None:
+                p = self.spec.params[name]
+                x = p.lo + np.mod(np.median(self.samples()[:, i]) - p.lo, period)
+                med[i] = np.clip(p.to_internal(min(x, p.hi)), -INTERNAL_LIMIT, INTERNAL_LIMIT)
+        return med
 
     def residuals(self) -> dict:
         """Residuals at the posterior median (:func:`analysis.fit.quality.residuals`)."""
@@ -211,7 +222,7 @@ def _num(value) -> str:
 def summarize(spec, diag) -> dict:
     """Per free parameter: median, 68% / 95% intervals (natural units), tau, N/tau, R-hat, ESS
     and unit, from a :class:`~analysis.fit.convergence.Diagnosis`."""
-    natural = spec.to_natural(diag.chains)
+    natural = circular_natural(spec, diag.chains)     # one mode across a wrap
     summ = diagnostics.interval_summary(natural)
     ess = diagnostics.ess(diag.chains, diag.taus)
     out = {}
@@ -219,6 +230,8 @@ def summarize(spec, diag) -> dict:
         out[n] = {k: float(summ[k][i]) for k in summ}
         out[n].update(tau=float(diag.tau[i]), n_over_tau=float(diag.kept / diag.tau[i]),
                       rhat=float(diag.rhat[i]), ess=float(ess[i]), unit=spec.params[n].unit)
+        if spec.period(n) is not None:          # circular: no bound, an interval may wrap
+            out[n]["period"] = spec.period(n)
     return out
 
 

@@ -4,7 +4,10 @@ Each warning is ``{"kind", "parameters", "message"}``, computed from the posteri
 
 - ``at_bound``: the 95% interval reaches into the outer 1% of the prior range (measured
   where the prior is flat: in the value, or in its logarithm for a log-uniform prior). The
-  bound then shapes the answer, not the data.
+  bound then shapes the answer, not the data. Not for a circular parameter
+  (:meth:`analysis.params.ParamSpec.period`: a symmetric fabric's ``rotation`` on [-90, 90]
+  degrees), whose ends are one point: its draws are unwrapped (:mod:`analysis.fit.circular`)
+  before this and every other check.
 - ``not_informed``: the posterior sd is above half the prior sd, both where the prior is flat;
   the prior sd is that of the fit's actual prior (:meth:`analysis.params.ParamSpec.log_prior`,
   its ties and the area constraint included), from :data:`PRIOR_DRAWS` draws of it.
@@ -99,6 +102,8 @@ def at_bound(result) -> list[dict]:
     g = _flat_samples(result)
     for i, name in enumerate(result.names):
         p = result.spec.params[name]
+        if result.spec.period(name) is not None:     # a circle has no bound, only a wrap
+            continue
         g0, g1 = flat_values(p, p.lo), flat_values(p, p.hi)
         lo, hi = np.percentile(g[:, i], [2.5, 97.5])
         for side, edge, q, zone in (("lower", p.lo, (lo - g0) / (g1 - g0),

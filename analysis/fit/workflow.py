@@ -65,6 +65,12 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
     >>> fit_spec(Lambert()).free
     ('base_r', 'base_g', 'base_b')
     """
+    return _fit_spec(fabric, free, ties, toml, table).with_periods(
+        family_of(fabric).periods(fabric))
+
+
+def _fit_spec(fabric, free, ties, toml, table) -> ParamSpec:
+    """:func:`fit_spec` before the model's periods are added."""
     fam = family_of(fabric)
     defaults = fam.defaults(fabric)
     if ties is not None:

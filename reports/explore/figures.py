@@ -20,10 +20,13 @@ import numpy as np
 from bokeh.models import ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure
 
-__all__ = ["VIEWS", "make_figures", "update_figures", "tone_map", "polar", "DECADES"]
+__all__ = ["VIEWS", "SCALED", "make_figures", "update_figures", "tone_map", "polar",
+           "DECADES"]
 
 #: The views, in the page's order.
 VIEWS = ("lobe", "hemisphere", "slice", "sphere", "albedo", "masking", "tangent")
+#: The views drawn on the scale (linear or log): a change of scale redraws them.
+SCALED = ("lobe", "hemisphere", "slice")
 #: Decades of f_r the log radius and the log colour scales show below the peak.
 DECADES = 3.0
 #: The sphere's exposure: radiance (1/sr, unit irradiance) times this before tone mapping.
@@ -156,17 +159,23 @@ def _map(src, name, image, log):
     return peak
 
 
-def update_figures(figs: dict, src: dict, frame, log: bool) -> None:
-    """Put ``frame``'s numbers into the figures' sources (titles say the peaks)."""
-    peak = _lobe(src, frame, log)
+def update_figures(figs: dict, src: dict, frame, log: bool, views=VIEWS) -> None:
+    """Put ``frame``'s numbers into the figures' sources of ``views`` (by default every
+    view; those a move left unchanged need not be sent again); the titles say the peaks."""
     scale = "log" if log else "linear"          # log: DECADES below the peak
-    figs["lobe"].title.text = f"lobe ({scale}; peak {peak:.3g} 1/sr)"
+    if "lobe" in views:
+        peak = _lobe(src, frame, log)
+        figs["lobe"].title.text = f"lobe ({scale}; peak {peak:.3g} 1/sr)"
     for name in ("hemisphere", "slice"):
-        p = _map(src, name, getattr(frame, name), log)
-        figs[name].title.text = f"{name} ({scale}; peak {p:.3g} 1/sr)"
-    src["sphere"].data = {"image": [tone_map(frame.sphere)]}
-    a = frame.albedo
-    src["albedo"].data = {"t": frame.albedo_theta, "r": a[:, 0], "g": a[:, 1], "b": a[:, 2]}
+        if name in views:
+            p = _map(src, name, getattr(frame, name), log)
+            figs[name].title.text = f"{name} ({scale}; peak {p:.3g} 1/sr)"
+    if "sphere" in views:
+        src["sphere"].data = {"image": [tone_map(frame.sphere)]}
+    if "albedo" in views:
+        a = frame.albedo
+        src["albedo"].data = {"t": frame.albedo_theta, "r": a[:, 0], "g": a[:, 1],
+                              "b": a[:, 2]}
     if not _same(src["masking"].data.get("M"), frame.masking["M"]):
         _masking(src, frame)
     cols = ("#1f77b4", "#d62728")

@@ -2,13 +2,8 @@
 share (:class:`reports.explore.engine.State`).
 
 :func:`app` returns the function that builds a document, for the local server
-(:func:`reports.explore.server.serve`, ``microcyl explore``) and for Jupyter::
-
-    from bokeh.io import output_notebook, show
-    from bokeh.resources import INLINE
-    from reports.explore import app
-    output_notebook(resources=INLINE)       # BokehJS from the package: nothing from the web
-    show(app("velvet"))
+(:func:`reports.explore.server.serve`, ``microcyl explore``) and for Jupyter
+(:func:`reports.explore.notebook.explore`: ``explore(brdf.fabric("velvet"))``).
 
 Every control is named ``param-NAME`` (a model parameter's name, e.g. ``param-gamma_s1``,
 or ``param-theta_i``, ``param-plane``, ``param-channel``, ``param-scale``,
@@ -35,7 +30,7 @@ from bokeh.models import Button, Paragraph, Select, Slider
 
 from brdf.fabric import Fabric
 from reports.explore.data import Inputs, load_inputs
-from reports.explore.engine import Explorer, State
+from reports.explore.engine import Explorer
 from reports.explore.figures import SCALED, VIEWS, make_figures, update_figures
 from reports.explore.models import explore_model, model_names
 from reports.explore.page import page_script
@@ -239,19 +234,21 @@ class Controller:
         elif self.ex.cache.prepare_pending():
             self._prepare_later(1.0)
 
-    def layout(self):
-        """The document's one root: the view controls beside the views, then the variants
-        and the parameters in columns of eight."""
+    def layout(self, per_row: int = 4):
+        """The document's one root: the view controls beside the views (``per_row`` a
+        row), then the variants and the parameters in columns of eight."""
         views = [self.figs[v] for v in VIEWS]
-        grid = column(row(views[:4]), row(views[4:]), self.status)
+        grid = column(*(row(views[k:k + per_row]) for k in range(0, len(views), per_row)),
+                      self.status)
         self.param_box = row(self.variant_box, self.slider_box)
         return column(row(column(*self.widgets), grid), self.param_box)
 
 
-def app(*texts, inputs: Inputs | None = None):
+def app(*texts, inputs: Inputs | None = None, per_row: int = 4):
     """The function that builds an explorer document of the FABRIC / TABLE / FITDIR
-    arguments ``texts`` (default the ``linen_plain`` preset): hand it to
-    ``bokeh.io.show`` in Jupyter, or to :func:`reports.explore.server.serve`."""
+    arguments or model objects ``texts`` (default the ``linen_plain`` preset), ``per_row``
+    views a row: for :func:`reports.explore.server.serve`, or Jupyter
+    (:func:`reports.explore.notebook.explore`)."""
     inputs = inputs if inputs is not None else load_inputs(list(texts) or ["linen_plain"])
     if not inputs.sources:
         inputs.sources.extend(load_inputs(["linen_plain"]).sources)
@@ -260,7 +257,7 @@ def app(*texts, inputs: Inputs | None = None):
 
     def build(doc) -> None:
         ctl = Controller(doc, explorer)
-        doc.add_root(ctl.layout())
+        doc.add_root(ctl.layout(per_row))
         doc.title = "microcyl explore"
         doc.js_on_event("document_ready", page_script())
         ctl.redraw()

@@ -168,3 +168,15 @@ def test_the_rotation_slider_turns_the_fabric_about_its_normal():
     assert np.isclose(ctl.state.options["rotation"], np.pi / 2)
     ctl.redraw()
     assert not np.allclose(ctl.src["hemisphere"].data["image"][0], before)
+
+
+def test_the_notebook_server_accepts_the_running_jupyter_servers_pages_only(tmp_path):
+    from reports.explore.notebook import jupyter_origins
+    (tmp_path / "jpserver-11.json").write_text('{"port": 8891, "url": "http://localhost:8891/"}')
+    (tmp_path / "nbserver-12.json").write_text('{"port": 9000}')
+    (tmp_path / "jpserver-13.json").write_text('{"port": "8892; evil"}')   # not a port
+    (tmp_path / "jpserver-14.json").write_text("not json")
+    (tmp_path / "kernel-15.json").write_text('{"port": 7000}')           # a kernel's, not a server
+    assert jupyter_origins(tmp_path) == ["localhost:8891", "127.0.0.1:8891",
+                                         "localhost:9000", "127.0.0.1:9000"]
+    assert jupyter_origins(tmp_path / "none") == ["localhost:8888", "127.0.0.1:8888"]

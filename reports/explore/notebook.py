@@ -36,6 +36,12 @@ from bokeh.io.notebook import EXEC_MIME_TYPE, HTML_MIME_TYPE, publish_display_da
 from bokeh.io.state import curstate
 from bokeh.resources import INLINE
 from bokeh.server.server import Server
+from tornado.ioloop import IOLoop
+
+try:                       # optional (not a dependency of microcyl): there in any Jupyter kernel
+    from jupyter_core.paths import jupyter_runtime_dir
+except ImportError:
+    jupyter_runtime_dir = None
 
 from reports.explore.app import app
 
@@ -64,7 +70,9 @@ def jupyter_origins(runtime_dir=None) -> list:
     their runtime files in ``runtime_dir`` (Jupyter's by default), each on ``localhost``
     and ``127.0.0.1``; Jupyter's default port when none is found."""
     if runtime_dir is None:
-        from jupyter_core.paths import jupyter_runtime_dir   # with ipykernel, in any kernel
+        if jupyter_runtime_dir is None:
+            raise RuntimeError("explore in a notebook needs jupyter_core (every Jupyter kernel "
+                               "has it: pip install ipykernel)")
         runtime_dir = jupyter_runtime_dir()
     ports = _runtime_ports(Path(runtime_dir)) or [DEFAULT_PORT]
     return [f"{host}:{p}" for p in ports for host in ("localhost", "127.0.0.1")]
@@ -86,7 +94,6 @@ def explore(*sources, notebook_url=None, port: int = 0) -> None:
     if notebook_url is not None:
         show(build, notebook_url=notebook_url)
         return
-    from tornado.ioloop import IOLoop
     server = Server({"/": build}, io_loop=IOLoop.current(), address="127.0.0.1",
                     port=int(port), allow_websocket_origin=jupyter_origins())
     server.start()

@@ -5,8 +5,11 @@ from __future__ import annotations
 import contextlib
 import sys
 import threading
+import warnings
 
-import tqdm.auto
+with warnings.catch_warnings():    # a notebook without ipywidgets: text bars, without a warning
+    warnings.filterwarnings("ignore", message="IProgress not found")
+    import tqdm.auto
 
 from gonio.terminal import shown
 

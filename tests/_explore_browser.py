@@ -19,6 +19,25 @@ CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 DRIVER = shutil.which("chromedriver")
 #: The views every slider move redraws.
 VIEWS = ("lobe", "hemisphere", "slice", "sphere", "albedo")
+#: The controls that set a field of the state (engine.State) of their own name.
+_FIELDS = {"theta_i", "plane", "light_theta", "light_phi", "channel", "compare", "model",
+           "source"}
+
+
+def views_of(testid: str) -> tuple:
+    """The views of :data:`VIEWS` that control ``testid`` changes (the engine's
+    ``views_moved_by``: the incidence moves the lobe and the hemisphere only)."""
+    from reports.explore.engine import views_moved_by
+    from reports.explore.figures import SCALED
+    from reports.explore.models import VARIANTS
+    name = testid.removeprefix("param-")
+    if name == "scale":
+        moved = SCALED
+    elif name in _FIELDS:
+        moved = views_moved_by(name)
+    else:
+        moved = views_moved_by("options" if name in (*VARIANTS, "rotation") else "values")
+    return tuple(v for v in VIEWS if v in moved)
 
 #: JS: every element under the document and its shadow roots matching a selector.
 DEEP = """
@@ -32,11 +51,12 @@ function deep(root, sel, out) {
 """
 
 
-def start_server(*sources, timeout: float = 120.0):
-    """``(process, url)`` of ``microcyl explore --no-browser --port 0 SOURCES``."""
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
+def start_server(*sources, timeout: float = 120.0, root: Path = ROOT):
+    """``(process, url)`` of ``microcyl explore --no-browser --port 0 SOURCES``, run from
+    the source tree ``root`` (another checkout's: its packages before the installed ones)."""
+    env = dict(os.environ, PYTHONUNBUFFERED="1", PYTHONPATH=str(root))
     proc = subprocess.Popen([sys.executable, "-m", "reports", "explore", "--no-browser",
-                             "--port", "0", *sources], cwd=ROOT, env=env,
+                             "--port", "0", *sources], cwd=root, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.monotonic() + timeout
     for line in proc.stdout:
@@ -107,10 +127,12 @@ def load(drv, url, views=VIEWS, controls=("param-theta_i",)):
              and all(by_testid(drv, c) is not None for c in controls), timeout=120)
 
 
-def press(drv, testid, key, views=VIEWS, timeout: float = 30.0) -> float:
+def press(drv, testid, key, views=None, timeout: float = 30.0) -> float:
     """Focus control ``testid``, press ``key`` once, and wait until every view of ``views``
-    redrew; the seconds from the key press (the page's keydown) to the last view's redraw
-    (its ``data-drawn-at``), both measured in the page."""
+    (by default those the control changes, :func:`views_of`) redrew; the seconds from the
+    key press (the page's keydown) to the last view's redraw (its ``data-drawn-at``), both
+    measured in the page."""
+    views = views_of(testid) if views is None else views
     el = by_testid(drv, testid)
     drv.execute_script("arguments[0].focus();", el)
     before = versions(drv)

@@ -30,8 +30,11 @@ def test_every_model_builds_from_its_sliders_and_the_fast_path_agrees(name):
     wi = np.broadcast_to(wi, wo.shape)
     want = obj.eval(wi, wo)
     assert np.allclose(built.eval(wi, wo), want, rtol=1e-9, atol=1e-12)
-    fast = FastBRDF(model, values, obj, PreparedCache(), dtype=np.float64)
-    assert np.allclose(fast.eval(wi, wo), want, rtol=1e-9, atol=1e-12)
+    cache = PreparedCache()
+    fast = FastBRDF(model, values, obj, cache, dtype=np.float64)
+    assert np.allclose(fast.eval(wi, wo), want, rtol=1e-9, atol=1e-12)   # the model's own
+    assert cache.pending == 1 and not cache.prepare_pending() and len(cache) == 1
+    assert np.allclose(fast.eval(wi, wo), want, rtol=1e-9, atol=1e-12)   # prepared
     if model.is_microcylinder:                       # float32: a few 1e-6 relative
         f32 = FastBRDF(model, values, obj, PreparedCache()).eval(wi, wo)
         assert np.allclose(f32, want, rtol=1e-4, atol=1e-9 * want.max())
@@ -41,16 +44,37 @@ def test_a_slider_move_changes_every_parameter_view_and_reuses_the_prepared_pair
     ex = Explorer(load_inputs(["linen_plain"]))
     st = ex.initial_state()
     a = ex.frame(st)
+    assert len(ex.cache) == 0 and ex.cache.pending == 5   # shaded by the fabric, queued
+    while ex.cache.prepare_pending():                # what the app does when idle
+        pass
     held = len(ex.cache)
     b = ex.frame(st.replace(values=dict(st.values, gamma_s1=st.values["gamma_s1"] * 2)))
-    assert len(ex.cache) == held                     # the same pairs: nothing prepared
+    assert len(ex.cache) == held == 5 and ex.cache.pending == 0   # the same pairs
     for view in ("lobe_f", "hemisphere", "slice", "sphere", "albedo"):
         assert not np.allclose(getattr(a, view), getattr(b, view)), view
     assert a.compare_f is None
     d = ex.frame(st.replace(compare="velvet"))       # a preset not loaded: compared too
     assert d.compare_f is not None and not np.allclose(d.compare_f, a.lobe_f)
     c = ex.frame(st.replace(options=dict(st.options, masking=False)))
-    assert len(ex.cache) > held and not np.allclose(a.lobe_f, c.lobe_f)
+    assert ex.cache.pending == 5 and not np.allclose(a.lobe_f, c.lobe_f)   # new pairs
+
+
+@pytest.mark.parametrize("field,value", [("theta_i", 55.0), ("plane", 40.0),
+                                         ("light_phi", 90.0), ("light_theta", 20.0)])
+def test_a_view_slider_changes_the_views_it_names_and_no_other(field, value):
+    """Each frame from an explorer of its own (nothing computed before reused): the views
+    that views_moved_by leaves out are equal, those it names differ."""
+    from reports.explore.engine import views_moved_by
+    arrays = {"lobe": "lobe_f", "hemisphere": "hemisphere", "slice": "slice",
+              "sphere": "sphere", "albedo": "albedo"}
+    fresh = lambda: Explorer(load_inputs(["velvet"]))  # noqa: E731
+    st = fresh().initial_state()
+    a, b = fresh().frame(st), fresh().frame(st.replace(**{field: value}))
+    moved = views_moved_by(field)
+    for view, attr in arrays.items():
+        same = np.array_equal(getattr(a, attr), getattr(b, attr), equal_nan=True)
+        assert same == (view not in moved), (field, view)
+    assert set(b.changed(a)) == set(moved)
 
 
 def test_table_points_lie_where_they_were_measured_with_their_sigma():
@@ -144,3 +168,15 @@ def test_the_rotation_slider_turns_the_fabric_about_its_normal():
     assert np.isclose(ctl.state.options["rotation"], np.pi / 2)
     ctl.redraw()
     assert not np.allclose(ctl.src["hemisphere"].data["image"][0], before)
+
+
+def test_the_notebook_server_accepts_the_running_jupyter_servers_pages_only(tmp_path):
+    from reports.explore.notebook import jupyter_origins
+    (tmp_path / "jpserver-11.json").write_text('{"port": 8891, "url": "http://localhost:8891/"}')
+    (tmp_path / "nbserver-12.json").write_text('{"port": 9000}')
+    (tmp_path / "jpserver-13.json").write_text('{"port": "8892; evil"}')   # not a port
+    (tmp_path / "jpserver-14.json").write_text("not json")
+    (tmp_path / "kernel-15.json").write_text('{"port": 7000}')           # a kernel's, not a server
+    assert jupyter_origins(tmp_path) == ["localhost:8891", "127.0.0.1:8891",
+                                         "localhost:9000", "127.0.0.1:9000"]
+    assert jupyter_origins(tmp_path / "none") == ["localhost:8888", "127.0.0.1:8888"]

@@ -60,11 +60,15 @@ def test_every_control_and_view_has_a_testid(page):
                                                ("param-kd2", Keys.ARROW_UP, 1)])
 def test_arrow_keys_move_a_control_and_redraw_every_view(page, control, key, delta):
     drv, _ = page
-    before = _value(drv, control)
-    seconds = eb.press(drv, control, key)        # waits until every view redrew
-    after = _value(drv, control)
+    before, drawn = _value(drv, control), eb.versions(drv)
+    seconds = eb.press(drv, control, key)        # waits until the views it moves redrew
+    after, now = _value(drv, control), eb.versions(drv)
     assert (after - before) * delta > 0, (control, before, after)
     assert 0 < seconds < 30
+    moved = eb.views_of(control)                 # a parameter: every view
+    assert control == "param-theta_i" or moved == eb.VIEWS
+    unchanged = {v for v in eb.VIEWS if now[v] == drawn[v]}
+    assert unchanged == set(eb.VIEWS) - set(moved), (control, unchanged)
 
 
 def test_a_choice_moves_with_the_keyboard(page):

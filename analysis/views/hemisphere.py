@@ -108,8 +108,8 @@ def compute_hemisphere(brdf, theta_i_deg=45.0, phi_i_deg=0.0, resolution=101) ->
     check_angle("theta_i_deg", theta_i_deg, 0.0, 90.0)
     _, _, inside, wo = equal_area_grid(resolution)
     wi = from_angles(np.radians(theta_i_deg), np.radians(phi_i_deg))
-    values = eval_brdf(brdf, wi, wo)
-    values[~inside] = np.nan
+    values = np.full(wo.shape, np.nan)
+    values[inside] = eval_brdf(brdf, wi, wo[inside])    # the disc's pixels only
     return HemisphereView(theta_i_deg, phi_i_deg, values, wo)
 
 

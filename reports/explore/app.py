@@ -2,13 +2,8 @@
 share (:class:`reports.explore.engine.State`).
 
 :func:`app` returns the function that builds a document, for the local server
-(:func:`reports.explore.server.serve`, ``microcyl explore``) and for Jupyter::
-
-    from bokeh.io import output_notebook, show
-    from bokeh.resources import INLINE
-    from reports.explore import app
-    output_notebook(resources=INLINE)       # BokehJS from the package: nothing from the web
-    show(app("velvet"))
+(:func:`reports.explore.server.serve`, ``microcyl explore``) and for Jupyter
+(:func:`reports.explore.notebook.explore`: ``explore(brdf.fabric("velvet"))``).
 
 Every control is named ``param-NAME`` (a model parameter's name, e.g. ``param-gamma_s1``,
 or ``param-theta_i``, ``param-plane``, ``param-channel``, ``param-scale``,
@@ -28,14 +23,15 @@ Examples
 from __future__ import annotations
 
 import math
+import time
 
 from bokeh.layouts import column, row
 from bokeh.models import Button, Paragraph, Select, Slider
 
 from brdf.fabric import Fabric
 from reports.explore.data import Inputs, load_inputs
-from reports.explore.engine import Explorer, State
-from reports.explore.figures import VIEWS, make_figures, update_figures
+from reports.explore.engine import Explorer
+from reports.explore.figures import SCALED, VIEWS, make_figures, update_figures
 from reports.explore.models import explore_model, model_names
 from reports.explore.page import page_script
 
@@ -43,6 +39,10 @@ __all__ = ["app", "Controller", "CHANNELS"]
 
 #: What the lobe, the hemisphere and the slice show: luminance or one channel.
 CHANNELS = ("luminance", "r", "g", "b")
+
+#: Milliseconds with no control moved before the pairs shaded without being prepared are
+#: prepared (:meth:`Controller._prepare_later`).
+PREPARE_AFTER_MS = 300.0
 
 _VIEW = {"theta_i": ("incidence θi (deg)", 0.0, 85.0, 1.0),
          "plane": ("plane of incidence φ (deg)", 0.0, 180.0, 5.0),
@@ -66,6 +66,9 @@ class Controller:
         self.figs, self.src = make_figures()
         self.status = Paragraph(text="", name="status")   # plain text, never HTML
         self._pending = self._quiet = False
+        self._drawn = None                                 # (frame, log) drawn last
+        self._preparing = False                            # a prepare step scheduled
+        self._moved_at = time.monotonic()                  # the last control's move
         self.sliders: dict = {}
         self.slider_box = row()
         self.variant_box = column()
@@ -150,6 +153,7 @@ class Controller:
     def set(self, **changes) -> None:
         """Change the state and schedule a redraw."""
         self.state = self.state.replace(**changes)
+        self._moved_at = time.monotonic()
         if not self._pending:
             self._pending = True
             self.doc.add_next_tick_callback(self.redraw)
@@ -204,21 +208,47 @@ class Controller:
             self.status.text = f"not drawn: {exc}"[:300]
             return
         self.status.text = ""
-        update_figures(self.figs, self.src, frame, self.state.log)
+        before, self._drawn = self._drawn, (frame, self.state.log)
+        views = frame.changed(before[0] if before else None)
+        if before and before[1] != self.state.log:
+            views = tuple(dict.fromkeys(views + SCALED))
+        update_figures(self.figs, self.src, frame, self.state.log, views)
+        self._prepare_later()
 
-    def layout(self):
-        """The document's one root: the view controls beside the views, then the variants
-        and the parameters in columns of eight."""
+    def _prepare_later(self, delay_ms: float = PREPARE_AFTER_MS) -> None:
+        """Prepare the pairs the last frames shaded without (:mod:`reports.explore.fast`)
+        once no control has moved for :data:`PREPARE_AFTER_MS` (not during a drag, whose
+        next move would find other pairs), one pair set a callback: a move is served
+        first."""
+        if self.ex.cache.pending and not self._preparing:
+            self._preparing = True
+            self.doc.add_timeout_callback(self._prepare_step, max(delay_ms, 1.0))
+
+    def _prepare_step(self) -> None:
+        self._preparing = False
+        if self._pending:               # a move waits: draw it first, prepare after
+            return
+        idle_ms = 1e3 * (time.monotonic() - self._moved_at)
+        if idle_ms < PREPARE_AFTER_MS:
+            self._prepare_later(PREPARE_AFTER_MS - idle_ms)
+        elif self.ex.cache.prepare_pending():
+            self._prepare_later(1.0)
+
+    def layout(self, per_row: int = 4):
+        """The document's one root: the view controls beside the views (``per_row`` a
+        row), then the variants and the parameters in columns of eight."""
         views = [self.figs[v] for v in VIEWS]
-        grid = column(row(views[:4]), row(views[4:]), self.status)
+        grid = column(*(row(views[k:k + per_row]) for k in range(0, len(views), per_row)),
+                      self.status)
         self.param_box = row(self.variant_box, self.slider_box)
         return column(row(column(*self.widgets), grid), self.param_box)
 
 
-def app(*texts, inputs: Inputs | None = None):
+def app(*texts, inputs: Inputs | None = None, per_row: int = 4):
     """The function that builds an explorer document of the FABRIC / TABLE / FITDIR
-    arguments ``texts`` (default the ``linen_plain`` preset): hand it to
-    ``bokeh.io.show`` in Jupyter, or to :func:`reports.explore.server.serve`."""
+    arguments or model objects ``texts`` (default the ``linen_plain`` preset), ``per_row``
+    views a row: for :func:`reports.explore.server.serve`, or Jupyter
+    (:func:`reports.explore.notebook.explore`)."""
     inputs = inputs if inputs is not None else load_inputs(list(texts) or ["linen_plain"])
     if not inputs.sources:
         inputs.sources.extend(load_inputs(["linen_plain"]).sources)
@@ -227,7 +257,7 @@ def app(*texts, inputs: Inputs | None = None):
 
     def build(doc) -> None:
         ctl = Controller(doc, explorer)
-        doc.add_root(ctl.layout())
+        doc.add_root(ctl.layout(per_row))
         doc.title = "microcyl explore"
         doc.js_on_event("document_ready", page_script())
         ctl.redraw()

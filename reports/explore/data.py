@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+import brdf
 import gonio
 from analysis.planning.draws import fit_folder_spec, posterior_draws
 from analysis.sources import Source, resolve
@@ -23,7 +24,7 @@ from analysis.views.common import reduce_quantity
 from analysis.views.lobes import plane_directions
 from analysis.views.table import plane_points, reduce_sigma
 
-__all__ = ["Inputs", "Band", "Points", "load_inputs", "posterior_values", "lobe_band",
+__all__ = ["Inputs", "Band", "Points", "load_inputs", "object_source", "posterior_values", "lobe_band",
            "lobe_points", "BAND_DRAWS"]
 
 #: Posterior draws a band is computed from.
@@ -54,12 +55,31 @@ def posterior_values(folder, n: int = BAND_DRAWS, seed: int = 0) -> dict:
     return {k: np.asarray(v, float) for k, v in spec.values(theta).items()}
 
 
+def object_source(obj) -> Source:
+    """A model object as a source (kind ``fabric``), labelled by its name or its model's.
+
+    >>> object_source(brdf.fabric("velvet")).label
+    'velvet'
+    """
+    model = brdf.model_name(obj)
+    return Source("fabric", getattr(obj, "name", None) or model, obj, model=model)
+
+
 def load_inputs(texts) -> Inputs:
-    """Resolve each argument: a measured table (by its suffix and content) or a FABRIC
-    (:func:`analysis.sources.resolve`: preset, fit folder, exported .json/.xml). A fit
+    """Resolve each argument: a model object (a :class:`brdf.Fabric` or a baseline model of
+    :data:`brdf.MODELS`, :func:`object_source`), a measured table (by its suffix and
+    content) or a FABRIC (:func:`analysis.sources.resolve`: preset, fit folder, exported
+    .json/.xml). A fit
     folder's posterior is read when it has one (a missing checkpoint leaves no band)."""
     sources, tables, draws = [], [], {}
     for text in texts:
+        if isinstance(text, tuple(brdf.MODELS.values())):
+            src = object_source(text)
+            taken = {s.label for s in sources}
+            label = next(f"{src.label} ({k})" if k > 1 else src.label for k in range(1, 99)
+                         if (f"{src.label} ({k})" if k > 1 else src.label) not in taken)
+            sources.append(dataclasses.replace(src, label=label))
+            continue
         path = Path(text)
         if _is_table(path):
             tables.append((path.name, gonio.io.read(path)))

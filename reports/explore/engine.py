@@ -21,6 +21,7 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -37,7 +38,8 @@ from reports.explore.data import Band, Inputs, Points, lobe_band, lobe_points
 from reports.explore.fast import FastBRDF, PreparedCache
 from reports.explore.models import explore_model
 
-__all__ = ["State", "Frame", "Explorer", "RESOLUTION"]
+__all__ = ["State", "Frame", "Explorer", "RESOLUTION", "PARTS", "VIEW_PARTS", "views_moved_by",
+           "part_key"]
 
 #: Default resolution of each view: samples of the lobe, pixels a side of the hemisphere,
 #: the slice and the sphere, pixels a side of the albedo's quadrature.
@@ -69,6 +71,47 @@ class State:
         return dataclasses.replace(self, **changes)
 
 
+#: The State's fields a model's numbers depend on.
+_MODEL = ("model", "values", "options", "source")
+#: What each part of a :class:`Frame` is computed from: the :class:`State`'s fields. A move
+#: of any other field leaves the part as it was (neither computed nor sent again): the
+#: incidence moves the lobe and the hemisphere, not the slice, the sphere or the albedo.
+PARTS = {"lobe": _MODEL + ("theta_i", "plane", "channel"),
+         "compare": ("compare", "theta_i", "plane", "channel"),
+         "band": ("compare", "source", "theta_i", "plane", "channel"),
+         "points": ("theta_i", "plane", "channel"),
+         "hemisphere": _MODEL + ("theta_i", "plane", "channel"),
+         "slice": _MODEL,
+         "sphere": _MODEL + ("light_theta", "light_phi"),
+         "albedo": _MODEL + ("plane",),
+         "tangents": ("model", "options", "source")}
+#: The parts each view draws (:data:`reports.explore.figures.VIEWS`).
+VIEW_PARTS = {"lobe": ("lobe", "compare", "band", "points"), "hemisphere": ("hemisphere",),
+              "slice": ("slice",), "sphere": ("sphere",), "albedo": ("albedo",),
+              "masking": (), "tangent": ("tangents",)}
+
+
+def views_moved_by(field: str) -> tuple:
+    """The views whose numbers a change of the :class:`State`'s ``field`` changes.
+
+    >>> views_moved_by("theta_i"), views_moved_by("light_phi")
+    (('lobe', 'hemisphere'), ('sphere',))
+    """
+    if field not in State.__dataclass_fields__:
+        raise ValueError(f"no field {field!r} in the explorer's state")
+    return tuple(v for v, parts in VIEW_PARTS.items()
+                 if any(field in PARTS[p] for p in parts))
+
+
+def _hashable(value):
+    return tuple(sorted(value.items())) if isinstance(value, dict) else value
+
+
+def part_key(state: State, part: str) -> tuple:
+    """The key of ``part`` (:data:`PARTS`) in ``state``: equal keys, equal numbers."""
+    return (part,) + tuple(_hashable(getattr(state, f)) for f in PARTS[part])
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class Frame:
     """The numbers of every view for one state (f_r in 1/sr; angles in degrees).
@@ -78,7 +121,9 @@ class Frame:
     ``hemisphere`` f_r over the equal-area disc (NaN outside), ``slice`` f_r on theta_h
     (columns) x theta_d (rows), ``sphere`` the lit sphere's RGB radiance, ``albedo_theta``
     and ``albedo`` (m, 3) the directional albedo, ``masking`` M, u and the pair weight
-    against ``masking_angle``, ``tangents`` each thread's (arc length, offset in degrees).
+    against ``masking_angle``, ``tangents`` each thread's (arc length, offset in degrees);
+    ``keys`` each part's :func:`part_key` (a view whose parts' keys are those of the frame
+    drawn before needs no redraw: :meth:`changed`).
     """
 
     lobe_theta: np.ndarray
@@ -94,6 +139,15 @@ class Frame:
     masking_angle: np.ndarray
     masking: dict
     tangents: list
+    keys: dict = dataclasses.field(default_factory=dict)
+
+    def changed(self, before: "Frame | None") -> tuple:
+        """The views whose numbers differ from those of the frame ``before`` (every view
+        when there is none)."""
+        if before is None or not self.keys or not before.keys:
+            return tuple(VIEW_PARTS)
+        return tuple(v for v, parts in VIEW_PARTS.items()
+                     if any(self.keys[p] != before.keys[p] for p in parts))
 
 
 def _tangents(base) -> list:
@@ -118,7 +172,10 @@ class Explorer:
         self.inputs = inputs
         self.resolution = dict(RESOLUTION, **(resolution or {}))
         self.cache = PreparedCache(24)
+        self.memo = PreparedCache(64)        # each part's numbers by its key (small arrays)
         self.sources = {s.label: s for s in inputs.sources}
+        self._angle = np.linspace(-90.0, 90.0, 181)
+        self._masking = masking_terms(self._angle)
 
     def labels(self) -> list:
         """The loaded models' labels, in the command line's order."""
@@ -177,22 +234,38 @@ class Explorer:
             out.append((label, p))
         return out
 
-    def frame(self, state: State) -> Frame:
-        """Every view's numbers for ``state`` (one evaluation of each view's pairs)."""
-        res, q = self.resolution, state.channel
-        fast = self.fast(state)
-        lobe = compute_lobes(fast, state.theta_i, state.plane, resolution=res["lobe"])
-        theta = lobe.theta_o_deg
+    def _part(self, state: State, part: str, make):
+        """``make()`` of ``part``, or the numbers of the same key made before."""
+        return self.memo.get(part_key(state, part), make)
+
+    def _lobe(self, state: State, fast):
+        lobe = compute_lobes(fast, state.theta_i, state.plane,
+                             resolution=self.resolution["lobe"])
+        return lobe.theta_o_deg, reduce_quantity(lobe.rgb[0, 0], state.channel)
+
+    def _hemisphere(self, state: State, fast):
         hemi = compute_hemisphere(fast, state.theta_i, state.plane + 180.0,
-                                  resolution=res["hemisphere"])
-        sl = compute_slice_image(fast, resolution=res["slice"])
-        sph = compute_sphere(fast, state.light_theta, state.light_phi,
-                             resolution=res["sphere"])
-        alb = compute_albedo_curve(fast, ALBEDO_THETAS, state.plane + 180.0,
-                                   resolution=res["albedo"])
-        angle = np.linspace(-90.0, 90.0, 181)
-        return Frame(theta, reduce_quantity(lobe.rgb[0, 0], q), self._compare(state, theta),
-                     self._band(state, theta), self.points(state),
-                     reduce_quantity(hemi.rgb, q), sl.image, sph.radiance,
-                     alb.theta_i_deg, alb.albedo, angle, masking_terms(angle),
-                     _tangents(self.base(state)))
+                                  resolution=self.resolution["hemisphere"])
+        return reduce_quantity(hemi.rgb, state.channel)
+
+    def frame(self, state: State) -> Frame:
+        """Every view's numbers for ``state``: each part (:data:`PARTS`) computed again
+        only where its fields differ from a state computed before (one evaluation of the
+        part's pairs, prepared once)."""
+        res, part = self.resolution, lambda name, make: self._part(state, name, make)
+        fast = functools.cache(lambda: self.fast(state))   # one for the parts made anew
+        theta, lobe_f = part("lobe", lambda: self._lobe(state, fast()))
+        alb = part("albedo", lambda: compute_albedo_curve(
+            fast(), ALBEDO_THETAS, state.plane + 180.0, resolution=res["albedo"]))
+        return Frame(
+            theta, lobe_f, part("compare", lambda: self._compare(state, theta)),
+            part("band", lambda: self._band(state, theta)),
+            part("points", lambda: self.points(state)),
+            part("hemisphere", lambda: self._hemisphere(state, fast())),
+            part("slice", lambda: compute_slice_image(fast(), resolution=res["slice"]).image),
+            part("sphere", lambda: compute_sphere(fast(), state.light_theta,
+                                                  state.light_phi,
+                                                  resolution=res["sphere"]).radiance),
+            alb.theta_i_deg, alb.albedo, self._angle, self._masking,
+            part("tangents", lambda: _tangents(self.base(state))),
+            {p: part_key(state, p) for p in PARTS})

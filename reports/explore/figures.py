@@ -17,13 +17,16 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from bokeh.models import ColumnDataSource, LinearColorMapper
+from bokeh.models import ColumnDataSource, HoverTool, LinearColorMapper
 from bokeh.plotting import figure
 
-__all__ = ["VIEWS", "make_figures", "update_figures", "tone_map", "polar", "DECADES"]
+__all__ = ["VIEWS", "SCALED", "make_figures", "update_figures", "tone_map", "polar",
+           "DECADES"]
 
 #: The views, in the page's order.
 VIEWS = ("lobe", "hemisphere", "slice", "sphere", "albedo", "masking", "tangent")
+#: The views drawn on the scale (linear or log): a change of scale redraws them.
+SCALED = ("lobe", "hemisphere", "slice")
 #: Decades of f_r the log radius and the log colour scales show below the peak.
 DECADES = 3.0
 #: The sphere's exposure: radiance (1/sr, unit irradiance) times this before tone mapping.
@@ -67,7 +70,7 @@ def _fig(name, title, **kw):
 def make_figures() -> tuple[dict, dict]:
     """The figures (name -> figure) and their data sources (name -> ColumnDataSource)."""
     src = {k: ColumnDataSource(data=d, name=f"src-{k}") for k, d in {
-        "lobe": {"x": [], "y": []}, "lobe_compare": {"x": [], "y": []},
+        "lobe": {"x": [], "y": [], "theta": [], "f": []}, "lobe_compare": {"x": [], "y": []},
         "lobe_band": {"x": [], "y": []}, "lobe_points": {"x": [], "y": []},
         "lobe_sigma": {"x0": [], "y0": [], "x1": [], "y1": []},
         "hemisphere": {"image": [np.zeros((2, 2))]}, "slice": {"image": [np.zeros((2, 2))]},
@@ -82,7 +85,10 @@ def make_figures() -> tuple[dict, dict]:
     for r in (0.25, 0.5, 0.75, 1.0):
         f.line(r * np.sin(t), r * np.cos(t), color="#cccccc")
     f.patch("x", "y", source=src["lobe_band"], color="#1f77b4", alpha=0.3)
-    f.line("x", "y", source=src["lobe"], color="#1f77b4", line_width=2)
+    lobe = f.line("x", "y", source=src["lobe"], color="#1f77b4", line_width=2)
+    f.add_tools(HoverTool(renderers=[lobe], tooltips=[("θo (deg)", "@theta{0.0}"),
+                                                      ("f_r (1/sr)", "@f{%.3g}")],
+                          formatters={"@f": "printf"}))
     f.line("x", "y", source=src["lobe_compare"], color="#d62728", line_dash="dashed")
     f.segment("x0", "y0", "x1", "y1", source=src["lobe_sigma"], color="black")
     f.scatter("x", "y", source=src["lobe_points"], color="black", size=4)
@@ -92,13 +98,20 @@ def make_figures() -> tuple[dict, dict]:
         maps[name] = LinearColorMapper(palette="Viridis256", low=-DECADES, high=0.0)
         x, y, w, h = extent
         g = figs[name] = _fig(name, title, x_range=(x, x + w), y_range=(y, y + h))
-        g.image("image", x=x, y=y, dw=w, dh=h, source=src[name], color_mapper=maps[name])
+        img = g.image("image", x=x, y=y, dw=w, dh=h, source=src[name],
+                      color_mapper=maps[name])
+        g.add_tools(HoverTool(renderers=[img], formatters={"@image": "printf"}, tooltips=[
+            ("x, y", "$x{0.00}, $y{0.00}"),
+            ("f_r (1/sr; log10 of it on the log scale)", "@image{%.3g}")]))
     s = figs["sphere"] = _fig("sphere", "lit sphere", x_range=(-1, 1), y_range=(-1, 1))
     s.image_rgba("image", x=-1, y=-1, dw=2, dh=2, source=src["sphere"])
     a = figs["albedo"] = _fig("albedo", "albedo against θi (deg)",
                               y_range=(0, 1.05))
     for c, col in (("r", "#d62728"), ("g", "#2ca02c"), ("b", "#1f77b4")):
         a.line("t", c, source=src["albedo"], color=col, line_width=2, legend_label=c)
+    a.add_tools(HoverTool(tooltips=[("θi (deg)", "@t{0}"), ("albedo r, g, b",
+                                                            "@r{0.000}, @g{0.000}, @b{0.000}")],
+                          mode="vline"))
     m = figs["masking"] = _fig("masking", "masking M, u, pair weight (deg)", y_range=(0, 1.05))
     for c, col in (("M", "#1f77b4"), ("u", "#ff7f0e"), ("pair", "#2ca02c")):
         m.line("a", c, source=src["masking"], color=col, legend_label=c)
@@ -121,7 +134,7 @@ def _lobe(src, frame, log):
                float(np.nanmax(frame.compare_f)) if frame.compare_f is not None else 0.0)
     th = frame.lobe_theta
     x, y = polar(th, frame.lobe_f, peak, log)
-    src["lobe"].data = {"x": x, "y": y}
+    src["lobe"].data = {"x": x, "y": y, "theta": th, "f": frame.lobe_f}
     cx, cy = polar(th, frame.compare_f, peak, log) if frame.compare_f is not None else ([], [])
     _put(src["lobe_compare"], {"x": cx, "y": cy})
     if frame.band is not None:
@@ -156,17 +169,23 @@ def _map(src, name, image, log):
     return peak
 
 
-def update_figures(figs: dict, src: dict, frame, log: bool) -> None:
-    """Put ``frame``'s numbers into the figures' sources (titles say the peaks)."""
-    peak = _lobe(src, frame, log)
+def update_figures(figs: dict, src: dict, frame, log: bool, views=VIEWS) -> None:
+    """Put ``frame``'s numbers into the figures' sources of ``views`` (by default every
+    view; those a move left unchanged need not be sent again); the titles say the peaks."""
     scale = "log" if log else "linear"          # log: DECADES below the peak
-    figs["lobe"].title.text = f"lobe ({scale}; peak {peak:.3g} 1/sr)"
+    if "lobe" in views:
+        peak = _lobe(src, frame, log)
+        figs["lobe"].title.text = f"lobe ({scale}; peak {peak:.3g} 1/sr)"
     for name in ("hemisphere", "slice"):
-        p = _map(src, name, getattr(frame, name), log)
-        figs[name].title.text = f"{name} ({scale}; peak {p:.3g} 1/sr)"
-    src["sphere"].data = {"image": [tone_map(frame.sphere)]}
-    a = frame.albedo
-    src["albedo"].data = {"t": frame.albedo_theta, "r": a[:, 0], "g": a[:, 1], "b": a[:, 2]}
+        if name in views:
+            p = _map(src, name, getattr(frame, name), log)
+            figs[name].title.text = f"{name} ({scale}; peak {p:.3g} 1/sr)"
+    if "sphere" in views:
+        src["sphere"].data = {"image": [tone_map(frame.sphere)]}
+    if "albedo" in views:
+        a = frame.albedo
+        src["albedo"].data = {"t": frame.albedo_theta, "r": a[:, 0], "g": a[:, 1],
+                              "b": a[:, 2]}
     if not _same(src["masking"].data.get("M"), frame.masking["M"]):
         _masking(src, frame)
     cols = ("#1f77b4", "#d62728")

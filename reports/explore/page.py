@@ -6,7 +6,9 @@ another model's sliders) finds the hosts by their CSS class (``param-NAME``,
 ``view-NAME``), sets ``data-testid`` to that class, makes each control focusable
 (``tabindex=0``) and moves it with the arrow keys (a slider by its step, up and right
 raising it; a choice to the next option with down or right, the previous with up or left)
-when it is focused itself, and counts each view's redraws in
+when it is focused itself (the app's outermost element says
+``data-lm-suppress-shortcuts``: in Jupyter the notebook's own keys, arrows included, do
+not take those meant for a control), and counts each view's redraws in
 ``data-version`` (its data sources' changes, after the next animation frame; the time of
 the last in ``data-drawn-at``, milliseconds of ``performance.now()``; the views by name in
 ``window.__microcylViews``, for tests that read them without walking the page). Nothing
@@ -39,6 +41,10 @@ function hosts(root, out) {
   }
   return out;
 }
+function outermost(el) {
+  while (el.getRootNode() instanceof ShadowRoot) el = el.getRootNode().host;
+  return el;
+}
 function step(m, dir) {
   if (m.step !== undefined && m.start !== undefined) {
     const v = Math.min(m.end, Math.max(m.start, m.value + dir * m.step));
@@ -56,6 +62,7 @@ function tag() {
     if (el.dataset.testid === c) continue;
     el.dataset.testid = c;
     if (c.startsWith('param-')) {
+      outermost(el).dataset.lmSuppressShortcuts = 'true';  // Jupyter's keys pass it by
       el.tabIndex = 0;
       el.addEventListener('keydown', e => {
         if (e.composedPath()[0] !== el) return;

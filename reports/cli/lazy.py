@@ -34,10 +34,12 @@ def report():
 
 
 def renderer() -> SimpleNamespace:
-    """The built-in renderer's ``engine``, ``exposure``, ``files`` and ``imageio`` modules."""
+    """The built-in renderer's ``engine``, ``exposure``, ``files``, ``imageio`` and
+    ``scenefile`` modules."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
-    from reports.render import engine, exposure, files, imageio
-    return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio)
+    from reports.render import engine, exposure, files, imageio, scenefile
+    return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio,
+                           scenefile=scenefile)
 
 
 def explorer():

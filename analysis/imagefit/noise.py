@@ -2,9 +2,11 @@
 
 A pixel's residual (the image minus the render at the fabric's parameters) has the variance
 
-    var = shot * max(image, 0) + read^2 + var_mc + floor
+    var = shot * max(render, 0) + read^2 + var_mc + floor
 
-per channel, in the image's linear units squared:
+per channel, in the image's linear units squared, ``render`` the mean of the Monte Carlo
+noise's renders (the expected value, not the noisy image: weights from the image's own values
+would favour the pixels whose noise fell low, and pull the fit down):
 
 - ``shot`` (``--shot-noise``): the camera's shot noise, variance per unit of linear value (a
   sensor of gain g electrons per unit has ``shot = 1 / g``);
@@ -12,7 +14,7 @@ per channel, in the image's linear units squared:
 - ``var_mc``: the render's own Monte Carlo noise, the variance of a pixel between renders of
   independent seeds (:func:`mc_variance`: ``K`` seeds, each pixel's sample variance pooled
   over its 3 x 3 neighbourhood, so ``9 (K - 1)`` degrees of freedom a pixel);
-- ``floor``: ``(1e-4 max|image|)^2``, so that a black pixel of a noiseless image has a
+- ``floor``: ``(1e-4 max|render|)^2``, so that a black pixel of a noiseless image has a
   variance.
 
 The fit renders every step with one seed (common random numbers), so the render is a smooth
@@ -58,18 +60,20 @@ class NoiseModel:
                 raise ValueError(f"--{name} {value!r}: must be a finite number >= 0 ({what})")
 
     def variance(self, image, var_mc) -> np.ndarray:
-        """The residual variance of each value of ``image`` (module notes)."""
+        """The residual variance of each pixel whose expected value is ``image`` (the
+        render's: module notes)."""
         image = np.asarray(image, float)
         floor = (FLOOR * float(np.max(np.abs(image), initial=0.0))) ** 2
         return self.shot * np.maximum(image, 0.0) + self.read ** 2 + var_mc + floor
 
     def describe(self) -> dict:
         """The model as ``results.json`` states it."""
-        return {"formula": "var = shot * max(image, 0) + read^2 + var_mc + floor",
+        return {"formula": "var = shot * max(render, 0) + read^2 + var_mc + floor",
                 "shot": self.shot, "read": self.read,
                 "var_mc": "each pixel's variance between renders of independent seeds, "
                           "pooled over 3 x 3 pixels",
-                "floor": f"({FLOOR:g} * max|image|)^2"}
+                "render": "the mean of the Monte Carlo noise's renders",
+                "floor": f"({FLOOR:g} * max|render|)^2"}
 
 
 def mc_variance(renders) -> np.ndarray:

@@ -101,8 +101,9 @@ def levenberg_marquardt(pair: Callable, u0, lo, hi, *, max_iter: int = 30,
     """Minimize the decorrelated loss of ``pair(u) -> (r_a, r_b)`` over the box
     ``[lo, hi]`` (module notes).
 
-    ``on_step(entry)`` is called after each step (progress, checkpoints); ``history``
-    continues an earlier run's (its steps are counted on).
+    ``on_step(entry)`` is called at the start (``entry["start"]`` true) and after each step
+    (progress, checkpoints); ``history`` continues an earlier run's (its steps are counted
+    on).
 
     Examples
     --------
@@ -118,6 +119,11 @@ def levenberg_marquardt(pair: Callable, u0, lo, hi, *, max_iter: int = 30,
     st = _State(pair, np.clip(np.asarray(u0, float), lo, hi), lo, hi)
     st.differentiate(pair, lo, hi)
     evals, lam, start = 1 + st.u.size, 1e-2, len(history)
+    entry = {"iteration": start, "loss": st.loss, "u": st.u.tolist(), "accepted": True,
+             "lambda": lam, "start": True}
+    history.append(entry)
+    if on_step is not None:
+        on_step(entry)
     for it in range(start, start + max_iter):
         dec = st.decrement(lo, hi)
         if dec < DECREMENT:

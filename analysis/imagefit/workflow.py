@@ -119,7 +119,8 @@ class _Model:
         of two seeds' normalized residuals (camera plus half the Monte Carlo's)."""
         runs = [self.images(u, SEED_STRIDE * (k + 1)) for k in range(mc_seeds)]
         mc = [mc_variance([r[i] for r in runs]) for i in range(len(self.obs))]
-        var = [noise.variance(ob.image, m) for ob, m in zip(self.obs, mc)]
+        mean = [np.mean([r[i] for r in runs], axis=0) for i in range(len(self.obs))]
+        var = [noise.variance(m, v) for m, v in zip(mean, mc)]
         self.sd = [np.sqrt(x) for x in var]
         self.v = np.concatenate([((x - m / 2) / x).ravel() for x, m in zip(var, mc)])
 
@@ -181,6 +182,8 @@ def fit_images(observations, fabric, free, out_dir, *, render: Callable,
     """
     if isinstance(mc_seeds, bool) or not isinstance(mc_seeds, int) or not 2 <= mc_seeds <= 64:
         raise ValueError(f"--mc-seeds {mc_seeds!r}: must be an integer from 2 to 64")
+    if isinstance(max_iter, bool) or not isinstance(max_iter, int) or not 1 <= max_iter <= 1000:
+        raise ValueError(f"--max-steps {max_iter!r}: must be an integer from 1 to 1000")
     observations, params = _checked(observations, fabric, free)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -220,7 +223,8 @@ def _optimize(model, u0, lo, hi, max_iter, history, out, digest, progress):
     with progress_bar(max_iter, desc="fit-images", unit="step", enabled=progress) as bar:
         def on_step(entry):
             hist.append(entry)
-            bar.update()
+            if not entry.get("start"):
+                bar.update()
             bar.set_postfix(loss=f"{entry['loss']:.6g}")
             with atomic_write(out / "state.json", "w") as fh:
                 json.dump({"digest": digest, "u": entry["u"], "history": hist}, fh)
@@ -265,7 +269,7 @@ def _document(model, sol, start, noise, mc_seeds, seconds) -> dict:
         "fit": {"steps": len(sol.history), "renders": model.renders, "seconds": seconds,
                 "images": per_image,
                 "history": [{"iteration": h["iteration"], "loss": h["loss"],
-                             "accepted": h["accepted"],
+                             "accepted": h["accepted"], "start": bool(h.get("start")),
                              "values": dict(zip(params.names,
                                                 params.to_natural(h["u"]).tolist()))}
                             for h in sol.history]},

@@ -12,12 +12,12 @@ from types import SimpleNamespace
 
 
 def plots() -> SimpleNamespace:
-    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``, ``plan``,
-    ``views``."""
+    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``,
+    ``imagefit``, ``plan``, ``views``."""
     # lazy: matplotlib, corner and colour-science (~2 s), which `microcyl --help` skips
-    from reports.plots import common, fit, fit_diagnostics, plan, views
+    from reports.plots import common, fit, fit_diagnostics, imagefit, plan, views
     return SimpleNamespace(common=common, fit=fit, fit_diagnostics=fit_diagnostics,
-                           plan=plan, views=views)
+                           imagefit=imagefit, plan=plan, views=views)
 
 
 def report():

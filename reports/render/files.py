@@ -18,7 +18,21 @@ from reports.render.exposure import Exposure, auto_exposure, exr_attributes
 from reports.render.imageio import write_exr, write_png
 from reports.render.scenefile import write_scene_file
 
-__all__ = ["render_to_files"]
+__all__ = ["render_to_files", "render_image"]
+
+
+def render_image(scene, fabric, *, engine: str = "builtin", width: int, height: int, spp: int,
+                 seed: int = 0, workers=None, progress=False, variant=None, max_depth=None,
+                 mask=False):
+    """The linear RGB image (H, W, 3) of ``scene`` with cloth of ``fabric`` in ``engine``
+    (and the cloth's coverage with ``mask=True``); the arguments as :func:`render_to_files`.
+    """
+    if engine == "mitsuba":
+        return render_mitsuba(scene, fabric, width=width, height=height, spp=spp, seed=seed,
+                              max_depth=max_depth, variant=variant, workers=workers,
+                              progress=progress, mask=mask)
+    return render(scene, fabric, width=width, height=height, spp=spp, seed=seed,
+                  progress=progress, workers=workers, mask=mask)
 
 
 def render_to_files(scene, fabric, out, *, stops=None, engine: str = "builtin", width: int,
@@ -48,13 +62,9 @@ def render_to_files(scene, fabric, out, *, stops=None, engine: str = "builtin", 
     (Exposure, list of Path)
         The PNG's exposure and the files written.
     """
-    if engine == "mitsuba":
-        image, cloth = render_mitsuba(scene, fabric, width=width, height=height, spp=spp,
-                                      seed=seed, max_depth=max_depth, variant=variant,
-                                      workers=workers, progress=progress, mask=True)
-    else:
-        image, cloth = render(scene, fabric, width=width, height=height, spp=spp, seed=seed,
-                              progress=progress, workers=workers, mask=True)
+    image, cloth = render_image(scene, fabric, engine=engine, width=width, height=height,
+                                spp=spp, seed=seed, workers=workers, progress=progress,
+                                variant=variant, max_depth=max_depth, mask=True)
     expo = auto_exposure(image, cloth) if stops is None else Exposure(stops)
     out = Path(out)
     if out.suffix.lower() == ".exr":

@@ -11,6 +11,8 @@ import pytest
 import brdf
 from analysis.imagefit import NoiseModel, Observation, fit_images
 from reports.cli import main
+from reports.mitsuba.render import have_mitsuba, variant_works
+from reports.plots.imagefit import FILES, write_plots
 from reports.render.truthset import write_truth_images
 
 #: The hidden fabric: linen_plain with thread 1's kd and gamma_s moved off the start's
@@ -132,3 +134,50 @@ def test_an_image_of_another_size_than_its_scene_is_one_line(truth_images, tmp_p
                  "-o", str(tmp_path / "fit")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "12 x 10 pixels, its scene 128 x 72" in err[0], err
+
+
+def _variant_or_skip(variant):
+    if not have_mitsuba():
+        pytest.skip("Mitsuba 3 is not installed")
+    ok, why = variant_works(variant)
+    if not ok:
+        pytest.skip(f"{variant} does not run here: {why}")
+
+
+@pytest.mark.parametrize("variant", ["llvm_ad_rgb", "cuda_ad_rgb"])
+def test_mitsuba_renders_forward_in_the_fit_too(tmp_path, variant):
+    """Images rendered by Mitsuba (direct light, the microcylinder plugin) and fitted with
+    the same renderer, the variant their scene files name: the cylinder alone, kd1 and
+    gamma_s1 free (the CUDA variant where a GPU is present)."""
+    _variant_or_skip(variant)
+    fabric = brdf.fabric("linen_plain").with_values(TRUTH)
+    images = write_truth_images(tmp_path, fabric, width=128, height=72, spp=8, shot=SHOT,
+                                read=READ, seed=2, scenes=("cylinder",), engine="mitsuba",
+                                variant=variant)
+    assert json.loads(images[0].with_name("cylinder0.scene.json").read_text())["render"][
+        "variant"] == variant
+    out = tmp_path / "fit"
+    subprocess.run([sys.executable, "-m", "reports", "fit-images", *map(str, images),
+                    "--fabric", "linen_plain", "--free", "kd1,gamma_s1", "--shot-noise",
+                    str(SHOT), "--read-noise", str(READ), "--spp", "4", "--mc-seeds", "3",
+                    "--no-plots", "-q", "-o", str(out)], check=True, timeout=900)
+    doc = json.loads((out / "results.json").read_text())
+    assert doc["converged"], doc["reason"]
+    for name, true in TRUTH.items():
+        p = doc["parameters"][name]
+        assert p["lo95"] < true < p["hi95"], (name, p)
+
+
+def test_the_figures_are_written(tmp_path):
+    rng = np.random.default_rng(0)
+    img = rng.random((6, 8, 3))
+    doc = {"parameters": {"kd1": {"lo95": 0.4, "hi95": 0.5, "start": 0.3, "unit": "1"}},
+           "fit": {"history": [{"iteration": 0, "loss": 9.0, "accepted": True, "start": True,
+                                "values": {"kd1": 0.3}},
+                               {"iteration": 1, "loss": 5.0, "accepted": True,
+                                "start": False, "values": {"kd1": 0.45}}]}}
+    files = write_plots(doc, [("a.exr", img, img * 0.9, rng.normal(size=img.shape))],
+                        tmp_path)
+    assert files == FILES
+    for name in FILES.values():
+        assert (tmp_path / name).read_bytes()[:4] == b"\x89PNG"

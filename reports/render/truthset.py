@@ -28,8 +28,12 @@ LIGHTS = ((-1.6, 2.8, 2.2), (1.9, 2.4, 2.0), (2.6, 0.9, 0.9))
 
 def write_truth_images(out_dir, fabric, *, width: int = 128, height: int = 72, spp: int = 16,
                        shot: float = 1e-4, read: float = 0.002, seed: int = 0,
-                       scenes=("cylinder", "curtain")) -> list[Path]:
+                       scenes=("cylinder", "curtain"), engine: str = "builtin",
+                       variant: str | None = None) -> list[Path]:
     """Render, add noise, write ``<scene><k>.exr`` and ``.scene.json``; return the EXR paths.
+
+    ``engine="mitsuba"`` renders in Mitsuba 3's ``variant`` with paths of 2 vertices (direct
+    light alone, as the built-in engine).
 
     Examples
     --------
@@ -47,12 +51,15 @@ def write_truth_images(out_dir, fabric, *, width: int = 128, height: int = 72, s
         for k, pos in enumerate(LIGHTS):
             scene = base.replace(light=dataclasses.replace(base.light, position=pos))
             s = seed + k
-            img = render_image(scene, fabric, width=width, height=height, spp=spp, seed=s,
-                               workers=1).astype(float)
+            depth = 2 if engine == "mitsuba" else None
+            img = render_image(scene, fabric, engine=engine, width=width, height=height,
+                               spp=spp, seed=s, workers=1, variant=variant,
+                               max_depth=depth).astype(float)
             img = img + rng.normal(0.0, np.sqrt(shot * np.maximum(img, 0.0) + read ** 2))
             path = out_dir / f"{name}{k}.exr"
             write_exr(path, img)
-            write_scene_file(path, scene, fabric, engine="builtin", width=width,
-                             height=height, spp=spp, seed=s, exposure_stops=None)
+            write_scene_file(path, scene, fabric, engine=engine, width=width,
+                             height=height, spp=spp, seed=s, exposure_stops=None,
+                             variant=variant, max_depth=depth)
             paths.append(path)
     return paths

@@ -28,8 +28,9 @@ def _shown(img, scale) -> np.ndarray:
     return np.clip(np.clip(img * scale, 0.0, 1.0) ** (1 / 2.2), 0.0, 1.0)
 
 
-def images_figure(panels, filename):
-    """``images.png`` (module notes) of ``panels``: ``(name, image, fitted, residual)``."""
+def images_figure(panels, filename=None):
+    """``images.png`` (module notes) of ``panels``: ``(name, image, fitted, residual)``;
+    saved to ``filename`` (the path returned), or the figure returned when None."""
     n = len(panels)
     fig, axes = plt.subplots(n, 3, figsize=(9.0, 1.9 * n + 0.4), squeeze=False)
     for row, (name, image, fitted, resid) in zip(axes, panels):
@@ -45,6 +46,8 @@ def images_figure(panels, filename):
     for ax, title in zip(axes[0], ("image", "fitted render", "residual / sd (G)")):
         ax.set_title(title, fontsize=9)
     fig.colorbar(im, ax=axes[:, 2].tolist(), shrink=0.8)
+    if filename is None:
+        return fig
     out = save_figure(fig, filename)
     plt.close(fig)
     return out

@@ -15,8 +15,9 @@ ratio, the wall times and the machine's load.
     .venv/bin/python bench/bench_fit_images.py --coverage 20 [--engine mitsuba]
 
 ``--coverage N``: N image sets of independent noise (the cylinder alone, 64 x 36, images at 8
-samples a pixel, the fit's at 4), each fitted in this process with kd1 and gamma_s1 free;
-prints how often each truth fell inside its 68% and 95% intervals.
+samples a pixel or ``--image-spp``, the fit's at 4, ``--mc-seeds`` 3), each fitted in this
+process with kd1 and gamma_s1 free; prints how often each truth fell inside its 68% and 95%
+intervals.
 """
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ def _run(argv) -> float:
     return time.perf_counter() - t0
 
 
-def coverage(n: int, engine: str, work: Path) -> None:
+def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
+             mc_seeds: int = 3) -> None:
     """The intervals' coverage over ``n`` image sets (module notes)."""
     from analysis.imagefit import NoiseModel, Observation, fit_images
     from reports.render.files import render_image
@@ -65,13 +67,13 @@ def coverage(n: int, engine: str, work: Path) -> None:
     for rep in range(n):
         folder = work / f"set{rep}"
         folder.mkdir(parents=True, exist_ok=True)
-        paths = write_truth_images(folder, fabric, width=64, height=36, spp=8, shot=SHOT,
-                                   read=READ, seed=1000 + 10 * rep, scenes=("cylinder",),
+        paths = write_truth_images(folder, fabric, width=64, height=36, spp=image_spp,
+                                   shot=SHOT, read=READ, seed=1000 + 10 * rep, scenes=("cylinder",),
                                    engine=engine, variant=variant)
         obs = [Observation(p.name, read_exr(p), read_scene_file(scene_file_path(p)).scene,
                            1001 + 10 * rep + k) for k, p in enumerate(paths)]
         doc = fit_images(obs, brdf.fabric("linen_plain"), "kd1,gamma_s1", folder / "fit",
-                         render=render, noise=NoiseModel(SHOT, READ), mc_seeds=3)
+                         render=render, noise=NoiseModel(SHOT, READ), mc_seeds=mc_seeds)
         line = []
         for k, true in truth.items():
             p = doc["parameters"][k]
@@ -81,8 +83,8 @@ def coverage(n: int, engine: str, work: Path) -> None:
             line.append(f"{k} {p['median']:.4g} ({z:+.2f} sd)")
         print(f"set {rep}: " + ", ".join(line) + f"; chi2 ratio "
               f"{doc['noise']['chi2_ratio']:.3f}", flush=True)
-    print(f"{engine}: {n} image sets in {time.perf_counter() - t0:.0f} s, load "
-          f"{os.getloadavg()[0]:.1f}")
+    print(f"{engine}, images at {image_spp} spp, {mc_seeds} Monte Carlo seeds: {n} image "
+          f"sets in {time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f}")
     for k, (h68, h95) in hits.items():
         print(f"{k}: inside the 68% interval {h68} of {n}, the 95% interval {h95} of {n}")
 
@@ -98,10 +100,13 @@ def main() -> int:
                     help="instead: the intervals' coverage over N image sets")
     ap.add_argument("--engine", default="builtin", choices=("builtin", "mitsuba"),
                     help="--coverage's renderer (builtin)")
+    ap.add_argument("--image-spp", type=int, default=8, help="--coverage's images' spp (8)")
+    ap.add_argument("--mc-seeds", type=int, default=3, help="--coverage's fits' (3)")
     args = ap.parse_args()
     if args.coverage:
         coverage(args.coverage, args.engine,
-                 Path(args.keep or tempfile.mkdtemp(prefix="bench_fit_images_")))
+                 Path(args.keep or tempfile.mkdtemp(prefix="bench_fit_images_")),
+                 args.image_spp, args.mc_seeds)
         return 0
     free = args.free.split(",")
     truth = {k: TRUTH[k] for k in free}

@@ -69,7 +69,10 @@ def steps_figure(doc, filename):
     for h in hist[1:]:
         if h["start"]:
             for ax in axes:
-                ax.axvline(h["iteration"], color="grey", ls="--", lw=0.8)
+                ax.axvline(h["iteration"], color="grey", ls="--", lw=0.8,
+                           label="Monte Carlo noise estimated again" if ax is axes[0] else None)
+    if axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(fontsize=7, loc="best")
     for ax, name in zip(axes[1:], names):
         p = doc["parameters"][name]
         ax.axhspan(p["lo95"], p["hi95"], color="C0", alpha=0.25, label="95% interval")

@@ -63,8 +63,9 @@ def steps_figure(doc, filename):
     steps = [h["iteration"] for h in hist]
     ok = [h["accepted"] for h in hist]
     axes[0].plot(steps, [h["loss"] for h in hist], "k.-")
-    axes[0].plot([s for s, a in zip(steps, ok) if not a],
-                 [h["loss"] for h in hist if not h["accepted"]], "rx", label="step refused")
+    if not all(ok):
+        axes[0].plot([s for s, a in zip(steps, ok) if not a],
+                     [h["loss"] for h in hist if not h["accepted"]], "rx", label="step refused")
     axes[0].set_ylabel("loss")
     for h in hist[1:]:
         if h["start"]:

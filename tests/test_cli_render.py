@@ -88,7 +88,7 @@ def test_render_writes_exr_and_png(tmp_path):
     out = tmp_path / "c.exr"
     assert main(["render", "cylinder", "velvet", "--masking", "off", "--tangent-samples", "4",
                  *SMALL, "-o", str(out)]) == 0
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.exr", "c.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.exr", "c.png", "c.scene.json"]
     img = imageio.read_exr(out)
     assert img.shape == (9, 16, 3) and img.dtype == np.float32 and img.max() > 0
     assert np.asarray(Image.open(tmp_path / "c.png")).shape == (9, 16, 3)
@@ -105,7 +105,7 @@ def test_masking_toggle_changes_the_render(tmp_path):
     assert not np.allclose(a, b)
     assert main(["render", "cylinder", "velvet", "--masking", "off", "--tangent-samples", "4",
                  *SMALL, "-o", str(tmp_path / "m.png")]) == 0
-    assert [p.name for p in tmp_path.iterdir()] == ["m.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.png", "m.scene.json"]
 
 
 class _Interrupting:
@@ -184,7 +184,7 @@ def test_engine_mitsuba_end_to_end(tmp_path):
                         "-o", str(out)], capture_output=True, text=True, timeout=600, env=env)
     assert p.returncode == 0, p.stderr
     assert "mitsuba llvm_ad_rgb" in p.stderr and "wrote" in p.stderr
-    assert sorted(f.name for f in tmp_path.iterdir()) == ["c.exr", "c.png"]
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["c.exr", "c.png", "c.scene.json"]
     img = imageio.read_exr(out)
     assert img.shape == (36, 64, 3) and np.all(np.isfinite(img)) and img.max() > 0
     png = np.asarray(Image.open(tmp_path / "c.png"))

@@ -31,6 +31,7 @@ COMMAND_MODULES = (
     "reports.cli.render",
     "reports.cli.physics",
     "reports.cli.fit",
+    "reports.cli.fitimages",
     "reports.cli.compare",
     "reports.cli.measured",
     "reports.cli.batch",

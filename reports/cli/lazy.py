@@ -12,12 +12,12 @@ from types import SimpleNamespace
 
 
 def plots() -> SimpleNamespace:
-    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``, ``plan``,
-    ``views``."""
+    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``,
+    ``imagefit``, ``plan``, ``views``."""
     # lazy: matplotlib, corner and colour-science (~2 s), which `microcyl --help` skips
-    from reports.plots import common, fit, fit_diagnostics, plan, views
+    from reports.plots import common, fit, fit_diagnostics, imagefit, plan, views
     return SimpleNamespace(common=common, fit=fit, fit_diagnostics=fit_diagnostics,
-                           plan=plan, views=views)
+                           imagefit=imagefit, plan=plan, views=views)
 
 
 def report():
@@ -34,10 +34,12 @@ def report():
 
 
 def renderer() -> SimpleNamespace:
-    """The built-in renderer's ``engine``, ``exposure``, ``files`` and ``imageio`` modules."""
+    """The built-in renderer's ``engine``, ``exposure``, ``files``, ``imageio`` and
+    ``scenefile`` modules."""
     # lazy: imageio pulls in colour-science (~2 s), which `microcyl --help` does not need
-    from reports.render import engine, exposure, files, imageio
-    return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio)
+    from reports.render import engine, exposure, files, imageio, scenefile
+    return SimpleNamespace(engine=engine, exposure=exposure, files=files, imageio=imageio,
+                           scenefile=scenefile)
 
 
 def explorer():

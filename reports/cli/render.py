@@ -18,6 +18,10 @@ gives it in stops (2**1.5 times the linear values), ``--exposure 4x`` as a scale
 linear and records the exposure in its header (``microcyl_exposure_stops``, ...).  Every
 argument is checked (scene, fabric and its options, size, output folder, engine and variant)
 before rendering starts.
+Beside the image goes ``out.scene.json`` (:mod:`reports.render.scenefile`: geometry, camera,
+lights, exposure, integrator, spp, seed, engine and the fabric with every parameter);
+``microcyl render --scene out.scene.json -o again.exr`` renders the same image again (the
+options given, and a FABRIC, replace the file's).
 ``--engine mitsuba`` renders the same scene in Mitsuba 3 (:mod:`reports.mitsuba.render`: the
 ``microcylinder`` BSDF, the path integrator with ``--max-depth`` bounces, ``--variant``
 llvm_ad_rgb where LLVM works, else scalar_rgb).
@@ -48,17 +52,22 @@ def register(sub):
         "render", help="render a scene of cloth (curtain, cylinder, sphere, patch)",
         description="Render a scene of cloth shaded with the microcylinder BRDF to a float32 "
                     "OpenEXR (linear RGB) and an sRGB PNG.")
-    p.add_argument("scene", metavar="SCENE", help="curtain, cylinder, sphere or patch")
+    p.add_argument("scene", metavar="SCENE", nargs="?", default=None,
+                   help="curtain, cylinder, sphere or patch (none with --scene)")
+    p.add_argument("--scene", dest="scene_file", default=None, metavar="FILE",
+                   help="render the scene of a scene file (IMAGE.scene.json, written beside "
+                        "every render); the options given replace its settings, a FABRIC its "
+                        "fabric")
     cliutil.add_fabric_argument(p, tables=True)
     cliutil.add_fabric_options(p)
-    p.add_argument("--width", type=int, default=1280, help="pixels, at most 1280 (1280)")
-    p.add_argument("--height", type=int, default=720, help="pixels, at most 720 (720)")
-    p.add_argument("--spp", type=int, default=16, help="samples per pixel (16)")
-    p.add_argument("--exposure", default="auto", metavar="E",
+    p.add_argument("--width", type=int, default=None, help="pixels, at most 1280 (1280)")
+    p.add_argument("--height", type=int, default=None, help="pixels, at most 720 (720)")
+    p.add_argument("--spp", type=int, default=None, help="samples per pixel (16)")
+    p.add_argument("--exposure", default=None, metavar="E",
                    help="PNG exposure: auto (the 99th percentile of the cloth's pixels shown "
                         "at 0.9), stops (1.5: 2**1.5 times the linear values) or a scale "
                         "(4x) (auto); recorded in the EXR's header")
-    p.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    p.add_argument("--seed", type=int, default=None, help="random seed (0)")
     p.add_argument("--light-radius", type=float, default=None, metavar="R",
                    help="turn the scene's point light into a disc of this radius")
     p.add_argument("--workers", type=int, default=None, help="processes (all cores)")
@@ -105,11 +114,53 @@ def _engine_options(args, fabric):
     return variant, max_depth
 
 
+#: The render settings of a scene file a command line may replace, and their defaults.
+SETTINGS = {"width": 1280, "height": 720, "spp": 16, "seed": 0, "variant": None,
+            "max_depth": None}
+
+
+def _scene_and_fabric(args):
+    """The scene to render and its fabric text or object: from SCENE and FABRIC, or from
+    ``--scene FILE`` (its settings filling in the options not given, in ``args``)."""
+    if args.scene_file is None:
+        if args.scene is None:
+            raise ValueError("SCENE is required (curtain, cylinder, sphere or patch), or "
+                             "--scene FILE")
+        for key, default in SETTINGS.items():
+            if getattr(args, key) is None and default is not None:
+                setattr(args, key, default)
+        args.exposure = "auto" if args.exposure is None else args.exposure
+        return make_scene(args.scene), cliutil.fabric_argument(args)
+    if args.scene is not None:
+        if args.fabric is not None:
+            raise ValueError(f"SCENE {args.scene!r}: give no scene name with --scene "
+                             f"{args.scene_file}")
+        args.fabric, args.scene = args.scene, None      # the one positional is FABRIC
+    sf = lazy.renderer().scenefile.read_scene_file(args.scene_file)
+    for key in SETTINGS:
+        if getattr(args, key) is None:
+            setattr(args, key, sf.settings[key])
+    if args.engine == cliutil.DEFAULT_ENGINE:       # the file's engine, unless another given
+        args.engine = sf.settings["engine"]
+    if args.exposure is None:
+        stops = sf.settings["exposure_stops"]
+        args.exposure = "auto" if stops is None else repr(stops)
+    if args.fabric is None and args.fabric_option is None:
+        if sf.fabric is None:
+            raise ValueError(f"{args.scene_file}: its fabric is a measured table, not recorded "
+                             f"in the file; give FABRIC")
+        if cliutil.fabric_options(args):
+            raise ValueError("the variant options (--masking, ...) change a FABRIC given; the "
+                             "scene file's fabric has every parameter already")
+        return sf.scene, sf.fabric
+    return sf.scene, cliutil.fabric_argument(args)
+
+
 def run(args):
     """Check every argument, render, write the files; return 0."""
     built_in = lazy.renderer()
     exposure, imageio = built_in.exposure, built_in.imageio
-    scene = make_scene(args.scene)
+    scene, fabric = _scene_and_fabric(args)
     built_in.engine.check_size(args.width, args.height, args.spp)
     stops = exposure.parse_exposure(args.exposure)
     if args.seed < 0:
@@ -119,12 +170,13 @@ def run(args):
     if suffix not in (".exr", ".png"):
         raise ValueError(f"-o {args.output}: the output must end in .exr or .png")
     imageio.check_output(out)
-    fabric = cliutil.source_from_args(cliutil.fabric_argument(args), args, tables=True).brdf
+    if isinstance(fabric, str):
+        fabric = cliutil.source_from_args(fabric, args, tables=True).brdf
     if args.light_radius is not None:
         if not (args.light_radius >= 0 and math.isfinite(args.light_radius)):
             raise ValueError(f"--light-radius {args.light_radius}: must be >= 0")
         if not isinstance(scene.light, PointLight):
-            raise ValueError(f"--light-radius: scene {args.scene!r} has a directional light")
+            raise ValueError(f"--light-radius: scene {scene.name!r} has a directional light")
         scene = scene.replace(light=dataclasses.replace(scene.light, radius=args.light_radius))
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers {args.workers}: must be at least 1")

@@ -11,13 +11,34 @@ import importlib
 from types import SimpleNamespace
 
 
-def plots() -> SimpleNamespace:
-    """The plot modules the verbs call: ``common``, ``fit``, ``fit_diagnostics``,
-    ``imagefit``, ``plan``, ``views``."""
-    # lazy: matplotlib, corner and colour-science (~2 s), which `microcyl --help` skips
-    from reports.plots import common, fit, fit_diagnostics, imagefit, plan, views
-    return SimpleNamespace(common=common, fit=fit, fit_diagnostics=fit_diagnostics,
-                           imagefit=imagefit, plan=plan, views=views)
+class _PlotModules:
+    """``reports.plots.NAME`` for the NAMEs in :data:`PLOT_MODULES`, each imported when its
+    attribute is first read: ``fit_diagnostics`` loads corner, which loads arviz (about 2 s
+    of CPU), and only the verbs that fit draw its plots."""
+
+    def __getattr__(self, name: str):
+        if name not in PLOT_MODULES:
+            raise AttributeError(f"reports.plots has no module {name!r} for the verbs")
+        # lazy: matplotlib, corner (and arviz) and colour-science, which `microcyl --help`,
+        # `plot` and `plan` skip where they do not draw them; through importlib, one module
+        # at a time
+        return importlib.import_module(f"reports.plots.{name}")
+
+
+#: The plot modules the verbs call.
+PLOT_MODULES = ("common", "fit", "fit_diagnostics", "imagefit", "plan", "views")
+_PLOTS = _PlotModules()
+
+
+def plots() -> _PlotModules:
+    """The plot modules the verbs call (:data:`PLOT_MODULES`), each imported on first use.
+
+    Examples
+    --------
+    >>> plots().plan.__name__
+    'reports.plots.plan'
+    """
+    return _PLOTS
 
 
 def report():

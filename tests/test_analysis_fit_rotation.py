@@ -45,3 +45,43 @@ def test_a_rotated_satin_is_recovered_within_its_95_interval(tmp_path):
     assert s["lo95"] <= 25.0 <= s["hi95"], s
     assert s["hi95"] - s["lo95"] < 2.0          # the table tells it: well under a degree
     assert r.summary["kd1"]["lo95"] <= 0.1 <= r.summary["kd1"]["hi95"]
+
+
+def test_the_starts_spread_rotation_over_its_period(monkeypatch):
+    """Besides the perturbed starts, the point estimate starts at the preset's rotation
+    plus 45, 90 and 135 degrees (wrapped into [-90, 90]), and finds a satin turned 80."""
+    import analysis.fit.optimize as optimize
+    from analysis.fit.posterior import LogPosterior
+    from analysis.likelihood import Likelihood
+    start = brdf.fabric("polyester_satin_charmeuse")
+    truth = start.with_values({"rotation": 80.0})
+    table = gonio.measure(truth, gonio.full_grid(30.0, 60.0), INSTRUMENT, seed=4,
+                          progress=False)
+    spec = ParamSpec(("kd1", "rotation"), defaults=defaults_from_fabric(start))
+    lp = LogPosterior(spec, Likelihood(table), FabricModel(start, table.wi, table.wo))
+    seen = []
+    real = optimize.point_estimate
+
+    def spy(logpost, starts, **kw):
+        seen.append(spec.to_natural(starts))
+        return real(logpost, starts, **kw)
+    monkeypatch.setattr(optimize, "point_estimate", spy)
+    best, best_lp, _ = optimize.optimize_start(lp, 4, np.random.default_rng(0))
+    rot = seen[0][:, 1]
+    assert len(rot) == 4 + 3
+    # 90 wraps to -90, the bound, held just inside it (internal -10: 0.008 degrees)
+    np.testing.assert_allclose(rot[4:], [45.0, -90.0, -45.0], atol=0.01)
+    assert spec.to_natural(best)[1] == pytest.approx(80.0, abs=1.0)
+
+
+def test_curet_samples_rotation_on_a_window_holding_both_orientations():
+    from analysis.measured import MEASURED, measured_spec
+    for name, d in MEASURED.items():
+        spec, _ = measured_spec(name)
+        if d.kind == "curet":
+            p = spec.params["rotation"]
+            assert (p.lo, p.hi) == (-45.0, 135.0) and p.hi - p.lo == 180.0
+            # both of the samples' orientations (about -4 and 89.4) are 40 degrees inside
+            assert all(p.lo + 40 < v < p.hi - 40 for v in (-4.0, 89.4))
+        else:
+            assert "rotation" not in spec.free

@@ -27,12 +27,10 @@ Choices, all physically motivated and stated in the report:
 - **Rotation (CUReT).** Free, as the samples' weave direction is not known. The model is
   periodic in it with period 180 degrees (a thread's tangent and its opposite are the same
   cylinder), and CUReT's six samples lie either near 0 (felt, linen, cotton: about -4) or near
-  90 (polyester, velvet, corduroy: about 89.4, i.e. -90.6). On the schema's window [-90, 90]
-  the latter mode is cut in two at the window's ends, where the sampler cannot cross from one
-  half to the other (the ensembles split, R-hat never falls, and the logit coordinates give
-  each half an exponential tail): the fits did not converge. They are sampled on the window
-  [-45, 135] instead, the same prior by the period, which keeps both orientations 45 degrees
-  or more from its ends; a value above 90 is the orientation 180 degrees below it.
+  90 (polyester, velvet, corduroy: about 89.4, i.e. -90.6). The schema's window [-90, 90]
+  cuts the latter mode in two at its ends, which the sampler cannot cross: the fits did not
+  converge. They are sampled on [-45, 135], the same prior by the period, holding both
+  orientations 41 degrees or more inside; a value above 90 is the one 180 degrees below it.
 
 Examples
 --------

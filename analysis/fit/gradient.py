@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from brdf import jit
 from brdf.prepared import GRAD_PARAMS
 
 __all__ = ["gradient_available", "logpost_and_grad", "rotation_cache"]
@@ -50,7 +51,6 @@ def gradient_available(logpost) -> bool:
     """
     if _eval_and_grad(logpost.model) is None:
         return False
-    from brdf import jit
     return bool(jit.available()[0])
 
 

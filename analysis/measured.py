@@ -24,13 +24,6 @@ Choices, all physically motivated and stated in the report:
   direction pair once (at theta_o = 0 every azimuth names the same pair): 462 pairs of the
   1008. The mirrored half and the repeats are the same measurements and would count each
   several times, making the intervals too narrow. CUReT: the 205 configurations as measured.
-- **Rotation (CUReT).** Free, as the samples' weave direction is not known. The model is
-  periodic in it with period 180 degrees (a thread's tangent and its opposite are the same
-  cylinder), and CUReT's six samples lie either near 0 (felt, linen, cotton: about -4) or near
-  90 (polyester, velvet, corduroy: about 89.4, i.e. -90.6). The schema's window [-90, 90]
-  cuts the latter mode in two at its ends, which the sampler cannot cross: the fits did not
-  converge. They are sampled on [-45, 135], the same prior by the period, holding both
-  orientations 41 degrees or more inside; a value above 90 is the one 180 degrees below it.
 
 Examples
 --------
@@ -95,8 +88,6 @@ class MeasuredDataset:
         Preset giving the tangent curves, fixed values and start.
     free, ties : tuple of str
         Free parameters and ties (:class:`analysis.params.ParamSpec` syntax).
-    bounds : tuple of (str, float, float)
-        Bounds replacing the schema's (natural units): CUReT's rotation window.
     """
 
     name: str
@@ -107,12 +98,6 @@ class MeasuredDataset:
     preset: str
     free: tuple[str, ...]
     ties: tuple[str, ...]
-    bounds: tuple = ()
-
-
-#: CUReT's rotation window (degrees; see the module notes): both orientations of the six
-#: samples, about -4 and 89.4, 41 degrees or more inside it.
-CURET_ROTATION = ("rotation", -45.0, 135.0)
 
 
 def _rgl(colour: str) -> MeasuredDataset:
@@ -125,8 +110,7 @@ def _rgl(colour: str) -> MeasuredDataset:
 def _curet(sample: int, what: str, preset: str) -> MeasuredDataset:
     return MeasuredDataset(
         f"curet_{sample:02d}_{what}", f"CUReT sample {sample}, {what} (Dana et al. 1999)",
-        "curet", "curet/abrdf.dat", sample, preset, _SHARED_FREE + ("rotation",), _SHARED_TIES,
-        (CURET_ROTATION,))
+        "curet", "curet/abrdf.dat", sample, preset, _SHARED_FREE + ("rotation",), _SHARED_TIES)
 
 
 #: The measured datasets by name.
@@ -247,8 +231,7 @@ def measured_spec(name, fab=None):
     """
     d = _dataset(name)
     fab = fab if fab is not None else preset_fabric(d.preset)
-    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties,
-                     bounds={n: (lo, hi) for n, lo, hi in d.bounds}), fab
+    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties), fab
 
 
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
@@ -342,7 +325,6 @@ def _job(n: str, root: Path, rgl_step: float, plots, fit: dict,
                         loader=loader, plots=plots, model=model,
                         config_extra={"dataset": n, "rgl_step": rgl_step})
     return BatchJob(n, str(root / d.path), d.sample, d.preset, d.free, d.ties, fit=fit,
-                    bounds=d.bounds,
                     loader=loader, plots=plots,
                     config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
 

@@ -72,9 +72,6 @@ class BatchJob:
     config_extra : dict, optional
         Recorded in (and matched against) the fit's stored configuration; default the
         preset, its options and the sample, as ``microcyl fit`` records them.
-    bounds : tuple of (str, float, float)
-        Bounds (natural units) replacing the schema's, as ``(name, lo, hi)`` (e.g. the
-        window of a periodic ``rotation``; :data:`analysis.measured.MEASURED`).
     model : str
         The model fitted (:func:`analysis.families.model_names`; default microcylinder). A
         baseline model starts from its typical values (``preset`` unused) and, with
@@ -96,7 +93,6 @@ class BatchJob:
     plots: Callable | None = None
     config_extra: dict | None = None
     model: str = MICROCYLINDER
-    bounds: tuple = ()
 
     def fabric(self):
         """The start model: the preset's fabric with its options (a baseline model at its
@@ -108,8 +104,7 @@ class BatchJob:
         """The :class:`~analysis.params.ParamSpec` of this fit (checks every name); ``table``
         decides a baseline's default free set."""
         return fit_spec(fab if fab is not None else self.fabric(), self.free, self.ties,
-                        self.spec, table=table,
-                        bounds={n: (lo, hi) for n, lo, hi in self.bounds})
+                        self.spec, table=table)
 
     def key(self) -> str:
         """A digest of everything that decides the fit: the job's fields and the size and
@@ -118,8 +113,6 @@ class BatchJob:
                if f.name not in ("plots",)}
         if doc["model"] == MICROCYLINDER:
             del doc["model"]                # the keys of batches run before models stand
-        if not doc["bounds"]:
-            del doc["bounds"]               # and before bounds
         doc["loader"] = repr(self.loader)
         for what, p in (("table", self.path), ("spec_file", self.spec)):
             if p is not None and Path(p).exists():

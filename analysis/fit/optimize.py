@@ -25,11 +25,6 @@ __all__ = ["point_estimate", "laplace_cov", "initial_walkers", "optimize_start",
 GRADIENTS = ("auto", "fd", "analytic")
 #: What ``"auto"`` means (the faster on ``bench/bench_sampler.py --start``; docs/benchmarks.rst).
 AUTO_GRADIENT = "fd"
-#: Periodic parameters and their period (natural units): the microcylinder's rotation
-#: (degrees; a thread's tangent and its opposite are the same cylinder). The starts of the
-#: point estimate spread such a parameter over its period, so that an orientation far from
-#: the start is found (CUReT's cut piles lie 90 degrees from the presets').
-PERIODS = {"rotation": 180.0}
 #: Dr.Jit's AD of one start at a time (its kernel uses the cores itself).
 _AD_LOCK = threading.Lock()
 
@@ -213,9 +208,7 @@ def initial_walkers(logpost, best, cov, nwalkers, rng) -> tuple[np.ndarray, np.n
 def optimize_start(logpost, n_starts: int, rng, threads: int = 1,
                    gradient: str = "auto") -> tuple[np.ndarray, float, np.ndarray | None]:
     """Point estimate from the spec's start and ``n_starts - 1`` perturbations of it (5% of
-    each parameter's internal range, from ``rng``) and, for each periodic parameter of
-    :data:`PERIODS`, ``n_starts - 1`` more: the start with that parameter moved by k /
-    n_starts of its period (wrapped into its bounds); then the Laplace covariance there;
+    each parameter's internal range, from ``rng``), then the Laplace covariance there;
     ``gradient`` as :func:`point_estimate`.
 
     Returns
@@ -244,15 +237,6 @@ def optimize_start(logpost, n_starts: int, rng, threads: int = 1,
     for _ in range(max(0, n_starts - 1)):
         starts.append(np.clip(start + rng.normal(scale=0.05 * spec.width), spec.lower,
                               spec.upper))
-    for i, name in enumerate(spec.free):          # a periodic parameter over its period
-        period, p = PERIODS.get(name), spec.params[name]
-        if period is None or p.hi - p.lo < period:
-            continue
-        for k in range(1, max(2, n_starts)):
-            x = start.copy()
-            v = p.lo + (p.default + k * period / max(2, n_starts) - p.lo) % period
-            x[i] = np.clip(p.to_internal(v), -10.0, 10.0)
-            starts.append(x)
     best, best_logp, _ = point_estimate(logpost, np.array(starts), threads=threads,
                                         gradient=gradient)
     return best, best_logp, laplace_cov(logpost, best)

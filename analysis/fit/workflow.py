@@ -26,7 +26,7 @@ from analysis.params import ParamSpec
 __all__ = ["fit_fabric", "fit_spec", "check_fit_size"]
 
 
-def fit_spec(fabric, free=None, ties=None, toml=None, table=None, bounds=None) -> ParamSpec:
+def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
     """The parameter spec of a fit as ``microcyl fit`` builds it from its options.
 
     Parameters
@@ -51,8 +51,6 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None, bounds=None) -
     table : gonio.Table, optional
         The table to be fitted: whether it is grey or relative decides a baseline's default
         free set (without it: neither).
-    bounds : mapping of str to (float, float), optional
-        Bounds (natural units) replacing those of the schema (with ``toml``: added to its own).
 
     Returns
     -------
@@ -84,16 +82,8 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None, bounds=None) -
         if table is not None and not grey and fam.cls.DEFAULT_FREE is not None:
             return _with_table_colour(fabric, table, free, ties, notes, defaults)
     if toml is not None:
-        spec = ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties, family=fam)
-        if not bounds:
-            return spec
-        return ParamSpec(spec.free, defaults={n: p.default for n, p in spec.params.items()},
-                         ties=spec.ties, bounds={**{n: (p.lo, p.hi) for n, p in
-                                                   spec.params.items()}, **dict(bounds)},
-                         priors={n: p.prior for n, p in spec.params.items()}, family=fam,
-                         notes=spec.notes)
-    return ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes,
-                     bounds=dict(bounds or {}))
+        return ParamSpec.from_toml(toml, defaults=defaults, free=free, ties=ties, family=fam)
+    return ParamSpec(free, defaults=defaults, ties=ties or (), family=fam, notes=notes)
 
 
 def _with_table_colour(fabric, table, free, ties, notes, defaults) -> ParamSpec:

@@ -10,6 +10,7 @@ log-probability evaluations per second, effective samples per second, and the wa
     .venv/bin/python bench/bench_fit.py --calibration 20  # coverage over 20 replicas
     .venv/bin/python bench/bench_fit.py --real          # RGL felts and CUReT fabrics
     .venv/bin/python bench/bench_fit.py --diagnostics   # warnings and adequacy, known truth
+    .venv/bin/python bench/bench_fit.py --backends 2    # numpy vs drjit, interleaved
 
 Every fit prints its adequacy verdict and its warnings (:mod:`analysis.fit.trust`).
 """
@@ -17,14 +18,17 @@ Every fit prints its adequacy verdict and its warnings (:mod:`analysis.fit.trust
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import resource
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 from scipy import stats
 
 import brdf
@@ -125,6 +129,59 @@ def speed(args):
     return 0 if r.converged and t["wall_s"] < 300 else 1
 
 
+def _one_backend(backend, seed):
+    """The default fit in a fresh process under ``MICROCYL_BACKEND=backend``: its JSON."""
+    env = dict(os.environ, MICROCYL_BACKEND=backend)
+    out = subprocess.run([sys.executable, __file__, "--json", "--seed", str(seed)], env=env,
+                         capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def backends(args):
+    """The default fit under each backend, alternately (``--backends`` rounds): wall and CPU
+    time ratios, and the quantiles compared in units of their Monte Carlo error."""
+    runs = {"numpy": [], "drjit": []}
+    for r in range(args.backends):
+        for b in (("numpy", "drjit") if r % 2 == 0 else ("drjit", "numpy")):
+            doc = _one_backend(b, args.seed)
+            runs[b].append(doc)
+            print(f"round {r} {b:6s}: wall {doc['wall_s']:6.1f} s, CPU {doc['cpu_s']:6.1f} s, "
+                  f"{doc['steps']} steps, load {doc['load']:.1f}; {doc['reason']}", flush=True)
+    med = {b: {k: float(sorted(d[k] for d in v)[len(v) // 2]) for k in ("wall_s", "cpu_s")}
+           for b, v in runs.items()}
+    print(f"numpy / drjit (medians of {args.backends}): wall "
+          f"{med['numpy']['wall_s'] / med['drjit']['wall_s']:.2f}x, CPU "
+          f"{med['numpy']['cpu_s'] / med['drjit']['cpu_s']:.2f}x; load average now "
+          f"{os.getloadavg()[0]:.1f}")
+    a, b = runs["numpy"][0]["summary"], runs["drjit"][0]["summary"]
+    worst = 0.0
+    for n in a:
+        for q in ("lo95", "median", "hi95"):
+            # the Monte Carlo se of a quantile, roughly sd x sqrt(1/ESS) x a factor 1.25 to
+            # 2 (median to 2.5%); the two fits' errors combined
+            sd = (a[n]["hi68"] - a[n]["lo68"]) / 2
+            se = 2.0 * sd * np.hypot(1 / np.sqrt(a[n]["ess"]), 1 / np.sqrt(b[n]["ess"]))
+            z = abs(a[n][q] - b[n][q]) / se
+            worst = max(worst, z)
+        print(f"   {n:10s} median numpy {a[n]['median']:10.5g} drjit {b[n]['median']:10.5g}; "
+              f"95% [{a[n]['lo95']:.5g}, {a[n]['hi95']:.5g}] vs [{b[n]['lo95']:.5g}, "
+              f"{b[n]['hi95']:.5g}]")
+    print(f"largest quantile difference: {worst:.2f} Monte Carlo standard errors "
+          f"({'within' if worst < 3 else 'NOT within'} 3)")
+    return 0
+
+
+def as_json(args):
+    """The default fit, one JSON line (for :func:`backends`)."""
+    table, fab = simulate("silk_crepe_de_chine", seed=args.seed)
+    cpu0, load = time.process_time(), os.getloadavg()[0]
+    r = run_fit(table, fab, seed=args.seed, progress=False)
+    print(json.dumps({"wall_s": r.timing["wall_s"], "cpu_s": time.process_time() - cpu0,
+                      "steps": r.steps, "load": load, "reason": r.reason,
+                      "backend": brdf.jit.backend(), "summary": r.summary}))
+    return 0
+
+
 def recovery(args):
     bad = 0
     for name in ("silk_crepe_de_chine", "polyester_satin_charmeuse", "velvet"):
@@ -215,7 +272,14 @@ def main():
                     help="with --real: per fit")
     ap.add_argument("--out", default=None)
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--backends", type=int, default=0, metavar="ROUNDS",
+                    help="the default fit under MICROCYL_BACKEND=numpy and drjit, alternately")
+    ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.json:
+        return as_json(args)
+    if args.backends:
+        return backends(args)
     if args.recovery:
         return recovery(args)
     if args.calibration:

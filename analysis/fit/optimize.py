@@ -8,12 +8,25 @@ a few single evaluations.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import threading
 
 import numpy as np
 import scipy
 import scipy.optimize
 
-__all__ = ["point_estimate", "laplace_cov", "initial_walkers", "optimize_start"]
+from analysis.fit.gradient import gradient_available, logpost_and_grad, rotation_cache
+
+__all__ = ["point_estimate", "laplace_cov", "initial_walkers", "optimize_start", "GRADIENTS"]
+
+#: The gradients the point estimate may use: ``"fd"`` (a batch of ndim + 1 evaluations, every
+#: model), ``"analytic"`` (the kernel's automatic differentiation,
+#: :mod:`analysis.fit.gradient`; finite differences where the model has none), ``"auto"``
+#: (the default: :data:`AUTO_GRADIENT`).
+GRADIENTS = ("auto", "fd", "analytic")
+#: What ``"auto"`` means (the faster on ``bench/bench_sampler.py --start``; docs/benchmarks.rst).
+AUTO_GRADIENT = "fd"
+#: Dr.Jit's AD of one start at a time (its kernel uses the cores itself).
+_AD_LOCK = threading.Lock()
 
 #: SciPy's L-BFGS-B is C (re-entrant) from 1.15 on; before, Fortran with shared state.
 _LBFGSB_THREAD_SAFE = tuple(int(v) for v in scipy.__version__.split(".")[:2]) >= (1, 15)
@@ -27,8 +40,10 @@ def _fd_grad_batch(x, h, lower, upper):
     return pts, steps
 
 
-def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int = 1):
-    """Maximum a posteriori estimate from several starts (L-BFGS-B, batched FD gradient).
+def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int = 1,
+                   gradient: str = "auto"):
+    """Maximum a posteriori estimate from several starts (L-BFGS-B, batched FD gradient or
+    the kernel's analytic one).
 
     Parameters
     ----------
@@ -37,6 +52,8 @@ def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int
         Internal coordinates of the starts.
     threads : int
         Starts optimized at once (each independent of the others: same result for any value).
+    gradient : {"auto", "fd", "analytic"}
+        See :data:`GRADIENTS`; "analytic" falls back to "fd" for a model without derivatives.
 
     Returns
     -------
@@ -60,6 +77,20 @@ def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int
         fi = np.where(np.isfinite(lp[1:]), -lp[1:], f0 + 1e6 * np.abs(steps))
         return float(f0), (fi - f0) / steps
 
+    if gradient not in GRADIENTS:
+        raise ValueError(f"gradient must be one of {', '.join(GRADIENTS)}; got {gradient!r}")
+    if gradient == "auto":
+        gradient = AUTO_GRADIENT
+    analytic = gradient == "analytic" and gradient_available(logpost)
+
+    def fun_grad_ad(x, bad, cache):
+        with _AD_LOCK:
+            r = logpost_and_grad(logpost, x, cache)
+        if r is None:                       # no kernel at this point (tangent scales)
+            return fun_grad(x, bad)
+        lp, g = r
+        return (bad, np.zeros_like(x)) if not np.isfinite(lp) else (-lp, -g)
+
     def one(s):
         f_start = -float(logpost(s[None])[0])
         if not np.isfinite(f_start):
@@ -67,7 +98,9 @@ def point_estimate(logpost, starts: np.ndarray, maxiter: int = 300, threads: int
         # a point that cannot be evaluated must look worse than the start, however poor the
         # start (a log-posterior of -1e43 made the bounds, where it is -inf, look better)
         bad = big + 10.0 * abs(f_start)
-        r = scipy.optimize.minimize(fun_grad, s, args=(bad,), jac=True, method="L-BFGS-B",
+        fg, args = (fun_grad_ad, (bad, rotation_cache(logpost))) if analytic else (fun_grad,
+                                                                                    (bad,))
+        r = scipy.optimize.minimize(fg, s, args=args, jac=True, method="L-BFGS-B",
                                     bounds=list(zip(lower, upper)),
                                     options={"maxiter": maxiter})
         if not (np.isfinite(r.fun) and r.fun < bad and r.fun <= f_start):
@@ -172,10 +205,11 @@ def initial_walkers(logpost, best, cov, nwalkers, rng) -> tuple[np.ndarray, np.n
                        "--spec) or fit other parameters (--free)")
 
 
-def optimize_start(logpost, n_starts: int, rng,
-                   threads: int = 1) -> tuple[np.ndarray, float, np.ndarray | None]:
+def optimize_start(logpost, n_starts: int, rng, threads: int = 1,
+                   gradient: str = "auto") -> tuple[np.ndarray, float, np.ndarray | None]:
     """Point estimate from the spec's start and ``n_starts - 1`` perturbations of it (5% of
-    each parameter's internal range, from ``rng``), then the Laplace covariance there.
+    each parameter's internal range, from ``rng``), then the Laplace covariance there;
+    ``gradient`` as :func:`point_estimate`.
 
     Returns
     -------
@@ -203,5 +237,6 @@ def optimize_start(logpost, n_starts: int, rng,
     for _ in range(max(0, n_starts - 1)):
         starts.append(np.clip(start + rng.normal(scale=0.05 * spec.width), spec.lower,
                               spec.upper))
-    best, best_logp, _ = point_estimate(logpost, np.array(starts), threads=threads)
+    best, best_logp, _ = point_estimate(logpost, np.array(starts), threads=threads,
+                                        gradient=gradient)
     return best, best_logp, laplace_cov(logpost, best)

@@ -189,6 +189,10 @@ class ParamSpec:
             prior = priors.get(name, prior)
             self.params[name] = Param(name, float(lo), float(hi), prior, unit,
                                       float(defaults.get(name, fallback)))
+        for name, per in self.periods.items():  # a repeating angle spans one whole period
+            p = self.params.get(name)
+            if p is not None and name not in bounds and not p.is_log and p.hi - p.lo < per:
+                self.params[name] = dataclasses.replace(p, lo=-per / 2.0, hi=per / 2.0)
         self.free: tuple[str, ...] = tuple(free)
         if not self.free:
             raise ValueError("no free parameter left after applying ties")
@@ -278,11 +282,15 @@ class ParamSpec:
                          family=self.family, notes=self.notes, periods=self.periods)
 
     def with_periods(self, periods: Mapping[str, float]) -> "ParamSpec":
-        """A copy with the periods ``periods`` (name -> period, natural units) added."""
-        new = object.__new__(ParamSpec)
-        new.__dict__.update(self.__dict__)
-        new.periods = {**self.periods, **{str(k): float(v) for k, v in periods.items()}}
-        return new
+        """A copy with the periods ``periods`` (name -> period, natural units) added; a
+        periodic parameter left at its family's bounds spans one whole period, centred on 0
+        (a fabric's ``rotation``: [-90, 90] degrees for 180, [-180, 180] for 360)."""
+        ps = self.params.values()
+        own = {p.name: (p.lo, p.hi) for p in ps if (p.lo, p.hi) != self.family.entry(p.name)[:2]}
+        return ParamSpec(list(self.free), defaults={p.name: p.default for p in ps}, bounds=own,
+                         priors={p.name: p.prior for p in ps}, ties=self.ties,
+                         family=self.family, notes=self.notes,
+                         periods={**self.periods, **periods})
 
     def period(self, name: str) -> float | None:
         """The period of a circular parameter: its model repeats every ``periods[name]`` and
@@ -293,7 +301,9 @@ class ParamSpec:
         --------
         >>> spec = ParamSpec("rotation", periods={"rotation": 180.0})
         >>> spec.period("rotation"), spec.with_periods({"rotation": 360.0}).period("rotation")
-        (180.0, None)
+        (180.0, 360.0)
+        >>> spec.with_periods({"rotation": 360.0}).params["rotation"].hi
+        180.0
         """
         period = self.periods.get(name)
         p = self.params.get(name)

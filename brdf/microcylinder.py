@@ -11,8 +11,9 @@ of :data:`brdf.schema.THREAD_PARAMS`, then the RGB one per channel), then
 [-90, 90] degrees), then ``rotation``, the rotation of both threads about the normal n in
 degrees (the fabric option :attr:`brdf.FabricOptions.rotation` is in radians; the fit's
 parameter, its results and the command line are in degrees: warp along (cos rho, sin rho, 0),
-counter-clockwise from +x toward +y). Its search range and prior are uniform on [-90, 90]
-degrees: a fabric whose tangent curves are symmetric (unchanged by negating and reversing
+counter-clockwise from +x toward +y). A fit's search range and prior are uniform over one
+period (:mod:`analysis.params`: [-90, 90] degrees, or [-180, 180] for a fabric that a half
+turn changes): a fabric whose tangent curves are symmetric (unchanged by negating and reversing
 the offsets: four presets' threads; not velvet's pile nor the satin back's first thread) is
 unchanged by a half turn, so [-90, 90] holds every orientation of it, once
 (:meth:`MicrocylinderModel.periods`; a fit summarizes such a rotation as an angle on a circle,

@@ -70,7 +70,8 @@ def test_without_the_period_the_same_draws_read_as_two_bounds():
     """The check above could fail: the same draws, the rotation not known to be circular,
     give the plain summary (a median far from the mode) and the bound warning."""
     natural = np.stack([_wrapped_draws(89.0, 1.0), np.full((2, 400, 8), 0.3)], -1)
-    plain = ParamSpec(("rotation", "kd1"), periods={"rotation": 360.0})   # range < period
+    plain = ParamSpec(("rotation", "kd1"), bounds={"rotation": (-90.0, 90.0)},
+                      periods={"rotation": 360.0})                     # range < period
     s = summarize(plain, _diagnosis(plain, natural))["rotation"]
     assert "period" not in s and s["hi95"] - s["lo95"] > 100.0
     result = SimpleNamespace(names=plain.free, spec=plain, samples=lambda: natural.reshape(-1, 2))
@@ -109,8 +110,11 @@ def test_a_satin_turned_to_the_wrap_is_recovered_without_a_bound_warning(tmp_pat
 
 def test_the_measured_datasets_rotation_is_circular_where_the_preset_repeats():
     """polyester's satin is symmetric under a half turn (its -90 and +90 are one orientation);
-    velvet's pile is not, so its [-90, 90] is an interval with two real bounds."""
+    velvet's pile is not: its rotation spans a whole turn, [-180, 180], not half of one."""
     from analysis.measured import measured_spec
     assert measured_spec("curet_02_polyester")[0].period("rotation") == 180.0
     assert measured_spec("curet_44_linen")[0].period("rotation") == 180.0
-    assert measured_spec("curet_07_velvet")[0].period("rotation") is None
+    velvet = measured_spec("curet_07_velvet")[0]
+    assert velvet.period("rotation") == 360.0
+    assert (velvet.params["rotation"].lo, velvet.params["rotation"].hi) == (-180.0, 180.0)
+    assert measured_spec("curet_02_polyester")[0].params["rotation"].hi == 90.0

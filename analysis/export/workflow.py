@@ -26,6 +26,7 @@ from analysis.export.projection import Projection, project_draws
 from analysis.fit.medians import fabric_at, median_fabric
 from analysis.planning.draws import fit_folder_spec, posterior_draws
 from gonio.atomic import atomic_write
+from gonio.safeopen import read_bytes
 from gonio.jsonplain import plain
 
 __all__ = ["ExportResult", "export_fabric", "fidelity_path", "DEFAULT_DRAWS"]
@@ -107,6 +108,15 @@ def _draw_sources(src, draws: int, seed: int) -> tuple[list, list[str]]:
     return out, notes
 
 
+def _earlier_fidelity(fpath: Path) -> bytes | None:
+    """The bytes of an earlier export's fidelity file at ``fpath`` (a regular file under
+    1 MiB), to put back should this export fail; None otherwise."""
+    try:
+        return read_bytes(fpath, max_bytes=1 << 20) if fpath.is_file() else None
+    except (OSError, ValueError):
+        return None
+
+
 def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID,
                   draws: int = DEFAULT_DRAWS, seed: int = 0,
                   objective: str = "cos_cos") -> ExportResult:
@@ -148,6 +158,7 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
     if src.kind == "table":
         raise ValueError(f"{src.label}: a measured table is exported by fitting it first "
                          f"(`microcyl fit`), then exporting the fit folder")
+    path, settled_note = tgt.settled(path)
     if tgt.model is None:
         if not src.is_fabric:
             raise ValueError(f"--to {tgt.name}: the Mitsuba plugin is the microcylinder "
@@ -158,6 +169,8 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
         sources, notes = _draw_sources(src, draws, seed)
         proj = project_draws(src.brdf, sources, tgt.model, grid, objective)
         target_brdf = proj.brdf()
+    if settled_note:
+        notes.append(settled_note)
     fid = fidelity(src.brdf, target_brdf, grid)
     doc = {"file": path.name, "target": tgt.name, "target_conventions": tgt.describe,
            "source": {"label": src.label, "kind": src.kind, "model": src.model,
@@ -165,10 +178,19 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
            "projection": None if proj is None else proj.as_dict(),
            "fidelity": fid, "notes": notes}
     fpath = fidelity_path(path)
+    earlier = _earlier_fidelity(fpath)
     with atomic_write(fpath, "w") as fh:
         fh.write(json.dumps(plain(doc), indent=1, allow_nan=False) + "\n")
-    if proj is None:
-        tgt.write(path, src.brdf, src.preset)
-    else:
-        tgt.write(path, proj, src.label)
+    try:
+        if proj is None:
+            tgt.write(path, src.brdf, src.preset)
+        else:
+            tgt.write(path, proj, src.label)
+    except BaseException:       # the export failed (Blender's .blend): FILE and its fidelity
+        if earlier is None:     # as they were before
+            fpath.unlink(missing_ok=True)
+        else:
+            with atomic_write(fpath, "wb") as fh:
+                fh.write(earlier)
+        raise
     return ExportResult(path, fpath, tgt.name, proj, fid, tuple(notes))

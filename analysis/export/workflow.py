@@ -23,6 +23,7 @@ from analysis.export import TARGETS, target_named
 from analysis.export.fidelity import fidelity, summary_lines
 from analysis.export.grid import DEFAULT_GRID, HemisphereGrid
 from analysis.export.projection import Projection, project_draws
+from analysis.export.scale import Scaled, check_albedo_scale, relative_fit, scale_report
 from analysis.fit.medians import fabric_at, median_fabric
 from analysis.planning.draws import fit_folder_spec, posterior_draws
 from gonio.atomic import atomic_write
@@ -119,7 +120,8 @@ def _earlier_fidelity(fpath: Path) -> bytes | None:
 
 def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID,
                   draws: int = DEFAULT_DRAWS, seed: int = 0,
-                  objective: str = "cos_cos") -> ExportResult:
+                  objective: str = "cos_cos", albedo_scale: float | None = None
+                  ) -> ExportResult:
     """Export the resolved FABRIC ``src`` to ``target`` at ``path`` (module notes).
 
     Parameters
@@ -137,6 +139,10 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
         Picks the draws.
     objective : str
         What the projection fits (:data:`analysis.export.projection.OBJECTIVES`).
+    albedo_scale : float, optional
+        A factor on the source's f_r before the projection (``--albedo-scale``), for a fit
+        of a relative table whose absolute level the user knows
+        (:mod:`analysis.export.scale`); not for the Mitsuba target.
 
     Returns
     -------
@@ -158,7 +164,14 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
     if src.kind == "table":
         raise ValueError(f"{src.label}: a measured table is exported by fitting it first "
                          f"(`microcyl fit`), then exporting the fit folder")
+    k = check_albedo_scale(albedo_scale)
+    if k is not None and tgt.model is None:
+        raise ValueError(f"--albedo-scale {albedo_scale!r}: the {tgt.name} target writes the "
+                         f"fabric itself, whose f_r no parameter scales as a whole; export "
+                         f"--to {', '.join(n for n, t in TARGETS.items() if t.model)}")
     path, settled_note = tgt.settled(path)
+    rel = relative_fit(src)
+    source = src.brdf if k is None else Scaled(src.brdf, k)
     if tgt.model is None:
         if not src.is_fabric:
             raise ValueError(f"--to {tgt.name}: the Mitsuba plugin is the microcylinder "
@@ -167,16 +180,18 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
         proj, target_brdf, notes = None, src.brdf, []
     else:
         sources, notes = _draw_sources(src, draws, seed)
-        proj = project_draws(src.brdf, sources, tgt.model, grid, objective)
+        if k is not None:
+            sources = [Scaled(b, k) for b in sources]
+        proj = project_draws(source, sources, tgt.model, grid, objective)
         target_brdf = proj.brdf()
-    if settled_note:
-        notes.append(settled_note)
-    fid = fidelity(src.brdf, target_brdf, grid)
+    fid = fidelity(source, target_brdf, grid)
+    scale_doc, scale_note = scale_report(src, rel, k, fid)
+    notes += [n for n in (scale_note, settled_note) if n]
     doc = {"file": path.name, "target": tgt.name, "target_conventions": tgt.describe,
            "source": {"label": src.label, "kind": src.kind, "model": src.model,
                       "path": None if src.path is None else str(src.path)},
            "projection": None if proj is None else proj.as_dict(),
-           "fidelity": fid, "notes": notes}
+           "scale": scale_doc, "fidelity": fid, "notes": notes}
     fpath = fidelity_path(path)
     earlier = _earlier_fidelity(fpath)
     with atomic_write(fpath, "w") as fh:

@@ -61,6 +61,11 @@ def register(sub):
     p.add_argument("--objective", choices=list(OBJECTIVES), default="cos_cos",
                    help="what the projection fits: f_r cos(theta_i) cos(theta_o) (cos_cos, the "
                         "quantity whose error is reported) or f_r cos(theta_o) (cos_o)")
+    p.add_argument("--albedo-scale", type=float, default=None, metavar="K",
+                   help="multiply the source's f_r by K before projecting: a fit of a "
+                        "relative table (CUReT) has no absolute level, and the export says "
+                        "what it assumed (the directional albedo at normal incidence); K = "
+                        "the cloth's measured albedo / that one")
     p.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     p.set_defaults(func=run)
 
@@ -84,7 +89,7 @@ def run(args) -> int:
     grid = _grid(args.grid)
     src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
     res = export_fabric(src, tgt.name, out, grid=grid, draws=args.draws, seed=args.seed,
-                       objective=args.objective)
+                       objective=args.objective, albedo_scale=args.albedo_scale)
     log.info("wrote %s and %s", res.path, res.fidelity_path)
     if src.kind == "fit":
         med = median_fabric(src.path)

@@ -156,19 +156,7 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
     """
     tgt = target_named(target)
     path = Path(path)
-    if path.suffix.lower() not in tgt.suffixes:
-        raise ValueError(f"-o {str(path)!r}: the {tgt.name} target writes "
-                         f"{' or '.join(tgt.suffixes)}")
-    if not isinstance(draws, int) or isinstance(draws, bool) or not 0 <= draws <= 1000:
-        raise ValueError(f"--draws {draws!r}: must be an integer in [0, 1000]")
-    if src.kind == "table":
-        raise ValueError(f"{src.label}: a measured table is exported by fitting it first "
-                         f"(`microcyl fit`), then exporting the fit folder")
-    k = check_albedo_scale(albedo_scale)
-    if k is not None and tgt.model is None:
-        raise ValueError(f"--albedo-scale {albedo_scale!r}: the {tgt.name} target writes the "
-                         f"fabric itself, whose f_r no parameter scales as a whole; export "
-                         f"--to {', '.join(n for n, t in TARGETS.items() if t.model)}")
+    k = _check_request(tgt, path, src, draws, albedo_scale)
     path, settled_note = tgt.settled(path)
     rel = relative_fit(src)
     source = src.brdf if k is None else Scaled(src.brdf, k)
@@ -193,19 +181,43 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
            "projection": None if proj is None else proj.as_dict(),
            "scale": scale_doc, "fidelity": fid, "notes": notes}
     fpath = fidelity_path(path)
+    _write_both(fpath, doc, lambda: (tgt.write(path, src.brdf, src.preset) if proj is None
+                                     else tgt.write(path, proj, src.label)))
+    return ExportResult(path, fpath, tgt.name, proj, fid, tuple(notes))
+
+
+def _check_request(tgt, path: Path, src, draws, albedo_scale) -> float | None:
+    """The request's checks, before any work (one ValueError line each); the factor of
+    ``--albedo-scale`` (None without one)."""
+    if path.suffix.lower() not in tgt.suffixes:
+        raise ValueError(f"-o {str(path)!r}: the {tgt.name} target writes "
+                         f"{' or '.join(tgt.suffixes)}")
+    if not isinstance(draws, int) or isinstance(draws, bool) or not 0 <= draws <= 1000:
+        raise ValueError(f"--draws {draws!r}: must be an integer in [0, 1000]")
+    if src.kind == "table":
+        raise ValueError(f"{src.label}: a measured table is exported by fitting it first "
+                         f"(`microcyl fit`), then exporting the fit folder")
+    k = check_albedo_scale(albedo_scale)
+    if k is not None and tgt.model is None:
+        raise ValueError(f"--albedo-scale {albedo_scale!r}: the {tgt.name} target writes the "
+                         f"fabric itself, whose f_r no parameter scales as a whole; export "
+                         f"--to {', '.join(n for n, t in TARGETS.items() if t.model)}")
+    return k
+
+
+def _write_both(fpath: Path, doc: dict, write_export) -> None:
+    """The fidelity file, then the export (``write_export()``); when the export fails
+    (Blender's .blend), the fidelity file as it was before (removed, or an earlier export's
+    put back) and the error raised."""
     earlier = _earlier_fidelity(fpath)
     with atomic_write(fpath, "w") as fh:
         fh.write(json.dumps(plain(doc), indent=1, allow_nan=False) + "\n")
     try:
-        if proj is None:
-            tgt.write(path, src.brdf, src.preset)
-        else:
-            tgt.write(path, proj, src.label)
-    except BaseException:       # the export failed (Blender's .blend): FILE and its fidelity
-        if earlier is None:     # as they were before
+        write_export()
+    except BaseException:
+        if earlier is None:
             fpath.unlink(missing_ok=True)
         else:
             with atomic_write(fpath, "wb") as fh:
                 fh.write(earlier)
         raise
-    return ExportResult(path, fpath, tgt.name, proj, fid, tuple(notes))

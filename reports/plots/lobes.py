@@ -295,7 +295,8 @@ def draw_lobe_planes(view: LobeView, *, fig=None, filename=None, **kwargs):
     planes = view.planes_deg
     own = fig is None
     if own:
-        fig = Figure(figsize=(4.2 * len(planes), 2.9), layout="constrained")
+        # 3.9 in a panel: three fit a page column (12.2 in of 8 pt text at 12 px or more)
+        fig = Figure(figsize=(3.9 * len(planes), 2.9), layout="constrained")
     else:
         fig.clear()
     axes = [fig.add_subplot(1, len(planes), n + 1, axes_class=HalfDiscAxes)

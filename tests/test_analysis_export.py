@@ -18,7 +18,7 @@ from analysis import sources
 from analysis.export import TARGETS, HemisphereGrid, fidelity, project, target_for
 from analysis.export.blender import blender_script
 from analysis.export.gltf import read_gltf
-from analysis.export.mtlx import model_from_mtlx, mtlx_text, read_mtlx
+from analysis.export.mtlx import mtlx_text, read_mtlx
 from analysis.export.projection import Projection
 from analysis.export.workflow import export_fabric, fidelity_path
 from analysis.fit.medians import median_fabric

@@ -44,7 +44,7 @@ def test_export_gltf_prints_fidelity_and_reads_back(tmp_path):
 
 def test_export_refusals_are_one_line(tmp_path):
     bad = [(("export", "velvet", "--to", "gltf", "-o", "v.mtlx"), "must end in .gltf, .glb"),
-           (("export", "velvet", "-o", "v.obj"), "must end in .json, .xml, .mtlx, .gltf, .glb, .py"),
+           (("export", "velvet", "-o", "v.obj"), "must end in .json, .xml, .mtlx, .gltf, .glb, .py, .blend"),
            (("export", "velvet", "-o", "v.glb", "--grid", "4by8"), "--grid '4by8'"),
            (("export", "velvet", "-o", "v.glb", "--draws", "-1"), "--draws -1")]
     procs = [subprocess.Popen([sys.executable, "-m", "reports", *argv], env=ENV, cwd=tmp_path,

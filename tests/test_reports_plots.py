@@ -453,3 +453,60 @@ def test_a_half_disc_legend_sits_under_the_disc():
     edge_y = ax.transData.transform((0.0, 0.0))[1]          # the disc's centre, display px
     top = ax.get_legend().get_window_extent(r).y1
     assert 0 < (edge_y - top) * 72.0 / fig.dpi < 60.0
+
+
+def _pt(fig, pixels):
+    return pixels * 72.0 / fig.dpi
+
+
+def _polar_layout(fig):
+    """Per polar axes, in points: the gap from the top of the disc and its angle labels to
+    the title, and the lowest point of its labels; and per figure legend its top."""
+    fig.draw_without_rendering()
+    gaps, bottoms = [], []
+    for ax in (a for a in fig.axes if a.name == "polar"):
+        top = max([ax.transData.transform((0.0, ax.get_rmax()))[1]]
+                  + [t.get_window_extent().y1 for t in ax.get_xticklabels() if t.get_text()])
+        gaps.append(_pt(fig, ax.title.get_window_extent().y0 - top))
+        texts = [t for t in [*ax.texts, *ax.get_xticklabels(), *ax.get_yticklabels()]
+                 if t.get_text()]
+        bottoms.append(min(t.get_window_extent().y0 for t in texts))
+    legend_gaps = [_pt(fig, min(bottoms) - leg.get_window_extent().y1) for leg in fig.legends]
+    return gaps, legend_gaps
+
+
+def _lobe_figures(velvet, silk):
+    from reports.plots.views import lobes_view, masking_view
+    yield "polar lobe", plots.plot_polar_lobe(velvet, (30.0, 60.0), resolution=19)[0]
+    yield "comparison", plots.plot_lobe_comparison({"v": velvet, "s": silk}, 30.0,
+                                                   resolution=19)[0]
+    yield "planes", plots.plot_lobe_planes(velvet, (30.0,), scale="log", resolution=19)[0]
+    yield "masking", plots.plot_masking_lobes(velvet, 60.0, resolution=19)[0]
+    yield "plot lobes, two fabrics", lobes_view({"v": velvet, "s": silk}, theta_i=(30.0, 60.0),
+                                                resolution=19)
+    yield "plot masking, two rows", masking_view({"v": velvet, "s": silk}, resolution=19)
+
+
+def test_lobe_figures_keep_title_and_legend_next_to_the_half_disc(velvet, silk):
+    """Issue 40: the half disc sat in the middle of a square box, a quarter of it empty above
+    (23 to 47 pt between the title and the disc) and below (a figure legend 19 to 21 pt away
+    from the labels). Now the title is a title's pad away, the legend a few points."""
+    for name, fig in _lobe_figures(velvet, silk):
+        gaps, legend_gaps = _polar_layout(fig)
+        assert gaps and all(0.0 < g < 8.0 for g in gaps), (name, gaps)
+        assert all(0.0 < g < 10.0 for g in legend_gaps), (name, legend_gaps)
+
+
+def test_the_half_disc_is_round_and_fills_its_box(velvet):
+    fig, ax = plots.plot_polar_lobe(velvet, (30.0,), resolution=19)
+    fig.draw_without_rendering()
+    box = ax.get_window_extent()
+    rmax = ax.get_rmax()
+    (cx, cy), (lx, ly), (tx, ty), (rx, ry) = ax.transData.transform(
+        [(0.0, 0.0), (-np.pi / 2, rmax), (0.0, rmax), (np.pi / 2, rmax)])
+    radius = cx - lx
+    assert np.allclose([rx - cx, ty - cy], radius, rtol=1e-6)       # round, not squashed
+    assert np.allclose([lx, rx, cy, ty], [box.x0, box.x1, box.y0, box.y1], atol=0.5)
+    # the clip path is the disc: a point just inside the rim at 60 degrees is kept
+    inside = ax.transData.transform((np.radians(60.0), 0.99 * rmax))
+    assert ax.patch.get_path().transformed(ax.patch.get_transform()).contains_point(inside)

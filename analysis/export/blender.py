@@ -1,4 +1,4 @@
-r"""Blender (4.x, 5.x): a Python script that builds the material with ``bpy``.
+r"""Blender (4.x, 5.x): a ``.blend`` whose material ``bpy`` built, or the script that builds it.
 
 The Principled BSDF (Blender manual, render/shader_nodes/shader/principled.html) with
 ``Base Color`` the projected base, ``Diffuse Roughness`` 0 (Lambert), ``Specular IOR Level`` 0
@@ -11,12 +11,21 @@ MaterialX's ``sheen_bsdf`` uses the colourless 1 - weight R; the two agree for a
 whose largest channel is 1 and differ otherwise by (1 - max(tint)) R of the base (the fidelity
 file measures microcyl's Zeltner model, not Cycles).
 
-The file is code for Blender, not data: microcyl never runs or reads it back (a FABRIC never
-names a .py). Run it as ``blender --background --python FILE`` (adds the material to the open
-file) or, with ``-- --render OUT.png``, to render a small Cycles sphere under a sun at 45
-degrees; under a Python with the ``bpy`` module, ``python FILE --render OUT.png`` does the
-same. (The ``bpy`` wheel on PyPI, 5.0.1, requires numpy < 2 and cannot share microcyl's
-environment; it is no extra of microcyl.)
+``-o FILE.py`` writes the script: code for Blender, not data, which microcyl never reads back
+(a FABRIC never names a .py). Run it as ``blender --background --python FILE`` (adds the
+material to the open file), with ``-- --save OUT.blend`` to save the material on a sample
+sphere (a sun at 45 degrees, an orthographic camera above it, a black world) or with
+``-- --render OUT.png`` to render that sphere with Cycles; under a Python with the ``bpy``
+module, ``python FILE --save OUT.blend`` does the same.
+
+``-o FILE.blend`` runs that script with ``--save`` where ``bpy`` can be reached
+(:func:`blender_command`: the Python named by ``MICROCYL_BLENDER_PYTHON``, ``bpy`` importable
+in microcyl's own Python, or ``blender`` on the PATH) and writes the ``.blend`` it saved.
+Without one, the export writes ``FILE.py`` instead and says so
+(:func:`settle_blender_path`). PyPI's ``bpy`` is no extra of microcyl: its wheels for
+Python 3.11 (up to 5.0.1) require numpy < 2, which microcyl's colour-science rules out;
+those of ``bpy`` 5.1 and later (Python 3.13) take numpy 2, in a virtual environment of their
+own (``MICROCYL_BLENDER_PYTHON=/that/venv/bin/python``).
 
 Examples
 --------
@@ -30,17 +39,34 @@ Examples
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
 
 from analysis.export.target import Target
 from gonio.atomic import atomic_write
 
-__all__ = ["blender_script", "BLENDER"]
+__all__ = ["blender_script", "blender_command", "settle_blender_path", "write_blend",
+           "BLENDER", "BLENDER_PYTHON_ENV"]
+
+#: The environment variable naming a Python with ``bpy`` (a venv of its own).
+BLENDER_PYTHON_ENV = "MICROCYL_BLENDER_PYTHON"
+#: Seconds a ``.blend`` may take to build (importing bpy takes about 4 s).
+BLEND_TIMEOUT_S = 300
 
 _SCRIPT = '''"""microcyl export: {label} as a Blender Principled BSDF (Zeltner microfiber sheen).
 
 {doc}
-Run: blender --background --python THIS_FILE [-- --render OUT.png]
+Run: blender --background --python THIS_FILE [-- [--save OUT.blend] [--render OUT.png]]
+(or: python THIS_FILE [--save OUT.blend] [--render OUT.png], under a Python with bpy).
+Without arguments it adds the material to the open file; --save writes it on a sample
+sphere (a sun at 45 degrees, an orthographic camera above, a black world), --render
+renders that sphere with Cycles.
 """
 import sys
 
@@ -59,13 +85,14 @@ def build_material():
     return mat
 
 
-def render(out, size=64, samples=64):
+def build_scene(size=64, samples=64):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     scene.cycles.samples = samples
     scene.render.resolution_x = scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
     scene.view_settings.view_transform = "Standard"
     bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0)
     bpy.ops.object.shade_smooth()
@@ -76,18 +103,117 @@ def render(out, size=64, samples=64):
     scene.camera = bpy.context.object
     scene.camera.data.type = "ORTHO"
     scene.camera.data.ortho_scale = 2.2
-    scene.world = bpy.data.worlds.new("black")
+    scene.world = world = bpy.data.worlds.new("black")
+    world.color = (0.0, 0.0, 0.0)
+    if world.node_tree is None:                 # Blender 4.x: nodes on demand
+        world.use_nodes = True
+    for node in world.node_tree.nodes:          # a new world's background is 0.05 grey
+        if node.type == "BACKGROUND":
+            node.inputs["Strength"].default_value = 0.0
+    return scene
+
+
+def save(out):
+    build_scene()
+    bpy.context.preferences.filepaths.save_version = 0      # no OUT.blend1 backup
+    bpy.ops.wm.save_as_mainfile(filepath=out, check_existing=False)
+
+
+def render(out):
+    scene = build_scene()
     scene.render.filepath = out
     bpy.ops.render.render(write_still=True)
 
 
 if __name__ == "__main__":
     args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+    if "--save" in args:
+        save(args[args.index("--save") + 1])
     if "--render" in args:
         render(args[args.index("--render") + 1])
-    else:
+    if "--save" not in args and "--render" not in args:
         build_material()
 '''
+
+
+def blender_command() -> list[str] | None:
+    """The command that runs a Python file with ``bpy`` (the file and its arguments follow),
+    or None where none can be reached.
+
+    In this order: the Python named by ``MICROCYL_BLENDER_PYTHON`` (a ValueError when it
+    names no executable file), microcyl's own Python where ``bpy`` is importable in it,
+    ``blender`` on the PATH (run ``--background --factory-startup``; the file's arguments go
+    after ``--``).
+    """
+    named = os.environ.get(BLENDER_PYTHON_ENV)
+    if named:
+        if not (os.path.isfile(named) and os.access(named, os.X_OK)):
+            raise ValueError(f"{BLENDER_PYTHON_ENV}={named!r}: not an executable file (a "
+                             f"Python with bpy, e.g. /path/to/venv/bin/python)")
+        return [named]
+    if importlib.util.find_spec("bpy") is not None:
+        return [sys.executable]
+    blender = shutil.which("blender")
+    if blender:
+        return [blender, "--background", "--factory-startup", "--python"]
+    return None
+
+
+def _run_command(command: list[str], script: Path, args: list[str]) -> list[str]:
+    if Path(command[0]).name.startswith("blender") and "--python" in command:
+        return [*command, str(script), "--", *args]
+    return [*command, str(script), *args]
+
+
+def settle_blender_path(path) -> tuple[Path, str | None]:
+    """Where a Blender export of ``path`` is written and what to say of it: ``path`` itself
+    unless it is a ``.blend`` with no ``bpy`` in reach (:func:`blender_command`), then the
+    script ``FILE.py`` beside it and a note saying so. A ValueError (before any work) when
+    that ``.py`` exists already: it is not overwritten unasked.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".blend" or blender_command() is not None:
+        return path, None
+    script = path.with_suffix(".py")
+    if os.path.lexists(script):
+        raise ValueError(f"-o {str(path)!r}: no Python with bpy here ({BLENDER_PYTHON_ENV} "
+                         f"unset, bpy not importable, no blender on the PATH), so the export "
+                         f"would write the script {str(script)!r} instead, which exists; "
+                         f"remove it, or give -o {str(script)!r}")
+    return script, (f"no Python with bpy here ({BLENDER_PYTHON_ENV} unset, bpy not "
+                     f"importable, no blender on the PATH): wrote the script {script.name} "
+                     f"instead of {path.name}; `blender --background --python {script.name} "
+                     f"-- --save {path.name}` makes the .blend")
+
+
+def write_blend(path, projection, label: str, *, timeout_s: float = BLEND_TIMEOUT_S) -> Path:
+    """Build the material with ``bpy`` (:func:`blender_command`) and write the ``.blend``
+    at ``path`` (atomically: Blender saves in a private temporary folder, the file is then
+    copied into place). A RuntimeError naming the command and its last error line when
+    Blender fails; a ValueError when no ``bpy`` is in reach."""
+    command = blender_command()
+    if command is None:
+        raise ValueError(f"-o {str(path)!r}: no Python with bpy to build the .blend "
+                         f"({BLENDER_PYTHON_ENV} unset, bpy not importable, no blender on "
+                         f"the PATH)")
+    with tempfile.TemporaryDirectory(prefix="microcyl-blend-") as tmp:
+        script, blend = Path(tmp) / "material.py", Path(tmp) / "material.blend"
+        script.write_text(blender_script(projection, label), encoding="utf-8")
+        try:
+            run = subprocess.run(_run_command(command, script, ["--save", str(blend)]),
+                                 capture_output=True, text=True, timeout=timeout_s,
+                                 stdin=subprocess.DEVNULL, cwd=tmp)
+        except subprocess.TimeoutExpired:
+            raise RuntimeError(f"{command[0]}: building the .blend took over {timeout_s:g} "
+                               f"s; nothing written") from None
+        if run.returncode != 0 or not blend.is_file():
+            last = (run.stderr.strip().splitlines() or ["no error output"])[-1][:300]
+            raise RuntimeError(f"{command[0]} failed to build the .blend (exit "
+                               f"{run.returncode}): {last}; nothing written")
+        data = blend.read_bytes()
+    with atomic_write(path, "wb") as fh:
+        fh.write(data)
+    return Path(path)
 
 
 def blender_script(projection, label: str) -> str:
@@ -108,10 +234,14 @@ def blender_script(projection, label: str) -> str:
 
 
 def _write(path, projection, label):
+    if Path(path).suffix.lower() == ".blend":
+        write_blend(path, projection, label)
+        return
     with atomic_write(path, "w") as fh:
         fh.write(blender_script(projection, label))
 
 
-BLENDER = Target("blender", (".py",), "zeltner", _write, None,
+BLENDER = Target("blender", (".py", ".blend"), "zeltner", _write, None,
                  "Blender Principled BSDF: Base Color, Sheen Weight 1, Sheen Tint, Sheen "
-                 "Roughness (Cycles' microfiber sheen, Zeltner), Specular IOR Level 0")
+                 "Roughness (Cycles' microfiber sheen, Zeltner), Specular IOR Level 0",
+                 settle_blender_path)

@@ -41,6 +41,10 @@ class Target:
         the file is code (Blender's script) or the reader lives elsewhere.
     describe : str
         The target's parameters and conventions, in one sentence.
+    settle : callable or None
+        ``settle(path) -> (path, note or None)``: where the export of ``path`` is written
+        when this machine cannot write that file (Blender's ``.blend`` without ``bpy``: its
+        script), checked before any work; None: always ``path``.
     """
 
     name: str
@@ -49,3 +53,14 @@ class Target:
     write: Callable
     read: Callable | None
     describe: str
+    settle: Callable | None = None
+
+    def settled(self, path):
+        """``(path, note)``: :attr:`settle`'s answer, or ``path`` and None.
+
+        Examples
+        --------
+        >>> Target("demo", (".demo",), None, print, None, "a demonstration").settled("a.demo")
+        ('a.demo', None)
+        """
+        return (path, None) if self.settle is None else self.settle(path)

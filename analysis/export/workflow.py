@@ -23,9 +23,11 @@ from analysis.export import TARGETS, target_named
 from analysis.export.fidelity import fidelity, summary_lines
 from analysis.export.grid import DEFAULT_GRID, HemisphereGrid
 from analysis.export.projection import Projection, project_draws
+from analysis.export.scale import Scaled, check_albedo_scale, relative_fit, scale_report
 from analysis.fit.medians import fabric_at, median_fabric
 from analysis.planning.draws import fit_folder_spec, posterior_draws
 from gonio.atomic import atomic_write
+from gonio.safeopen import read_bytes
 from gonio.jsonplain import plain
 
 __all__ = ["ExportResult", "export_fabric", "fidelity_path", "DEFAULT_DRAWS"]
@@ -107,9 +109,19 @@ def _draw_sources(src, draws: int, seed: int) -> tuple[list, list[str]]:
     return out, notes
 
 
+def _earlier_fidelity(fpath: Path) -> bytes | None:
+    """The bytes of an earlier export's fidelity file at ``fpath`` (a regular file under
+    1 MiB), to put back should this export fail; None otherwise."""
+    try:
+        return read_bytes(fpath, max_bytes=1 << 20) if fpath.is_file() else None
+    except (OSError, ValueError):
+        return None
+
+
 def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID,
                   draws: int = DEFAULT_DRAWS, seed: int = 0,
-                  objective: str = "cos_cos") -> ExportResult:
+                  objective: str = "cos_cos", albedo_scale: float | None = None
+                  ) -> ExportResult:
     """Export the resolved FABRIC ``src`` to ``target`` at ``path`` (module notes).
 
     Parameters
@@ -127,6 +139,10 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
         Picks the draws.
     objective : str
         What the projection fits (:data:`analysis.export.projection.OBJECTIVES`).
+    albedo_scale : float, optional
+        A factor on the source's f_r before the projection (``--albedo-scale``), for a fit
+        of a relative table whose absolute level the user knows
+        (:mod:`analysis.export.scale`); not for the Mitsuba target.
 
     Returns
     -------
@@ -140,14 +156,10 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
     """
     tgt = target_named(target)
     path = Path(path)
-    if path.suffix.lower() not in tgt.suffixes:
-        raise ValueError(f"-o {str(path)!r}: the {tgt.name} target writes "
-                         f"{' or '.join(tgt.suffixes)}")
-    if not isinstance(draws, int) or isinstance(draws, bool) or not 0 <= draws <= 1000:
-        raise ValueError(f"--draws {draws!r}: must be an integer in [0, 1000]")
-    if src.kind == "table":
-        raise ValueError(f"{src.label}: a measured table is exported by fitting it first "
-                         f"(`microcyl fit`), then exporting the fit folder")
+    k = _check_request(tgt, path, src, draws, albedo_scale)
+    path, settled_note = tgt.settled(path)
+    rel = relative_fit(src)
+    source = src.brdf if k is None else Scaled(src.brdf, k)
     if tgt.model is None:
         if not src.is_fabric:
             raise ValueError(f"--to {tgt.name}: the Mitsuba plugin is the microcylinder "
@@ -156,19 +168,56 @@ def export_fabric(src, target: str, path, *, grid: HemisphereGrid = DEFAULT_GRID
         proj, target_brdf, notes = None, src.brdf, []
     else:
         sources, notes = _draw_sources(src, draws, seed)
-        proj = project_draws(src.brdf, sources, tgt.model, grid, objective)
+        if k is not None:
+            sources = [Scaled(b, k) for b in sources]
+        proj = project_draws(source, sources, tgt.model, grid, objective)
         target_brdf = proj.brdf()
-    fid = fidelity(src.brdf, target_brdf, grid)
+    fid = fidelity(source, target_brdf, grid)
+    scale_doc, scale_note = scale_report(src, rel, k, fid)
+    notes += [n for n in (scale_note, settled_note) if n]
     doc = {"file": path.name, "target": tgt.name, "target_conventions": tgt.describe,
            "source": {"label": src.label, "kind": src.kind, "model": src.model,
                       "path": None if src.path is None else str(src.path)},
            "projection": None if proj is None else proj.as_dict(),
-           "fidelity": fid, "notes": notes}
+           "scale": scale_doc, "fidelity": fid, "notes": notes}
     fpath = fidelity_path(path)
+    _write_both(fpath, doc, lambda: (tgt.write(path, src.brdf, src.preset) if proj is None
+                                     else tgt.write(path, proj, src.label)))
+    return ExportResult(path, fpath, tgt.name, proj, fid, tuple(notes))
+
+
+def _check_request(tgt, path: Path, src, draws, albedo_scale) -> float | None:
+    """The request's checks, before any work (one ValueError line each); the factor of
+    ``--albedo-scale`` (None without one)."""
+    if path.suffix.lower() not in tgt.suffixes:
+        raise ValueError(f"-o {str(path)!r}: the {tgt.name} target writes "
+                         f"{' or '.join(tgt.suffixes)}")
+    if not isinstance(draws, int) or isinstance(draws, bool) or not 0 <= draws <= 1000:
+        raise ValueError(f"--draws {draws!r}: must be an integer in [0, 1000]")
+    if src.kind == "table":
+        raise ValueError(f"{src.label}: a measured table is exported by fitting it first "
+                         f"(`microcyl fit`), then exporting the fit folder")
+    k = check_albedo_scale(albedo_scale)
+    if k is not None and tgt.model is None:
+        raise ValueError(f"--albedo-scale {albedo_scale!r}: the {tgt.name} target writes the "
+                         f"fabric itself, whose f_r no parameter scales as a whole; export "
+                         f"--to {', '.join(n for n, t in TARGETS.items() if t.model)}")
+    return k
+
+
+def _write_both(fpath: Path, doc: dict, write_export) -> None:
+    """The fidelity file, then the export (``write_export()``); when the export fails
+    (Blender's .blend), the fidelity file as it was before (removed, or an earlier export's
+    put back) and the error raised."""
+    earlier = _earlier_fidelity(fpath)
     with atomic_write(fpath, "w") as fh:
         fh.write(json.dumps(plain(doc), indent=1, allow_nan=False) + "\n")
-    if proj is None:
-        tgt.write(path, src.brdf, src.preset)
-    else:
-        tgt.write(path, proj, src.label)
-    return ExportResult(path, fpath, tgt.name, proj, fid, tuple(notes))
+    try:
+        write_export()
+    except BaseException:
+        if earlier is None:
+            fpath.unlink(missing_ok=True)
+        else:
+            with atomic_write(fpath, "wb") as fh:
+                fh.write(earlier)
+        raise

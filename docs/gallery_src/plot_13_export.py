@@ -9,7 +9,9 @@ target: Mitsuba's ``microcylinder`` plugin (the fabric itself) and the sheen mod
 OpenPBR, MaterialX, glTF and Blender, each projected from the fit's posterior (the medians of
 4 projected draws, with 95% intervals) over a stated grid. Beside each file,
 ``FILE.fidelity.json`` says how closely it follows the fit and where it cannot; the bars show
-the relative L2 error of f_r cos cos and the largest CIEDE2000 of a patch lit at 45 degrees.
+the relative L2 error of f_r cos cos and the largest CIEDE2000 of a patch lit at 45 degrees,
+and the spheres show the fit and each export read back, rendered side by side. CUReT's values
+are relative: the export says what absolute level it assumed (``--albedo-scale`` sets one).
 """
 import json
 import os
@@ -63,3 +65,35 @@ fig.tight_layout()
 # What the sheen models cannot follow, in the words of the glTF export's fidelity file:
 for line in docs["gltf"]["fidelity"]["cannot_follow"] or ["nothing flagged"]:
     print(line)
+
+# %%
+# The fit and each export read back as a FABRIC (the ``.mtlx`` and ``.glb`` files themselves;
+# Blender's script is code, so its sphere is microcyl's Zeltner model at the values its
+# fidelity file records), rendered by microcyl's built-in renderer in the lit-sphere scene,
+# all at one exposure (the fit's brightest pixels at 90%).
+import numpy as np
+
+from analysis.sources import resolve
+from brdf.baselines import Zeltner
+from reports.colour import to_srgb
+from reports.render.engine import render
+
+v = docs["blender"]["projection"]["values"]
+spheres = {"fit (mitsuba)": resolve(fabric).brdf,
+           "openpbr": resolve(str(out / files["openpbr"])).brdf,
+           "materialx": resolve(str(out / files["materialx"])).brdf,
+           "gltf": resolve(str(out / files["gltf"])).brdf,
+           "blender": Zeltner(base=tuple(v["base"]), sheen=tuple(v["sheen"]),
+                              roughness=v["roughness"])}
+images = {name: np.asarray(render("sphere", b, width=120, height=120, spp=4, workers=1,
+                                  progress=False))
+          for name, b in spheres.items()}
+peak = float(np.percentile(images["fit (mitsuba)"], 99.5)) / 0.9
+fig, axes = plt.subplots(1, len(images), figsize=(2.2 * len(images), 2.6))
+for ax, (name, img) in zip(axes, images.items()):
+    ax.imshow(to_srgb(img / peak))
+    key = name.split(" ")[-1].strip("()")
+    ax.set_title(f"{name}\nmax ΔE {docs[key]['fidelity']['delta_e2000']['max']:.1f}",
+                 fontsize=9)
+    ax.set_axis_off()
+fig.tight_layout()

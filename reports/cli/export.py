@@ -5,7 +5,8 @@
 FABRIC is any fabric source (:func:`analysis.sources.resolve`): a preset, a fit folder of any
 model, an exported file. ``--to`` picks the target (default: the one that writes FILE's
 suffix: .json/.xml Mitsuba's ``microcylinder`` dictionary or element, .mtlx OpenPBR,
-.gltf/.glb glTF, .py Blender). For every target but Mitsuba the target's sheen model is
+.gltf/.glb glTF, .blend/.py Blender: a .blend where a Python with ``bpy`` can be reached,
+else its script, said so). For every target but Mitsuba the target's sheen model is
 projected from the source over a stated grid, for a fit folder its medians and ``--draws``
 posterior draws; FILE.fidelity.json beside FILE says how closely the export follows the source
 and where it cannot, and the terminal shows the same
@@ -38,9 +39,12 @@ def register(sub):
                     "(JSON dictionary or XML element), or the renderer's sheen model projected "
                     "from the fabric by least squares (OpenPBR fuzz and MaterialX sheen_bsdf "
                     "as .mtlx, glTF KHR_materials_sheen as .gltf/.glb, a Blender Principled "
-                    "BSDF script as .py). FILE.fidelity.json beside FILE holds the fidelity "
-                    "of the export (relative L2 error, albedos, CIEDE2000 of a lit patch) and "
-                    "what the target cannot follow.")
+                    "BSDF as .blend, built by bpy where MICROCYL_BLENDER_PYTHON names a Python "
+                    "with bpy (or bpy imports here, or blender is on the PATH; else its "
+                    "script is written, said so), or its script as .py). "
+                    "FILE.fidelity.json beside FILE holds the fidelity of the export "
+                    "(relative L2 error, albedos, CIEDE2000 of a lit patch) and what the "
+                    "target cannot follow.")
     cliutil.add_fabric_argument(p)
     cliutil.add_fabric_options(p)
     p.add_argument("--to", choices=list(TARGETS), default=None,
@@ -57,6 +61,11 @@ def register(sub):
     p.add_argument("--objective", choices=list(OBJECTIVES), default="cos_cos",
                    help="what the projection fits: f_r cos(theta_i) cos(theta_o) (cos_cos, the "
                         "quantity whose error is reported) or f_r cos(theta_o) (cos_o)")
+    p.add_argument("--albedo-scale", type=float, default=None, metavar="K",
+                   help="multiply the source's f_r by K before projecting: a fit of a "
+                        "relative table (CUReT) has no absolute level, and the export says "
+                        "what it assumed (the directional albedo at normal incidence); K = "
+                        "the cloth's measured albedo / that one")
     p.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     p.set_defaults(func=run)
 
@@ -80,7 +89,7 @@ def run(args) -> int:
     grid = _grid(args.grid)
     src = cliutil.source_from_args(cliutil.fabric_argument(args), args)
     res = export_fabric(src, tgt.name, out, grid=grid, draws=args.draws, seed=args.seed,
-                       objective=args.objective)
+                       objective=args.objective, albedo_scale=args.albedo_scale)
     log.info("wrote %s and %s", res.path, res.fidelity_path)
     if src.kind == "fit":
         med = median_fabric(src.path)

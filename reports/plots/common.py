@@ -21,6 +21,7 @@ from brdf.frames import half_diff_to_directions
 from brdf.presets import PRESETS
 from gonio.atomic import atomic_write
 from reports.colour import CHANNEL_COLOURS
+from reports.plots.halfdisc import HalfDiscAxes
 
 __all__ = ["new_axes", "finish", "save_figure", "as_brdf", "eval_brdf", "reduce_quantity",
            "quantity_styles", "QUANTITIES", "check_quantity", "half_diff_to_io", "check_angle",
@@ -153,19 +154,23 @@ def new_axes(ax=None, *, projection=None, figsize=(5.0, 4.0)):
     ax : matplotlib Axes, optional
         Axes to draw into. Its projection must match ``projection``.
     projection : str, optional
-        "polar", "3d" or None (cartesian) for a new axes.
+        "polar", "halfdisc" (polar, theta_o from -90 to 90 degrees in a box of the half
+        disc's shape: :class:`reports.plots.halfdisc.HalfDiscAxes`), "3d" or None
+        (cartesian) for a new axes; a given ``ax`` for "halfdisc" may be any polar axes.
     figsize : tuple of float
         Size in inches of a new figure.
     """
     if ax is not None:
         name = getattr(ax, "name", "rectilinear")
-        want = projection or "rectilinear"
+        want = {None: "rectilinear", "halfdisc": "polar"}.get(projection, projection)
         if name != want:
             raise ValueError(f"ax must have projection {want!r}; got {name!r}")
         return ax.figure, ax
     fig = (plt.figure(figsize=figsize, layout="constrained") if _use_pyplot()
            else Figure(figsize=figsize, layout="constrained"))
-    ax = fig.add_subplot(1, 1, 1, projection=projection)
+    kind = ({"axes_class": HalfDiscAxes} if projection == "halfdisc"
+            else {"projection": projection})
+    ax = fig.add_subplot(1, 1, 1, **kind)
     return fig, ax
 
 

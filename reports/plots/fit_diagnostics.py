@@ -17,7 +17,7 @@ import corner
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import MaxNLocator, ScalarFormatter
+from matplotlib.ticker import ScalarFormatter
 from PIL import Image
 
 from analysis.fit import LogPosterior
@@ -25,6 +25,9 @@ from analysis.fit.adequacy import normal_scores, point_scores, regions
 from analysis.views.posterior import compute_posterior_lobes, posterior_draws
 from gonio import atomic_write
 from reports.plots.common import DPI
+from reports.plots.common import legend_outside
+from reports.plots.halfdisc import HalfDiscAxes
+from reports.plots.lobes import setup_polar
 from reports.plots.pit import pit_histogram
 
 __all__ = ["corner_plot", "trace_plot", "lobe_plot", "residual_map", "posterior_draws",
@@ -161,29 +164,26 @@ def lobe_plot(result, table, model_factory, theta_i_deg=None, phi_i_deg=None, ax
                                     n_draws=n_draws, plane_tol_deg=plane_tol_deg,
                                     theta_tol_deg=theta_tol_deg)
     if ax is None:
-        fig, ax = plt.subplots(1, len(lobes), subplot_kw={"projection": "polar"},
-                               figsize=(4.2 * len(lobes), 3.6), squeeze=False)
+        fig, ax = plt.subplots(1, len(lobes), subplot_kw={"axes_class": HalfDiscAxes},
+                               figsize=(4.2 * len(lobes), 3.0), squeeze=False,
+                               layout="constrained")
         ax = ax[0]
     else:
         ax = np.atleast_1d(ax)
         fig = ax[0].figure
     for a, lobe in zip(ax, lobes):
         th = np.radians(lobe.signed_deg)
-        a.set_theta_zero_location("N")
-        a.set_thetamin(-90)
-        a.set_thetamax(90)
         band = a.fill_between(th, lobe.lo, lobe.hi, alpha=0.35, color="C0", label="90% band")
         a.plot(th, lobe.median, color="C0", lw=1, label="median")
         if lobe.data.size:
             a.plot(np.radians(lobe.data_signed_deg), lobe.data, "k.", ms=3, label="data")
-        a.yaxis.set_major_locator(MaxNLocator(3))
-        a.tick_params(labelsize=8)
-        a.set_ylabel("f_r cos θo (1/sr)", fontsize=8, labelpad=14)
+        top = max(np.nanmax(lobe.hi), np.nanmax(lobe.data, initial=0.0))
+        setup_polar(a, "linear", 1.0, top, "f_r cos θo (1/sr)")   # as the other lobe plots
         _note_thin_band(a, band, np.asarray(lobe.hi) - np.asarray(lobe.lo))
         a.set_title(f"theta_i = {lobe.theta_i_deg:g} deg: f_r cos(theta_o) (1/sr), mean RGB\n"
                     f"(+ forward, - backward in the plane phi_i = {lobe.phi_i_deg:g} deg)",
                     fontsize=8)
-    ax[0].legend(fontsize=8, loc="lower left")
+    legend_outside(ax[0], "below", ncol=3)
     _save(fig, filename)
     return fig, ax
 
@@ -192,10 +192,12 @@ def _note_thin_band(ax, band, width, line_pt: float = 1.0):
     """Say so in the band's legend label when the band is nowhere wider than the median's
     line (``line_pt`` points) on this polar axes: it would be drawn but not seen."""
     fig = ax.figure
-    radius_pt = ax.get_window_extent(fig.canvas.get_renderer()).height * 72.0 / fig.dpi
     rmax = ax.get_rmax()
+    ax.apply_aspect()                            # the box of the disc's shape and size
+    centre, rim = ax.transData.transform([(0.0, 0.0), (0.0, rmax)])
+    radius_pt = float(np.hypot(*(rim - centre))) * 72.0 / fig.dpi
     w = float(np.nanmax(width)) if np.size(width) else 0.0
-    if rmax > 0 and radius_pt > 0 and w < 2.0 * line_pt / radius_pt * rmax:
+    if rmax > 0 and radius_pt > 0 and w < line_pt / radius_pt * rmax:
         band.set_label(f"90% band (thinner than the line: at most {w:.2g} 1/sr)")
         return True
     return False

@@ -17,6 +17,7 @@ from analysis.views import LobeView, compute_lobes, finite_max, plane_directions
 from reports.plots.common import (FONT, check_angle, check_quantity, finish, legend_outside,
                                new_axes, pow10_label, quantity_styles, series_styles,
                                series_style)
+from reports.plots.halfdisc import HalfDiscAxes, snug_height
 
 __all__ = ["plane_directions", "plot_polar_lobe", "plot_lobe_planes", "plot_lobe_comparison",
            "draw_polar_lobe", "draw_lobe_planes", "draw_lobe_comparison", "log_radius",
@@ -159,7 +160,7 @@ def plot_polar_lobe(brdf, theta_i_deg=(0.0, 30.0, 60.0), phi_deg=0.0, *, quantit
     _check_draw(scale, decades, normalize, quantity)
     check_angle("phi_deg", phi_deg, -360.0, 360.0)
     if ax is not None:                          # a wrong projection refused before work
-        new_axes(ax, projection="polar")
+        new_axes(ax, projection="halfdisc")
     view = compute_lobes(brdf, theta_i_deg, (phi_deg,), resolution=resolution, cosine=cosine)
     return draw_polar_lobe(view, phi_deg, quantity=quantity, scale=scale, decades=decades,
                            colour=colour, normalize=normalize, legend=legend, peak=peak,
@@ -196,7 +197,7 @@ def draw_polar_lobe(view: LobeView, phi_deg=None, *, quantity="luminance", scale
     """
     _check_draw(scale, decades, normalize, quantity)
     phi_deg = view.planes_deg[0] if phi_deg is None else phi_deg
-    fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
+    fig, ax = new_axes(ax, projection="halfdisc", figsize=(5.0, 3.6))
     thetas, theta_o = view.theta_i_deg, view.theta_o_deg
     curves = view.curves(phi_deg, quantity)
     own = max(finite_max(c) for c in curves)
@@ -292,11 +293,13 @@ def draw_lobe_planes(view: LobeView, *, fig=None, filename=None, **kwargs):
         axes is a list of PolarAxes, one per plane.
     """
     planes = view.planes_deg
-    if fig is None:
-        fig = Figure(figsize=(4.2 * len(planes), 2.9), layout="constrained")
+    own = fig is None
+    if own:
+        # 3.9 in a panel: three fit a page column (12.2 in of 8 pt text at 12 px or more)
+        fig = Figure(figsize=(3.9 * len(planes), 2.9), layout="constrained")
     else:
         fig.clear()
-    axes = [fig.add_subplot(1, len(planes), n + 1, projection="polar")
+    axes = [fig.add_subplot(1, len(planes), n + 1, axes_class=HalfDiscAxes)
             for n in range(len(planes))]
     if not kwargs.get("normalize") and "peak" not in kwargs:      # one set of decades
         kwargs["peak"] = view.peak(check_quantity(kwargs.get("quantity", "luminance")))
@@ -310,6 +313,8 @@ def draw_lobe_planes(view: LobeView, *, fig=None, filename=None, **kwargs):
     else:  # each panel's own peaks
         for ax in axes:
             legend_outside(ax, "below", ncol=1)
+    if own:
+        snug_height(fig)
     return finish(fig, axes, filename)
 
 
@@ -349,7 +354,7 @@ def plot_lobe_comparison(brdfs, theta_i_deg=30.0, phi_deg=0.0, *, scale="log", d
     if check_quantity(quantity) == "rgb":
         raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b'; got 'rgb'")
     if ax is not None:                          # a wrong projection refused before work
-        new_axes(ax, projection="polar")
+        new_axes(ax, projection="halfdisc")
     views = {name: compute_lobes(b, theta_i_deg, phi_deg, resolution=resolution)
              for name, b in dict(brdfs).items()}
     return draw_lobe_comparison(views, theta_i_deg, phi_deg, scale=scale, decades=decades,
@@ -366,7 +371,7 @@ def draw_lobe_comparison(views, theta_i_deg, phi_deg, *, scale="log", decades=4.
     _check_scale(scale)
     if check_quantity(quantity) == "rgb":
         raise ValueError("quantity must be 'luminance', 'r', 'g' or 'b'; got 'rgb'")
-    fig, ax = new_axes(ax, projection="polar", figsize=(5.6, 3.7))
+    fig, ax = new_axes(ax, projection="halfdisc", figsize=(5.6, 3.7))
     data = {name: v.curve(phi_deg, theta_i_deg, quantity) for name, v in views.items()}
     own = max((finite_max(v) for v in data.values()), default=0.0)
     floor = log_floor(own if peak is None else peak, decades)

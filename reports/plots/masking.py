@@ -98,7 +98,7 @@ def draw_masking_lobes(view: MaskingLobesView, theta_i_deg, phi_deg, *, scale="l
     """Draw one panel (incidence and plane, degrees) of a
     :class:`analysis.views.MaskingLobesView`; the other arguments and the result as
     :func:`plot_masking_lobes`, which computes the view and calls this."""
-    fig, ax = new_axes(ax, projection="polar", figsize=(5.0, 3.6))
+    fig, ax = new_axes(ax, projection="halfdisc", figsize=(5.0, 3.6))
     curves = view.curves(phi_deg, theta_i_deg)
     theta_o = view.on.theta_o_deg
     peak = max(float(np.nanmax(c)) for c in curves.values())

@@ -21,6 +21,7 @@ from analysis import albedo_curve
 from analysis.views import (compute_lobes, compute_masking_lobes, compute_table_panel,
                             compute_table_scatter)
 from reports.plots.common import FONT, series_styles
+from reports.plots.halfdisc import HalfDiscAxes, snug_height
 from reports.plots.albedo import plot_albedo
 from reports.plots.fit import (draw_scatter_residuals, draw_table_models, draw_table_scatter,
                                table_panels)
@@ -37,10 +38,11 @@ __all__ = ["VIEW_FUNCTIONS", "lobes_view", "slices_view", "hemisphere_view", "ma
 
 
 def _grid(nrows, ncols, panel, polar=False):
-    """A constrained-layout figure of ``nrows`` x ``ncols`` axes, ``panel`` inches each."""
+    """A constrained-layout figure of ``nrows`` x ``ncols`` axes, ``panel`` inches each
+    (``polar``: half discs, :class:`reports.plots.halfdisc.HalfDiscAxes`)."""
     fig = Figure(figsize=(panel[0] * ncols, panel[1] * nrows), layout="constrained")
-    axes = [[fig.add_subplot(nrows, ncols, r * ncols + c + 1,
-                             projection="polar" if polar else None)
+    kind = {"axes_class": HalfDiscAxes} if polar else {}
+    axes = [[fig.add_subplot(nrows, ncols, r * ncols + c + 1, **kind)
              for c in range(ncols)] for r in range(nrows)]
     return fig, axes
 
@@ -66,7 +68,7 @@ def lobes_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",
                                      scale="linear" if scale == "normalized" else scale,
                                      normalize=scale == "normalized")
         fig.suptitle(f"{name}: f_r in the planes of incidence", fontsize=FONT["title"])
-        return fig
+        return snug_height(fig)
     if quantity == "rgb":
         raise ValueError("--channel rgb draws one fabric only; give luminance, r, g or b "
                          "to overlay fabrics")
@@ -81,7 +83,7 @@ def lobes_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",
             draw_lobe_comparison(views, ti, phi, scale=scale, quantity=quantity,
                                  legend=False, peak=peak, ax=ax)
     _figure_legend(fig, axes[0][0], ncol=3)
-    return fig
+    return snug_height(fig)
 
 
 def slices_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",
@@ -149,7 +151,7 @@ def masking_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log
                                title=f"{name}: θi = {ti:g}°, φ = {phi:g}° "
                                      f"({plane_name(phi)})")
     _figure_legend(fig, axes[0][0])
-    return fig
+    return snug_height(fig)
 
 
 def albedo_view(fabrics, *, channel=None, theta_i=None, planes=None, scale="log",

@@ -17,6 +17,7 @@ from matplotlib.text import Text
 
 from gonio.csvcells import text_cells
 from reports.plots.common import FONT, save_figure
+from reports.plots.halfdisc import HalfDiscAxes
 from reports.report.folder import write_file
 from reports.report.markup import Markup, html, plain_json, url
 
@@ -174,9 +175,12 @@ def _close(fig):
 
 
 def new_figure(ncols=1, nrows=1, figsize=None, polar=False, **kw):
-    """A constrained-layout Figure (not registered with pyplot) and its list of axes."""
+    """A constrained-layout Figure (not registered with pyplot) and its list of axes
+    (``polar``: the lobes' half discs, :class:`reports.plots.halfdisc.HalfDiscAxes`)."""
     fig = Figure(figsize=figsize or (4.6 * ncols, 3.8 * nrows), layout="constrained")
-    axes = [fig.add_subplot(nrows, ncols, k + 1, projection="polar" if polar else None, **kw)
+    if polar:
+        kw["axes_class"] = HalfDiscAxes
+    axes = [fig.add_subplot(nrows, ncols, k + 1, **kw)
             for k in range(ncols * nrows)]
     return fig, axes
 

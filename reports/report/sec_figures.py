@@ -7,6 +7,7 @@ import numpy as np
 from analysis.views import (HemisphereView, compute_hemisphere, compute_lobes,
                             compute_masking_lobes)
 from reports.plots.common import FONT
+from reports.plots.halfdisc import snug_height
 from reports.plots.hemisphere import draw_hemisphere
 from reports.plots.lobe3d import plot_lobe_3d
 from reports.plots.lobes import draw_lobe_planes
@@ -139,7 +140,7 @@ def section_masking(p: Page) -> Section:
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=FONT["small"],
                    frameon=False)
-        out.append(p.figure(fig, stem, caption))
+        out.append(p.figure(snug_height(fig), stem, caption))
     out.append(Markup('<p>The terms M, P and u themselves are drawn on the <a href='
                       '"index.html#masking">overview page</a>.</p>'))
     return Section(join(out))

@@ -122,17 +122,19 @@ def test_a_worker_dies_with_its_killed_parent(tmp_path):
 
 def test_render_to_files_writes_the_exr_and_its_png_with_the_exposure(tmp_path):
     """reports.render.files: a tiny built-in render of the patch; out.exr is linear with the
-    PNG's exposure in its header, out.png beside it; a given exposure is kept, else it is
-    automatic; ``out.png`` alone is written without an EXR."""
+    PNG's exposure in its header, out.png and out.scene.json beside it; a given exposure is
+    kept, else it is automatic; ``out.png`` alone is written without an EXR."""
     fab = brdf.fabric("velvet")
     scene = scenes.make_scene("patch")
     expo, written = files.render_to_files(scene, fab, tmp_path / "a.exr", stops=1.5, width=32,
                                           height=18, spp=1, workers=1)
-    assert [p.name for p in written] == ["a.exr", "a.png"] and expo.stops == 1.5
+    assert [p.name for p in written] == ["a.exr", "a.png", "a.scene.json"]
+    assert expo.stops == 1.5
     assert imageio.read_exr_attributes(tmp_path / "a.exr")["microcyl_exposure_stops"] == 1.5
     linear = imageio.read_exr(tmp_path / "a.exr")
     assert linear.shape == (18, 32, 3) and linear.max() > 0
     auto, written = files.render_to_files(scene, fab, tmp_path / "b.png", width=32, height=18,
                                           spp=1, workers=1)
-    assert [p.name for p in written] == ["b.png"] and not (tmp_path / "b.exr").exists()
+    assert [p.name for p in written] == ["b.png", "b.scene.json"]
+    assert not (tmp_path / "b.exr").exists()
     assert auto.mode == "auto" and auto.stops != 1.5

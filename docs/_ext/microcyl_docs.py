@@ -182,6 +182,15 @@ def attr_doc(module: str, name: str, obj) -> list[str]:
     return []
 
 
+def _foreign_members(cls) -> list[str]:
+    """The public attributes a class's own dictionary holds but another library wrote
+    (matplotlib gives each Artist subclass a generated ``set`` with matplotlib's docstring and
+    roles): not ours to document."""
+    ours = tuple(API_PACKAGES) + tuple(WALKED)
+    return sorted(n for n, v in vars(cls).items() if not n.startswith("_") and callable(v)
+                  and not str(getattr(v, "__module__", "") or "").startswith(ours))
+
+
 def write_api_pages(out: Path) -> list[str]:
     """One page a module; returns the module names."""
     out.mkdir(parents=True, exist_ok=True)
@@ -222,6 +231,9 @@ def write_api_pages(out: Path) -> list[str]:
             page.append(f".. {kind}:: {name}.{n}")
             if kind == "autoclass" and key not in seen:
                 page.append("   :members:")
+                foreign = _foreign_members(obj)
+                if foreign:
+                    page.append("   :exclude-members: " + ", ".join(foreign))
             if dup:
                 page.append("   :no-index:")
             if key in seen:

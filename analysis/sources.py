@@ -66,6 +66,9 @@ class Source:
     model : str
         The model of the BRDF: ``microcylinder``, a baseline's name for a fit of one, or
         ``measured`` for a table.
+    median : analysis.fit.medians.MedianFabric or None
+        For a fit folder, its posterior medians as read once when it was resolved (values,
+        free set, ``scale``), which :attr:`brdf` is built from; None for any other kind.
     """
 
     kind: str
@@ -74,6 +77,7 @@ class Source:
     path: Path | None = None
     preset: str | None = None
     model: str = brdf.DEFAULT_MODEL
+    median: object = dataclasses.field(default=None, compare=False, repr=False)
 
     @property
     def is_fabric(self) -> bool:
@@ -136,7 +140,7 @@ def _fit(text: str, path: Path, what: str, preset: str | None) -> Source:
         med = median_fabric(folder, preset=preset)
     except ValueError as exc:
         raise ValueError(f"{what} {text!r}: not a fit folder: {exc}") from None
-    return Source("fit", _label(folder), med.fabric, folder, med.preset, med.model_name)
+    return Source("fit", _label(folder), med.fabric, folder, med.preset, med.model_name, med)
 
 
 def resolve(text, *, what: str = "FABRIC", tables: bool = False,

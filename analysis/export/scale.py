@@ -26,7 +26,6 @@ import math
 
 import numpy as np
 
-from analysis.fit.medians import median_fabric
 
 __all__ = ["Scaled", "check_albedo_scale", "relative_fit", "scale_report"]
 
@@ -75,7 +74,7 @@ def relative_fit(src) -> dict | None:
     the parameters that set the model's level and whether any was free; None otherwise."""
     if src.kind != "fit":
         return None
-    med = median_fabric(src.path)
+    med = src.median                    # read once, when the folder was resolved
     if "scale" not in med.free:
         return None
     level = [n for n in med.values if n.startswith(_LEVEL)]

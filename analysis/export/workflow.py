@@ -24,7 +24,7 @@ from analysis.export.fidelity import fidelity, summary_lines
 from analysis.export.grid import DEFAULT_GRID, HemisphereGrid
 from analysis.export.projection import Projection, project_draws
 from analysis.export.scale import Scaled, check_albedo_scale, relative_fit, scale_report
-from analysis.fit.medians import fabric_at, median_fabric
+from analysis.fit.medians import fabric_at
 from analysis.planning.draws import fit_folder_spec, posterior_draws
 from gonio.atomic import atomic_write
 from gonio.safeopen import read_bytes
@@ -89,7 +89,7 @@ def _draw_sources(src, draws: int, seed: int) -> tuple[list, list[str]]:
     """The fabrics (or baseline models) at ``draws`` posterior draws of a fit folder."""
     if src.kind != "fit" or draws == 0:
         return [], []
-    med = median_fabric(src.path)
+    med = src.median
     try:
         spec = fit_folder_spec(src.path)[0]
         thetas = posterior_draws(src.path, spec, draws, np.random.default_rng(seed))

@@ -21,7 +21,6 @@ import logging
 from analysis.export import TARGETS, HemisphereGrid, target_for, target_named
 from analysis.export.projection import OBJECTIVES
 from analysis.export.workflow import DEFAULT_DRAWS, export_fabric
-from analysis.fit.medians import median_fabric
 from gonio.terminal import shown
 from reports.cli import options as cliutil
 
@@ -92,7 +91,7 @@ def run(args) -> int:
                        objective=args.objective, albedo_scale=args.albedo_scale)
     log.info("wrote %s and %s", res.path, res.fidelity_path)
     if src.kind == "fit":
-        med = median_fabric(src.path)
+        med = src.median
         verdict = ("converged" if med.converged
                    else "NOT converged (medians of an unfinished fit)")
         print(shown(f"{med.preset or src.model}: medians of {', '.join(med.free)} "

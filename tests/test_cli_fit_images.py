@@ -98,6 +98,42 @@ def test_a_rerun_resumes_from_the_checkpoint(tmp_path):
         < 0.1 * first["parameters"]["kd1"]["sd_flat"]
 
 
+def test_a_folder_of_the_users_is_refused_and_a_planted_checkpoint_is_not_followed(tmp_path):
+    """fit-images writes only where fits wrote (the fit folder's marker and lock): a user's
+    results.json is refused untouched, before any render; a state.json that is a link to
+    another file, or a FIFO, is not read (no hang, the other file's bytes never used)."""
+    import os
+    render = _ramp_render()
+    obs = [Observation("ramp", render(None, brdf.fabric("linen_plain"), 5), None, 0)]
+    users = tmp_path / "users"
+    users.mkdir()
+    (users / "results.json").write_text("the user's own")
+    calls = []
+
+    def counting(*a):
+        calls.append(a)
+        return render(*a)
+    with pytest.raises(ValueError, match="holds files a fit did not write"):
+        fit_images(obs, brdf.fabric("linen_plain"), "kd1", users, render=counting)
+    assert (users / "results.json").read_text() == "the user's own" and not calls
+    secret = tmp_path / "secret.json"
+    for kind in ("link", "fifo"):
+        out = tmp_path / kind
+        fit_images(obs, brdf.fabric("linen_plain"), "kd1", out, render=render, max_iter=2)
+        state = json.loads((out / "state.json").read_text())    # this fit's own digest
+        secret.write_text(json.dumps({**state, "u": [0.95]}))
+        (out / "state.json").unlink()
+        if kind == "link":
+            (out / "state.json").symlink_to(secret)
+        else:
+            os.mkfifo(out / "state.json")
+        lines = []
+        fit_images(obs, brdf.fabric("linen_plain"), "kd1", out, render=render, max_iter=2,
+                   log=lines.append)
+        assert not any(line.startswith("resuming") for line in lines)   # a planted start
+        assert json.loads(secret.read_text())["u"] == [0.95]
+
+
 @pytest.mark.parametrize("argv, match", [
     (["--free", "kd9"], "unknown free parameter 'kd9'"),
     (["--free", "kd1", "--shot-noise", "-1"], "--shot-noise -1.0: must be"),

@@ -33,6 +33,8 @@ from typing import Callable
 import numpy as np
 
 import brdf
+from analysis.fit.outputs import check_fit_folder, claim_fit_folder
+from analysis.folderlock import output_lock
 from analysis.imagefit.noise import NoiseModel, mc_variance
 from analysis.imagefit.solver import laplace, levenberg_marquardt
 from analysis.imagefit.summary import Params, summaries, warnings_of
@@ -40,6 +42,7 @@ from analysis.paramnames import parse_free
 from gonio.atomic import atomic_write
 from gonio.jsonplain import plain
 from gonio.progress import progress_bar
+from gonio.statefields import load_json
 
 __all__ = ["Observation", "fit_images", "SCHEMA", "SCHEMA_VERSION"]
 
@@ -134,12 +137,15 @@ class _Model:
 
 
 def _resume(state_path, digest):
-    """The checkpoint's (u, history) when it belongs to this fit, else (None, [])."""
+    """The checkpoint's (u, history) when it belongs to this fit, else (None, []); read as a
+    state file from others (:func:`gonio.statefields.load_json`: no link, no FIFO, capped)."""
+    if not state_path.exists():
+        return None, []
     try:
-        state = json.loads(state_path.read_text())
+        state = load_json(state_path, "fit-images checkpoint")
         if state.get("digest") == digest:
             return np.asarray(state["u"], float), list(state["history"])
-    except (OSError, ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError, AttributeError):
         pass
     return None, []
 
@@ -186,7 +192,23 @@ def fit_images(observations, fabric, free, out_dir, *, render: Callable,
         raise ValueError(f"--max-steps {max_iter!r}: must be an integer from 1 to 1000")
     observations, params = _checked(observations, fabric, free)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    with output_lock(out, "fit"):             # a fit's folder: locked, and only its files
+        check_fit_folder(out)
+        claim_fit_folder(out, STATE_FILES + (PLOT_FILES if plots is not None else ()))
+        return _fit_in(out, observations, fabric, params, render=render, noise=noise,
+                       mc_seeds=mc_seeds, max_iter=max_iter, plots=plots, progress=progress,
+                       log=log)
+
+
+#: What fit-images writes into its folder: its checkpoint and results, then its figures
+#: (:data:`reports.plots.imagefit.FILES`).
+STATE_FILES = ("state.json", "results.json")
+PLOT_FILES = ("images.png", "steps.png")
+
+
+def _fit_in(out, observations, fabric, params, *, render, noise, mc_seeds, max_iter, plots,
+            progress, log) -> dict:
+    """:func:`fit_images` in its locked, checked folder ``out``."""
     say = log or (lambda s: None)
     t0 = time.perf_counter()
     start = np.clip([fabric.values()[n] for n in params.names], params.lo, params.hi)

@@ -14,12 +14,13 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
+from analysis.imagefit.workflow import PLOT_FILES
 from reports.plots.common import save_figure
 
 __all__ = ["write_plots", "FILES"]
 
-#: The figures and their files.
-FILES = {"images": "images.png", "steps": "steps.png"}
+#: The figures and their files (the names fit-images claims in its folder before it draws).
+FILES = dict(zip(("images", "steps"), PLOT_FILES))
 #: The residual colour scale's ends, in noise sds.
 RESIDUAL_RANGE = 4.0
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from analysis.imagefit.workflow import PLOT_FILES
 from reports.plots.common import save_figure
@@ -82,6 +83,7 @@ def steps_figure(doc, filename):
         ax.axhline(p["start"], color="grey", ls=":", label="start")
         ax.set_ylabel(f"{name} [{p['unit']}]", fontsize=8)
     axes[-1].set_xlabel("step")
+    axes[-1].xaxis.set_major_locator(MaxNLocator(integer=True))     # steps are whole
     if len(axes) > 1:
         axes[1].legend(fontsize=7, loc="best")
     out = save_figure(fig, filename)

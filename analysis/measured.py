@@ -45,6 +45,7 @@ import numpy as np
 
 from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
+from analysis.fit.swap import fold_thread_swap
 from analysis.folderlock import output_lock
 from analysis.families import MICROCYLINDER, family_of
 from analysis.measuredjson import load_measured_json
@@ -231,8 +232,9 @@ def measured_spec(name, fab=None):
     """
     d = _dataset(name)
     fab = fab if fab is not None else preset_fabric(d.preset)
-    return ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties,
-                     periods=family_of(fab).periods(fab)), fab
+    spec = ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties,
+                     periods=family_of(fab).periods(fab))
+    return fold_thread_swap(spec, fab), fab
 
 
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,

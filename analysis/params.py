@@ -15,20 +15,22 @@ density p (1 - p) in u (the Jacobian), so the log-prior is sum of log p + log(1 
 free parameters (minus infinity where area1 + area2 > 1 or a tied value leaves its bounds).
 A posterior piled against a bound (an albedo near 1, a k_d near 0) is then a smooth bump in u
 rather than a wall, which the samplers and the Laplace approximation handle far better.
-Internal values are limited to +-:data:`INTERNAL_LIMIT` (p within 4e-18 of a bound).
+Internal values are limited to +-:data:`INTERNAL_LIMIT` (p within 4e-18 of a bound). A
+circular parameter (a fabric's ``rotation``, :meth:`ParamSpec.period`) has no bound to pile
+against, only a wrap: its internal coordinate is linear instead, its prior flat in it
+(:meth:`ParamSpec.to_natural`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.special
 
 from analysis.families import ModelFamily, family
+from analysis.param import INTERNAL_LIMIT, INTERNAL_WIDTH, Param
 from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_PARAM_NAMES,
                                  PARAM_NAMES, checked_bounds, checked_defaults,
                                  checked_priors, checked_ties, checked_toml,
@@ -38,87 +40,6 @@ from gonio.statefields import load_toml
 
 __all__ = ["Param", "ParamSpec", "INTERNAL_LIMIT", "BASE_PARAMS", "PARAM_NAMES", "MODEL_PARAM_NAMES",
            "DEFAULT_FREE", "DEFAULT_TIES", "defaults_from_fabric", "parse_free", "parse_ties"]
-
-
-#: Internal (logit) coordinates are limited to [-INTERNAL_LIMIT, INTERNAL_LIMIT].
-INTERNAL_LIMIT = 40.0
-#: A typical internal scale: a logit range of 4 spans p from 0.12 to 0.88.
-INTERNAL_WIDTH = 4.0
-
-
-@dataclasses.dataclass(frozen=True)
-class Param:
-    """One scalar parameter: bounds (natural units), prior, unit, default.
-
-    Parameters
-    ----------
-    name : str
-        Full name, e.g. ``"gamma_s1"``.
-    lo, hi : float
-        Bounds in natural units (``lo < hi``; ``lo > 0`` for a log-uniform prior).
-    prior : {"uniform", "log-uniform"}
-        Flat in the value, or flat in its logarithm.
-    unit : str
-        Unit of the value (``"deg"``, ``"1"``, ...).
-    default : float
-        Starting / fixed value in natural units.
-    """
-
-    name: str
-    lo: float
-    hi: float
-    prior: str
-    unit: str
-    default: float
-
-    def __post_init__(self):
-        if self.prior not in ("uniform", "log-uniform"):
-            raise ValueError(f"prior of {self.name} must be 'uniform' or 'log-uniform'; "
-                             f"got {self.prior!r}")
-        if not (math.isfinite(self.lo) and math.isfinite(self.hi) and self.lo < self.hi):
-            raise ValueError(f"bounds of {self.name} must be finite with lo < hi; "
-                             f"got ({self.lo}, {self.hi})")
-        if self.prior == "log-uniform" and self.lo <= 0:
-            raise ValueError(f"log-uniform prior of {self.name} needs lo > 0; got {self.lo}")
-
-    @property
-    def is_log(self) -> bool:
-        return self.prior == "log-uniform"
-
-    def _g(self, x):
-        if self.is_log:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                return np.log(x)
-        return x
-
-    def to_internal(self, x):
-        """Natural value -> internal coordinate logit(p), p the position within the bounds
-        (on a log scale for log-uniform); +-inf at the bounds, NaN outside.
-
-        Examples
-        --------
-        >>> p = Param("kd1", 0.0, 1.0, "uniform", "1", 0.5)
-        >>> float(p.to_internal(0.5)), round(float(p.to_natural(p.to_internal(0.9))), 12)
-        (0.0, 0.9)
-        """
-        x = np.asarray(x, dtype=np.float64)
-        g0, g1 = self._g(self.lo), self._g(self.hi)
-        q = (self._g(x) - g0) / (g1 - g0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where((q >= 0) & (q <= 1), np.log(q) - np.log1p(-q), np.nan)
-
-    def to_natural(self, u):
-        """Internal coordinate -> natural value (within the bounds)."""
-        u = np.asarray(u, dtype=np.float64)
-        q = scipy.special.expit(u)
-        g0, g1 = self._g(self.lo), self._g(self.hi)
-        v = g0 + q * (g1 - g0)
-        x = np.exp(v) if self.is_log else v
-        return np.clip(x, self.lo, self.hi)
-
-    @property
-    def internal_bounds(self) -> tuple[float, float]:
-        return (-INTERNAL_LIMIT, INTERNAL_LIMIT)
 
 
 class ParamSpec:
@@ -147,6 +68,10 @@ class ParamSpec:
         Angles whose model repeats every ``period`` (natural units), from the model object
         (:meth:`analysis.families.ModelFamily.periods`: a fabric's ``rotation``, 180 or 360
         degrees); a parameter whose range holds a whole period is circular (:meth:`period`).
+    folds : mapping name -> float, optional
+        Parameters whose upper bound (the value) is a fold of a symmetry of the model, not a
+        limit (:func:`analysis.fit.swap.fold_thread_swap`: a value above it describes the same
+        model as one below): an interval reaching it is no ``at_bound``.
 
     Raises
     ------
@@ -172,11 +97,13 @@ class ParamSpec:
                  bounds: Mapping[str, Sequence[float]] | None = None,
                  priors: Mapping[str, str] | None = None,
                  family: ModelFamily | str | None = None, notes: Sequence[str] = (),
-                 periods: Mapping[str, float] | None = None):
+                 periods: Mapping[str, float] | None = None,
+                 folds: Mapping[str, float] | None = None):
         fam = _family(family)
         self.family = fam
         self.notes = tuple(notes)
         self.periods = {str(k): float(v) for k, v in (periods or {}).items()}
+        self.folds = {str(k): float(v) for k, v in (folds or {}).items()}
         defaults = checked_defaults(defaults, fam)
         bounds, priors = checked_bounds(bounds, fam), checked_priors(priors, fam)
         free = list(parse_free(free, fam))
@@ -257,8 +184,7 @@ class ParamSpec:
     def start(self) -> np.ndarray:
         """Internal coordinates of the free parameters' defaults, shape (ndim,); a default on
         a bound starts just inside it (internal values are clipped to +-10: p = 4.5e-5)."""
-        u = np.array([float(self.params[n].to_internal(self.params[n].default))
-                      for n in self.free])
+        u = self.to_internal(np.array([self.params[n].default for n in self.free]))
         return np.clip(u, -10.0, 10.0)
 
     def with_defaults(self, **values: float) -> "ParamSpec":
@@ -279,7 +205,8 @@ class ParamSpec:
         return ParamSpec(list(self.free) + list(names), defaults={p.name: p.default for p in ps},
                          bounds={p.name: (p.lo, p.hi) for p in ps},
                          priors={p.name: p.prior for p in ps}, ties=self.ties,
-                         family=self.family, notes=self.notes, periods=self.periods)
+                         family=self.family, notes=self.notes, periods=self.periods,
+                         folds=self.folds)
 
     def with_periods(self, periods: Mapping[str, float]) -> "ParamSpec":
         """A copy with the periods ``periods`` (name -> period, natural units) added; a
@@ -290,7 +217,7 @@ class ParamSpec:
         return ParamSpec(list(self.free), defaults={p.name: p.default for p in ps}, bounds=own,
                          priors={p.name: p.prior for p in ps}, ties=self.ties,
                          family=self.family, notes=self.notes,
-                         periods={**self.periods, **periods})
+                         periods={**self.periods, **periods}, folds=self.folds)
 
     def period(self, name: str) -> float | None:
         """The period of a circular parameter: its model repeats every ``periods[name]`` and
@@ -311,21 +238,58 @@ class ParamSpec:
             return None
         return period if p.hi - p.lo >= period * (1.0 - 1e-9) else None
 
+    def _circle(self, name: str) -> tuple[float, float, float] | None:
+        """(lo, centre, period) of a circular free parameter, else None."""
+        period = self.period(name)
+        if period is None:
+            return None
+        p = self.params[name]
+        return p.lo, 0.5 * (p.lo + p.hi), period
+
     def to_natural(self, theta) -> np.ndarray:
-        """Internal (..., ndim) -> natural values of the free parameters (..., ndim)."""
+        """Internal (..., ndim) -> natural values of the free parameters (..., ndim).
+
+        A circular parameter (:meth:`period`) has a linear internal coordinate, u = (x -
+        centre) * INTERNAL_WIDTH / period, its natural value wrapped into [lo, lo + period):
+        the sampler and the optimizer move across the wrap as anywhere else on the circle,
+        where a logit would make it a wall at each end.
+
+        Examples
+        --------
+        >>> spec = ParamSpec("rotation", periods={"rotation": 180.0})
+        >>> spec.to_natural(spec.to_internal(np.array([[85.0]])) + 0.25).round(9).tolist()
+        [[-83.75]]
+        """
         theta = np.asarray(theta, dtype=np.float64)
         out = np.empty_like(theta)
         for i, n in enumerate(self.free):
-            out[..., i] = self.params[n].to_natural(theta[..., i])
+            circle = self._circle(n)
+            if circle is None:
+                out[..., i] = self.params[n].to_natural(theta[..., i])
+            else:
+                lo, mid, per = circle
+                out[..., i] = lo + np.mod(mid - lo + theta[..., i] * per / INTERNAL_WIDTH, per)
         return out
 
     def to_internal(self, x) -> np.ndarray:
-        """Natural (..., ndim) -> internal coordinates."""
+        """Natural (..., ndim) -> internal coordinates (NaN outside the bounds)."""
         x = np.asarray(x, dtype=np.float64)
         out = np.empty_like(x)
         for i, n in enumerate(self.free):
-            out[..., i] = self.params[n].to_internal(x[..., i])
+            circle, p = self._circle(n), self.params[n]
+            if circle is None:
+                out[..., i] = p.to_internal(x[..., i])
+            else:
+                inside = (x[..., i] >= p.lo) & (x[..., i] <= p.hi)
+                u = (x[..., i] - circle[1]) * INTERNAL_WIDTH / circle[2]
+                out[..., i] = np.where(inside, u, np.nan)
         return out
+
+    @property
+    def circular(self) -> np.ndarray:
+        """Per free parameter, whether it is circular (bool (ndim,)): its internal coordinate
+        is linear and its prior flat in it (:meth:`to_natural`)."""
+        return np.array([self._circle(n) is not None for n in self.free], dtype=bool)
 
     def values(self, theta) -> dict[str, np.ndarray]:
         """Every parameter's natural value for internal coordinates ``theta`` (B..., ndim).
@@ -355,8 +319,9 @@ class ParamSpec:
         """
         theta = np.asarray(theta, dtype=np.float64)
         ok = np.all((theta >= self.lower) & (theta <= self.upper) & np.isfinite(theta), axis=-1)
-        with np.errstate(invalid="ignore"):
-            jac = -(np.logaddexp(0.0, theta) + np.logaddexp(0.0, -theta)).sum(axis=-1)
+        with np.errstate(invalid="ignore"):    # a circle's coordinate is linear: no Jacobian
+            jac = -np.where(self.circular, 0.0, np.logaddexp(0.0, theta)
+                            + np.logaddexp(0.0, -theta)).sum(axis=-1)
         cls = self.family.cls
         joint = bool(set(cls.CONSTRAINED) & set(self.free))
         if self.ties or joint:
@@ -388,6 +353,8 @@ class ParamSpec:
             "ties": {k: list(v) for k, v in self.ties.items()},
             "params": {n: {"lo": p.lo, "hi": p.hi, "prior": p.prior, "unit": p.unit,
                            "default": p.default} for n, p in self.params.items()},
+            **({"periods": dict(self.periods)} if self.periods else {}),
+            **({"folds": dict(self.folds)} if self.folds else {}),
         }
 
     def __repr__(self) -> str:

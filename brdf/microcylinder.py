@@ -171,6 +171,25 @@ class MicrocylinderModel:
                   and tuple(th.lengths[::-1]) == tuple(th.lengths) for th in self.threads)
         return {"rotation": 180.0 if sym else 360.0}
 
+    def thread_swap(self) -> float | None:
+        """The rotation (degrees) under which the two threads trade places, when they can: 90
+        for a fabric of two threads with the same tangent curve, symmetric under a half turn
+        (linen's (-25, 25) for both); None otherwise. Such a fabric with its threads'
+        parameters swapped and turned by a quarter is the same fabric (``area1`` = a at
+        ``rotation`` r is ``area1`` = 1 - a at r + 90 when the rest are equal).
+
+        Examples
+        --------
+        >>> import brdf
+        >>> brdf.fabric("linen_plain").thread_swap(), brdf.fabric("velvet").thread_swap()
+        (90.0, None)
+        """
+        if len(self.threads) != 2 or self.periods()["rotation"] != 180.0:
+            return None
+        a, b = self.threads
+        same = tuple(a.offsets) == tuple(b.offsets) and tuple(a.lengths) == tuple(b.lengths)
+        return 90.0 if same else None
+
     def with_values(self, values: Mapping[str, float]):
         """This fabric with some parameters changed (names of :data:`SCHEMA`; a colour's
         channels not given keep their values; a tangent scale multiplies the offsets; the

@@ -221,7 +221,8 @@ def read_config(path) -> dict:
     """A ``fit_config.json``, every field the readers use checked: ``config.spec`` (``free``
     a list of names, ``params`` each with finite ``lo``, ``hi``, ``default`` and string
     ``prior``/``unit``, ``ties`` target -> [source, "equal" or "complement"] among the
-    params), ``config.model`` (a string; absent: ``microcylinder``), ``config.extra``
+    params, ``periods`` and ``folds`` a parameter's name -> a number >= 0),
+    ``config.model`` (a string; absent: ``microcylinder``), ``config.extra``
     (``fabric``/``preset`` a string, ``options`` an object).
 
     Raises
@@ -254,6 +255,11 @@ def read_config(path) -> dict:
             raise f.error(f"config.spec.ties.{target}", "[SOURCE, \"equal\" or "
                           f"\"complement\"] with SOURCE and the target among the parameters",
                           tie)
+    for key in ("periods", "folds"):            # name -> a positive angle or a fold's value
+        for name, v in f.mapping(spec, key, "config.spec", default={}).items():
+            if name not in params:
+                raise f.error(f"config.spec.{key}.{name}", "a parameter's name", name)
+            f.number(spec[key], name, f"config.spec.{key}", lo=0.0)
     extra = f.mapping(cfg, "extra", "config", default={})
     for k in ("fabric", "preset"):
         f.string(extra, k, "config.extra", default=None, none=True)

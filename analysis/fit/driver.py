@@ -35,7 +35,7 @@ __all__ = ["fit", "FitOptions", "MAX_ENSEMBLES", "CONFIG_VERSION", "estimate_tim
 #: A fit that may take this many seconds or more says so before it starts (``notify``).
 ESTIMATE_MIN_S = 10.0
 #: Version of the sampler's configuration; a folder fitted by another version is refused.
-CONFIG_VERSION = 7
+CONFIG_VERSION = 8
 
 #: Most ensembles of a fit: R-hat needs a few; each is a group of the one checkpoint.
 MAX_ENSEMBLES = 64
@@ -329,7 +329,8 @@ def _check_start(spec: ParamSpec, best, best_logp: float, notify=None) -> None:
     """A point estimate the walkers can start from, or a ValueError saying what to change;
     ``notify`` is told of parameters that ended on a bound."""
     at_bound = [n for n, u in zip(spec.free, best)      # a circular one has no bound
-                if abs(u) >= 0.99 * INTERNAL_LIMIT and spec.period(n) is None]
+                if abs(u) >= 0.99 * INTERNAL_LIMIT and spec.period(n) is None
+                and not (u > 0 and n in spec.folds)]                # nor a fold
     if notify is not None and at_bound:
         notify(f"fit: the point estimate lies on the bound of {', '.join(at_bound)} "
                f"(log-posterior {best_logp:.4g}); if most are, the fabric may not match the "

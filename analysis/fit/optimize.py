@@ -15,6 +15,7 @@ import scipy
 import scipy.optimize
 
 from analysis.fit.gradient import gradient_available, logpost_and_grad, rotation_cache
+from analysis.param import INTERNAL_WIDTH
 
 __all__ = ["point_estimate", "laplace_cov", "initial_walkers", "optimize_start", "GRADIENTS"]
 
@@ -23,6 +24,8 @@ __all__ = ["point_estimate", "laplace_cov", "initial_walkers", "optimize_start",
 #: :mod:`analysis.fit.gradient`; finite differences where the model has none), ``"auto"``
 #: (the default: :data:`AUTO_GRADIENT`).
 GRADIENTS = ("auto", "fd", "analytic")
+#: Orientations a circular parameter's search starts from: its start and each quarter turn.
+CIRCLE_STARTS = 4
 #: What ``"auto"`` means (the faster on ``bench/bench_sampler.py --start``; docs/benchmarks.rst).
 AUTO_GRADIENT = "fd"
 #: Dr.Jit's AD of one start at a time (its kernel uses the cores itself).
@@ -208,8 +211,11 @@ def initial_walkers(logpost, best, cov, nwalkers, rng) -> tuple[np.ndarray, np.n
 def optimize_start(logpost, n_starts: int, rng, threads: int = 1,
                    gradient: str = "auto") -> tuple[np.ndarray, float, np.ndarray | None]:
     """Point estimate from the spec's start and ``n_starts - 1`` perturbations of it (5% of
-    each parameter's internal range, from ``rng``), then the Laplace covariance there;
-    ``gradient`` as :func:`point_estimate`.
+    each parameter's internal range, from ``rng``), and, where a parameter is circular (a
+    fabric's ``rotation``, :meth:`analysis.params.ParamSpec.period`), the start turned by
+    each 1/:data:`CIRCLE_STARTS` of the period (a local search from one orientation finds the
+    mode nearest it, not the best); then the Laplace covariance there; ``gradient`` as
+    :func:`point_estimate`.
 
     Returns
     -------
@@ -237,6 +243,9 @@ def optimize_start(logpost, n_starts: int, rng, threads: int = 1,
     for _ in range(max(0, n_starts - 1)):
         starts.append(np.clip(start + rng.normal(scale=0.05 * spec.width), spec.lower,
                               spec.upper))
+    circle = spec.circular           # an angle on a circle: the start turned by quarters too
+    for k in range(1, CIRCLE_STARTS if circle.any() else 1):
+        starts.append(np.where(circle, start + k * INTERNAL_WIDTH / CIRCLE_STARTS, start))
     best, best_logp, _ = point_estimate(logpost, np.array(starts), threads=threads,
                                         gradient=gradient)
     return best, best_logp, laplace_cov(logpost, best)

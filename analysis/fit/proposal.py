@@ -218,6 +218,8 @@ class LaplaceMove(emcee.moves.MHMove):
         centres = [z[rng.integers(n)]]
         for _ in range(components - 1):
             d2 = np.min([((z - c) ** 2).sum(axis=1) for c in centres], axis=0)
+            if not d2.sum() > 0:          # every point on a centre: no second component
+                return None
             centres.append(z[rng.choice(n, p=d2 / d2.sum())])
         resp = np.exp(-0.5 * np.array([((z - c) ** 2).sum(axis=1) for c in centres]))
         resp /= np.maximum(resp.sum(axis=0), 1e-300)

@@ -138,13 +138,13 @@ class FitResult:
         """Posterior median in internal coordinates (ndim,); a circular parameter's is its
         circular median (:mod:`analysis.fit.circular`), not the median of the internal values
         (which, for draws across the wrap, lies half a period away)."""
-        med = np.median(self.chains_internal.reshape(-1, len(self.names)), axis=0)
-        for i, name in enumerate(self.names):
-            period = None if self.spec is None else self.spec.period(name)
-            if period is not None:
-                p = self.spec.params[name]
-                x = p.lo + np.mod(np.median(self.samples()[:, i]) - p.lo, period)
-                med[i] = np.clip(p.to_internal(min(x, p.hi)), -INTERNAL_LIMIT, INTERNAL_LIMIT)
+        flat = self.chains_internal.reshape(-1, len(self.names))
+        med = np.median(flat, axis=0)
+        circle = self.spec.circular if self.spec is not None else np.zeros(len(med), bool)
+        if circle.any():
+            x = np.median(circular_natural(self.spec, flat), axis=0)
+            med[circle] = np.clip(self.spec.to_internal(x)[circle], -INTERNAL_LIMIT,
+                                  INTERNAL_LIMIT)
         return med
 
     def residuals(self) -> dict:

@@ -110,8 +110,8 @@ def at_bound(result) -> list[dict]:
                                      _from_flat(p, g0 + BOUND_ZONE * (g1 - g0))),
                                     ("upper", p.hi, (g1 - hi) / (g1 - g0),
                                      _from_flat(p, g1 - BOUND_ZONE * (g1 - g0)))):
-            if q < BOUND_ZONE:
-                a, b = _from_flat(p, lo), _from_flat(p, hi)
+            if q < BOUND_ZONE and not (side == "upper" and name in result.spec.folds):
+                a, b = _from_flat(p, lo), _from_flat(p, hi)   # a fold is no bound
                 meaning = ("the data need no noise beyond the table's sigma"
                            if name == "log_noise" and side == "lower"
                            else "the bound, not the data, sets this value")

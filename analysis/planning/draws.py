@@ -74,7 +74,7 @@ def prior_draws(spec: ParamSpec, draws: int, rng: np.random.Generator,
 
 def fit_folder_spec(folder) -> tuple[ParamSpec, list[str]]:
     """The ParamSpec a fit folder's ``fit_config.json`` describes (free, ties, bounds,
-    priors, defaults), so that its stored internal coordinates mean what they meant, and its
+    priors, defaults, periods and folds), so that its stored internal coordinates mean what they meant, and its
     ties as ``--tie`` strings (``"a=b"``, ``"a=1-b"``).
 
     Raises
@@ -88,7 +88,8 @@ def fit_folder_spec(folder) -> tuple[ParamSpec, list[str]]:
             for t, (s, kind) in spec.get("ties", {}).items()]
     return ParamSpec(spec["free"], defaults={n: p["default"] for n, p in params.items()},
                      ties=ties, bounds={n: (p["lo"], p["hi"]) for n, p in params.items()},
-                     priors={n: p["prior"] for n, p in params.items()}), ties
+                     priors={n: p["prior"] for n, p in params.items()},
+                     periods=spec.get("periods"), folds=spec.get("folds")), ties
 
 
 def posterior_draws(folder, spec: ParamSpec, draws: int,

@@ -9,8 +9,6 @@ its matrix from the primaries instead, 0.212639 R + 0.715169 G + 0.072192 B: the
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from analysis.likelihood import is_grey
@@ -25,19 +23,13 @@ def _colour():
     return colour
 
 
-@functools.cache
-def _weights() -> np.ndarray:
-    w = np.array(_colour().RGB_COLOURSPACES["sRGB"].matrix_RGB_to_XYZ[1], dtype=np.float64)
-    w.setflags(write=False)
-    return w
-
-
-def __getattr__(name):
-    """``LUMINANCE_WEIGHTS``: the luminance weights (R, G, B) of linear RGB, the Y row of
-    colour-science's sRGB RGB -> XYZ matrix (computed on first use)."""
-    if name == "LUMINANCE_WEIGHTS":
-        return _weights()
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: The luminance weights (R, G, B) of linear RGB: the Y row of the sRGB RGB -> XYZ matrix as
+#: IEC 61966-2-1 prints it, which is colour-science's ``RGB_COLOURSPACES["sRGB"]`` row
+#: (``tests/test_analysis_colour.py`` holds the two equal). Written here, not read from
+#: colour-science on use, because ``import colour`` costs every verb that shows a luminance
+#: about 1.3 s (it loads its plotting package and matplotlib).
+LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
+LUMINANCE_WEIGHTS.setflags(write=False)
 
 
 def luminance(rgb) -> np.ndarray:
@@ -72,7 +64,7 @@ def luminance(rgb) -> np.ndarray:
     arr = np.asarray(rgb, dtype=np.float64)
     if arr.ndim == 0 or arr.shape[-1] != 3:
         raise ValueError(f"rgb must have shape (..., 3); got {arr.shape}")
-    return arr @ _weights()
+    return arr @ LUMINANCE_WEIGHTS
 
 
 def albedo_colours(table, prediction):

@@ -12,9 +12,10 @@ r"""Convergence diagnostics for several independent emcee ensembles.
 
 from __future__ import annotations
 
-import emcee
 import numpy as np
 import scipy.fft
+
+from analysis.lazy import autocorr
 
 __all__ = ["autocorr_time", "split_rhat", "ess", "interval_summary"]
 
@@ -69,7 +70,7 @@ def autocorr_time(chain) -> np.ndarray:
     out = np.empty(d)
     for k in range(d):
         col = taus[:, k]
-        out[k] = col[emcee.autocorr.auto_window(col, 5)] if np.all(np.isfinite(col)) \
+        out[k] = col[autocorr.auto_window(col, 5)] if np.all(np.isfinite(col)) \
             else np.nan
     return out
 

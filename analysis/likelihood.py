@@ -34,9 +34,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import stats
 from scipy.special import gammaln
 
+from analysis.lazy import stats
 from brdf.scratch import Scratch
 
 __all__ = ["Likelihood", "KINDS", "is_relative", "is_grey"]

@@ -43,11 +43,11 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.batch import BatchJob, run_batch
 from analysis.fit.results import read_results
 from analysis.fit.swap import fold_thread_swap
 from analysis.folderlock import output_lock
 from analysis.families import MICROCYLINDER, family_of
+from analysis.lazy import lazy_module
 from analysis.measuredjson import load_measured_json
 from analysis.measuredmodels import fit_folder, models_entry, parse_models, verdict_warnings
 from analysis.params import ParamSpec, defaults_from_fabric
@@ -59,6 +59,9 @@ from gonio.rgl import load_rgl
 
 __all__ = ["MeasuredDataset", "MEASURED", "load_measured", "measured_spec", "default_data_dir",
            "fit_measured", "SUMMARY_FILE", "curet_sample"]
+
+#: The batch (the fit, Dask), on use: a reader of a dataset's name does not load them.
+batch = lazy_module("analysis.batch")
 
 #: The summary written beside the per-dataset folders by :func:`fit_measured`.
 SUMMARY_FILE = "measured.json"
@@ -304,7 +307,7 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
     fit = {"seed": seed, "max_steps": max_steps, "time_limit": time_limit}
     jobs = [_job(n, root, rgl_step, plots, fit, m) for n in names for m in models]
     with output_lock(out, "fit-measured"):       # the batch's lock, measured.json included
-        summary = run_batch(jobs, out, workers=workers, scheduler=scheduler,
+        summary = batch.run_batch(jobs, out, workers=workers, scheduler=scheduler,
                             progress=progress, echo=echo, locked=True)
         # read just before writing: another fit-measured run may have added its datasets
         doc = _read_summary(spath)
@@ -318,18 +321,20 @@ def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,
 
 
 def _job(n: str, root: Path, rgl_step: float, plots, fit: dict,
-         model: str = MICROCYLINDER) -> BatchJob:
+         model: str = MICROCYLINDER):
     """The batch job of dataset ``n`` and ``model``: read on the worker by
-    :func:`load_measured`; a baseline model with its default free set for the table."""
+    :func:`load_measured`; a baseline model with its default free set for the table
+    (an :class:`analysis.batch.BatchJob`)."""
     d = MEASURED[n]
     loader = functools.partial(load_measured, n, str(root), rgl_step)
+    job = batch.BatchJob
     if model != MICROCYLINDER:
-        return BatchJob(fit_folder(n, model), str(root / d.path), d.sample, d.preset, fit=fit,
-                        loader=loader, plots=plots, model=model,
-                        config_extra={"dataset": n, "rgl_step": rgl_step})
-    return BatchJob(n, str(root / d.path), d.sample, d.preset, d.free, d.ties, fit=fit,
-                    loader=loader, plots=plots,
-                    config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
+        return job(fit_folder(n, model), str(root / d.path), d.sample, d.preset, fit=fit,
+                   loader=loader, plots=plots, model=model,
+                   config_extra={"dataset": n, "rgl_step": rgl_step})
+    return job(n, str(root / d.path), d.sample, d.preset, d.free, d.ties, fit=fit,
+               loader=loader, plots=plots,
+               config_extra={"dataset": n, "preset": d.preset, "rgl_step": rgl_step})
 
 
 def _dataset_entry(n: str, table, rows: dict, out: Path, models, compare: bool,

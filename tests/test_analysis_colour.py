@@ -16,6 +16,13 @@ def test_weights_are_the_rec709_luma_coefficients():
         LUMINANCE_WEIGHTS[0] = 1.0          # the one definition cannot be changed in place
 
 
+def test_weights_are_colour_sciences_srgb_y_row():
+    """The constants written in analysis.colour are colour-science's sRGB matrix row."""
+    import colour
+    row = colour.RGB_COLOURSPACES["sRGB"].matrix_RGB_to_XYZ[1]
+    assert LUMINANCE_WEIGHTS.tolist() == np.asarray(row, dtype=np.float64).tolist()
+
+
 def _lambert_table(rho, n=40000, seed=3):
     """A table of the Lambertian f_r = rho / pi at pairs uniform in solid angle."""
     rng = np.random.default_rng(seed)

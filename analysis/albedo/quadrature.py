@@ -10,9 +10,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import stats
-from scipy.stats import qmc
 
+from analysis.lazy import qmc, stats
 from brdf.protocols import ThreadedBRDF
 
 __all__ = ["thread_axes", "gl_composite", "thread_dirs", "threads_rule", "sphere_rule",

@@ -44,6 +44,7 @@ BLAS is limited to one thread inside the fit (the fit's threads already fill the
 Examples
 --------
 >>> import brdf
+>>> from analysis.fit import FabricModel, fit
 >>> from analysis.params import ParamSpec, defaults_from_fabric
 >>> from gonio.table import Table
 >>> fab = brdf.fabric("silk_crepe_de_chine")
@@ -60,24 +61,25 @@ True
 
 import numpy as np  # noqa: F401  (the Examples use it)
 
-from analysis.fit.checkpoint import CHECKPOINT_FILE, CONFIG_FILE, FitFolder
-from analysis.fit.compare import compare_fits
-from analysis.fit.convergence import Criteria, Diagnosis
-from analysis.fit.driver import FitOptions, fit
-from analysis.fit.ensemble import Chain, EnsembleRunner
-from analysis.fit.lockstep import LockStep
-from analysis.fit.loo import LOO_FILE, Loo, load_loo, psis_loo
-from analysis.fit.medians import FitModel, MedianFabric, median_fabric
-from analysis.fit.moves import EnsembleMoves
-from analysis.fit.optimize import point_estimate
-from analysis.fit.posterior import BaselineForward, FabricModel, LogPosterior, forward_model
-from analysis.fit.proposal import LaplaceMove
-from analysis.fit.quality import albedo_colours, albedo_delta_e, fit_quality
-from analysis.fit.results import SCHEMA_VERSION, FitResult, write_results
-from analysis.fit.sampler import FitInterrupted
-from analysis.fit.adequacy import adequacy
-from analysis.fit.trust import fit_warnings
-from analysis.fit.workflow import fit_fabric, fit_spec
+from analysis.fit.adequacy import adequacy   # eager: the name is also its module's
+from analysis.lazy import lazy_getattr
+
+#: Names loaded on first use, with their modules (:mod:`analysis.lazy`): the sampler
+#: loads emcee and scipy.stats (about 0.5 s), which a verb reading a fit folder does not need.
+_LAZY = {name: f"analysis.fit.{module}" for module, names in {
+    "checkpoint": ("CHECKPOINT_FILE", "CONFIG_FILE", "FitFolder"),
+    "compare": ("compare_fits",), "convergence": ("Criteria", "Diagnosis"),
+    "driver": ("FitOptions", "fit"), "ensemble": ("Chain", "EnsembleRunner"),
+    "lockstep": ("LockStep",), "loo": ("LOO_FILE", "Loo", "load_loo", "psis_loo"),
+    "medians": ("FitModel", "MedianFabric", "median_fabric"), "moves": ("EnsembleMoves",),
+    "optimize": ("point_estimate",),
+    "posterior": ("BaselineForward", "FabricModel", "LogPosterior", "forward_model"),
+    "proposal": ("LaplaceMove",), "quality": ("albedo_colours", "albedo_delta_e", "fit_quality"),
+    "results": ("SCHEMA_VERSION", "FitResult", "write_results"),
+    "sampler": ("FitInterrupted",), "trust": ("fit_warnings",),
+    "workflow": ("fit_fabric", "fit_spec"),
+}.items() for name in names}
+__getattr__ = lazy_getattr(__name__, _LAZY, globals())
 
 __all__ = ["fit", "fit_fabric", "fit_spec", "FitOptions", "FitResult", "FitInterrupted",
            "write_results",

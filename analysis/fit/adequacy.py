@@ -50,7 +50,8 @@ that it is large; the region means say where and how much.
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
+
+from analysis.lazy import stats
 
 __all__ = ["adequacy", "normal_scores", "point_scores", "regions", "ALPHA", "MIN_REGION",
            "N_DRAWS"]

@@ -20,13 +20,16 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from analysis.fit.proposal import MIXTURE_COMPONENTS
+from analysis.lazy import lazy_module
 from gonio import atomic_write
 from gonio.jsonplain import plain
 from gonio.memory import memory_limit
 from gonio.safeh5 import H5Data, H5Group, read_h5
 from gonio.statefields import FileFields, load_json, loads_json
 
+
+#: The proposal's module, on use (it loads emcee: :mod:`analysis.lazy`).
+proposal = lazy_module("analysis.fit.proposal")
 __all__ = ["FitFolder", "table_digest", "read_config", "checkpoint_layout", "check_checkpoint",
            "CONFIG_FILE", "CHECKPOINT_FILE"]
 
@@ -214,7 +217,7 @@ def checkpoint_layout(ensembles: int, walkers: int, ndim: int) -> tuple[H5Group,
                         "rng": rng, "proposal": proposal})
     root = H5Group({f"ensemble_{k}": one(k) for k in range(ensembles)},
                    attrs={"progress": "text", "ensembles": "int"})
-    return root, {"components": max(MIXTURE_COMPONENTS), "draws": MAX_DRAWS}
+    return root, {"components": max(proposal.MIXTURE_COMPONENTS), "draws": MAX_DRAWS}
 
 
 def read_config(path) -> dict:

@@ -42,7 +42,8 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
+
+from analysis.lazy import stats
 
 from analysis.budget import memory_limit
 from gonio import atomic_write

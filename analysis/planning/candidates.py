@@ -14,8 +14,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.stats import qmc
 
+from analysis.lazy import qmc
 from brdf.frames import from_angles
 from gonio.geometry import Geometry
 from gonio.geomspec import from_spec, spec_pairs

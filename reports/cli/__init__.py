@@ -41,6 +41,23 @@ COMMAND_MODULES = (
 )
 
 
+#: Each verb and the module of :data:`COMMAND_MODULES` that registers it: ``microcyl VERB``
+#: imports that module alone (the others and what they import are not loaded: about 1.2 s
+#: of a short verb's start on the 2-core machine). ``tests/test_cli_verbs.py`` holds it to
+#: what the modules register.
+VERBS = {
+    "fabrics": "reports.cli.model", "eval": "reports.cli.model",
+    "report": "reports.cli.model", "measure": "reports.cli.measure",
+    "plan": "reports.cli.plan", "convert": "reports.cli.tables", "info": "reports.cli.tables",
+    "render": "reports.cli.render", "energy": "reports.cli.physics",
+    "reciprocity": "reports.cli.physics", "sanity": "reports.cli.physics",
+    "fit": "reports.cli.fit", "fit-images": "reports.cli.fitimages",
+    "compare": "reports.cli.compare", "fit-measured": "reports.cli.measured",
+    "fit-batch": "reports.cli.batch", "plot": "reports.cli.plot",
+    "export": "reports.cli.export", "explore": "reports.cli.explore",
+}
+
+
 class _Parser(argparse.ArgumentParser):
     """An ArgumentParser whose usage errors are one line and exit status 2, that never takes
     an abbreviation for an option (``--out`` is not ``--output``), and whose verbs take
@@ -75,8 +92,18 @@ def _version() -> str:
         return "(not installed)"
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Return the full ``microcyl`` parser with every registered verb."""
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """Return the ``microcyl`` parser: with every registered verb, or, when the arguments
+    ``argv`` name a verb of :data:`VERBS` (its first argument not an option), with the verbs
+    of that verb's module alone.
+
+    Examples
+    --------
+    >>> sorted(_subparsers(build_parser(["-q", "sanity", "velvet"])).choices)
+    ['energy', 'reciprocity', 'sanity']
+    >>> len(_subparsers(build_parser()).choices) == len(VERBS)
+    True
+    """
     parser = _Parser(
         prog="microcyl", intermixed=False,
         description="Measure and analyse the microcylinder cloth BRDF "
@@ -90,9 +117,15 @@ def build_parser() -> argparse.ArgumentParser:
                        help="only warnings and errors on stderr (no 'wrote ...' lines)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for name in COMMAND_MODULES:
+    verb = next((a for a in argv or () if not a.startswith("-")), None)
+    for name in (VERBS[verb],) if verb in VERBS else COMMAND_MODULES:
         importlib.import_module(name).register(sub)
     return parser
+
+
+def _subparsers(parser) -> argparse._SubParsersAction:
+    """The verbs' sub-parser action of a parser of :func:`build_parser`."""
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
 
 
 class _ShownFormatter(logging.Formatter):
@@ -148,7 +181,8 @@ def main(argv: list[str] | None = None) -> int:
         0 on success, 1 on a reported error, 130 on interrupt (2 for usage errors,
         raised by argparse as ``SystemExit``).
     """
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
     _configure_logging(args)
     try:

@@ -15,8 +15,8 @@ import gonio
 import gonio.io
 from analysis import sources
 from analysis.families import MICROCYLINDER, family, model_names
-from analysis.fit.driver import MAX_ENSEMBLES, FitOptions  # MAX_ENSEMBLES: re-exported
 from analysis.folderlock import missing_folders, remove_empty_folders
+from analysis.lazy import lazy_module
 from analysis.likelihood import KINDS
 from analysis.measured import curet_sample, default_data_dir
 from analysis.params import DEFAULT_FREE, DEFAULT_TIES
@@ -26,8 +26,11 @@ __all__ = ["add_fabric_options", "fabric_options", "fabric_from_args", "add_fabr
            "check_output_suffix", "parse_angle_pair", "check_writable_dir",
            "add_fit_options", "fit_kwargs", "split_ties", "data_dir",
            "add_cluster_options", "add_model_arguments", "start_model", "check_tangent_samples", "reader_options", "read_table",
-           "MAX_TANGENT_SAMPLES", "MAX_ENSEMBLES", "add_engine_option", "ENGINE_CHOICES",
+           "MAX_TANGENT_SAMPLES", "add_engine_option", "ENGINE_CHOICES",
            "DEFAULT_ENGINE", "curet_sample_arg", "curet_samples_text"]
+
+#: The fit's driver, on use (its sampler loads emcee: :mod:`analysis.lazy`).
+driver = lazy_module("analysis.fit.driver")
 
 #: Largest --tangent-samples (the default is 32): the model's own cap, whoever asks.
 MAX_TANGENT_SAMPLES = brdf.MAX_TANGENT_SAMPLES
@@ -255,7 +258,7 @@ def fit_kwargs(args: argparse.Namespace) -> dict:
     kw = {"likelihood": args.likelihood, "nu": args.nu, "ensembles": args.ensembles,
           "walkers": args.walkers, "seed": args.seed, "max_steps": args.max_steps,
           "check_every": args.check_every, "time_limit": args.time_limit}
-    FitOptions(**kw).check()
+    driver.FitOptions(**kw).check()
     return kw
 
 

@@ -144,3 +144,23 @@ def test_the_lobe_plot_notes_a_band_thinner_than_its_line_from_a_real_fit():
                 assert labels[0] == "90% band"
         finally:
             plt.close(fig)
+
+
+def test_corner_says_once_which_panels_lack_contours_not_on_the_root_logger(tmp_path, caplog):
+    """corner logs "Too few points to create valid contours" on the root logger (the terminal
+    showed ``WARNING:root:...``); the plot says it once through microcyl's logger."""
+    import logging
+    from types import SimpleNamespace
+
+    from reports.plots.fit_diagnostics import corner_plot
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(4000, 3))
+    x[:, 1] = rng.integers(0, 2, 4000) * 1e-3
+    x[:, 2] = np.where(rng.random(4000) < 0.999, 0.5, 0.6)      # hardly spread
+    result = SimpleNamespace(samples=lambda: x, names=["a", "b", "c"], units=["1"] * 3)
+    with caplog.at_level(logging.INFO):
+        corner_plot(result, filename=tmp_path / "corner.png")
+    assert not [r for r in caplog.records if r.name == "root"]
+    said = [r.getMessage() for r in caplog.records if r.name == "microcyl"]
+    assert len(said) == 1 and "without contours" in said[0], said
+    assert (tmp_path / "corner.png").stat().st_size > 1000

@@ -9,7 +9,9 @@ when given ``filename`` and never calls ``show()``.
 
 from __future__ import annotations
 
+import contextlib
 import io
+import logging
 import textwrap
 from pathlib import Path
 
@@ -83,12 +85,37 @@ def corner_plot(result, truths=None, fig=None, filename=None):
     d = samples.shape[1]
     if fig is None:
         fig = _plt().figure(figsize=(1.5 * d + 0.8, 1.5 * d + 0.8))
-    fig = corner.corner(samples, labels=labels, truths=tr, quantiles=[0.025, 0.5, 0.975],
-                        show_titles=False, fig=fig, max_n_ticks=3, plot_datapoints=False,
-                        plot_density=False, fill_contours=True,
-                        label_kwargs={"fontsize": 8}, labelpad=0.08)
+    with _corner_log() as said:
+        fig = corner.corner(samples, labels=labels, truths=tr, quantiles=[0.025, 0.5, 0.975],
+                            show_titles=False, fig=fig, max_n_ticks=3, plot_datapoints=False,
+                            plot_density=False, fill_contours=True,
+                            label_kwargs={"fontsize": 8}, labelpad=0.08)
+    if said:           # corner's own words on the root logger, once, as microcyl says things
+        logging.getLogger("microcyl").info(
+            f"corner plot: {len(said)} panel(s) drawn without contours (corner: "
+            f"{said[0].rstrip('.').lower()}: the draws of a pair of parameters hardly spread)")
     _corner_titles(fig, samples, labels)
     return _finish_corner(fig, filename)
+
+
+@contextlib.contextmanager
+def _corner_log():
+    """The messages corner logs on the root logger while it draws (its "Too few points to
+    create valid contours" would reach the terminal as ``WARNING:root:...``), kept in a list
+    instead of printed."""
+    said: list[str] = []
+
+    class _Keep(logging.Handler):
+        def emit(self, record):
+            said.append(record.getMessage())
+
+    root = logging.getLogger()
+    keep, propagate = _Keep(), root.handlers[:]
+    root.handlers[:] = [keep]
+    try:
+        yield said
+    finally:
+        root.handlers[:] = propagate
 
 
 def _corner_titles(fig, samples, labels):

@@ -133,6 +133,8 @@ def main(argv=None) -> int:
     ap.add_argument("--rst", type=Path, help="write the page's fragment here")
     ap.add_argument("--wall", type=float, help="the wall time of the run that made the fits, "
                     "seconds (where it was not this script's --run)")
+    ap.add_argument("--load", type=float, help="the load average during that run (default: "
+                    "the 1-minute load at the end of --run, or now)")
     args = ap.parse_args(argv)
     wall = args.wall
     if args.run:
@@ -142,9 +144,9 @@ def main(argv=None) -> int:
         wall = time.perf_counter() - t0
     doc = _load(args.fits / "measured.json")
     rows = [dataset_row(args.fits, n, e) for n, e in doc["datasets"].items()]
-    load = os.getloadavg()[0]
-    lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} with "
-             f"{os.cpu_count()} cores, load {load:.1f} (``bench/bench_measured.py``; "
+    load = args.load if args.load is not None else os.getloadavg()[0]
+    lines = [f"Fitted {time.strftime('%Y-%m-%d')} on {platform.machine()} with "
+             f"{os.cpu_count()} cores at a load of {load:.1f} (``bench/bench_measured.py``; "
              f"``fit-measured --models all``, seed 0, ``--max-steps 20000``). PSIS-LOO elpd "
              f"± se per model, the best in bold:", "", *table_rst(rows), "",
              *sentences(rows, wall), ""]

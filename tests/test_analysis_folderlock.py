@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+import analysis.batch
 import analysis.measured as measured
 from analysis.folderlock import (LOCK_NAME, REPORT_MARKER, FolderBusy, lock_name, output_lock,
                                  remove_stale_temporaries)
@@ -155,7 +156,7 @@ def test_fit_measured_takes_the_lock_through_measured_json(tmp_path, monkeypatch
         raise KeyboardInterrupt                          # stop here: no fit, no json
 
     monkeypatch.setattr(measured, "load_measured", lambda n, root, rgl_step: None)
-    monkeypatch.setattr(measured, "run_batch", fake_run_batch)
+    monkeypatch.setattr(analysis.batch, "run_batch", fake_run_batch)
     name = next(iter(measured.MEASURED))
     with output_lock(tmp_path, "report"):
         with pytest.raises(FolderBusy, match="another report is running"):

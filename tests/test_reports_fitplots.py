@@ -158,9 +158,22 @@ def test_corner_says_once_which_panels_lack_contours_not_on_the_root_logger(tmp_
     x[:, 1] = rng.integers(0, 2, 4000) * 1e-3
     x[:, 2] = np.where(rng.random(4000) < 0.999, 0.5, 0.6)      # hardly spread
     result = SimpleNamespace(samples=lambda: x, names=["a", "b", "c"], units=["1"] * 3)
-    with caplog.at_level(logging.INFO):
-        corner_plot(result, filename=tmp_path / "corner.png")
+    said = []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            said.append(record.getMessage())
+
+    log = logging.getLogger("microcyl")      # the CLI may have set it not to propagate
+    keep, level = Keep(), log.level
+    log.addHandler(keep)
+    log.setLevel(logging.INFO)
+    try:
+        with caplog.at_level(logging.INFO):
+            corner_plot(result, filename=tmp_path / "corner.png")
+    finally:
+        log.removeHandler(keep)
+        log.setLevel(level)
     assert not [r for r in caplog.records if r.name == "root"]
-    said = [r.getMessage() for r in caplog.records if r.name == "microcyl"]
     assert len(said) == 1 and "without contours" in said[0], said
     assert (tmp_path / "corner.png").stat().st_size > 1000

@@ -97,9 +97,9 @@ def test_report_page_of_measured_fits(fitted, tmp_path):
 def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeypatch):
     """Two fit-measured runs into one folder: the one that finishes last must not drop the
     entry the other wrote while it was fitting."""
-    import analysis.measured
+    import analysis.batch
     from analysis.measured import fit_measured
-    real = analysis.measured.run_batch
+    real = analysis.batch.run_batch
 
     def batch_and_other_run_finishing(*a, **kw):
         out = real(*a, **kw)
@@ -107,7 +107,7 @@ def test_concurrent_runs_keep_each_others_summary(tmp_path, shared_data, monkeyp
             {"datasets": {"curet_07_velvet": {"converged": True, "steps": 1}}}))
         return out
 
-    monkeypatch.setattr(analysis.measured, "run_batch", batch_and_other_run_finishing)
+    monkeypatch.setattr(analysis.batch, "run_batch", batch_and_other_run_finishing)
     doc = fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, max_steps=20,
                        plots=None, progress=False, workers=1)
     on_disk = json.loads((tmp_path / "measured.json").read_text())
@@ -318,13 +318,13 @@ def test_a_field_of_measured_json_out_of_its_schema_is_one_line(tmp_path, field,
                                  {"datasets": {"../x": {}}}])
 def test_fit_measured_refuses_a_damaged_summary_before_any_fit(tmp_path, shared_data, doc,
                                                               monkeypatch):
-    import analysis.measured
+    import analysis.batch
     from analysis.measured import fit_measured
 
     def no_batch(*a, **kw):
         raise AssertionError("a fit started")
 
-    monkeypatch.setattr(analysis.measured, "run_batch", no_batch)
+    monkeypatch.setattr(analysis.batch, "run_batch", no_batch)
     (tmp_path / "measured.json").write_text(json.dumps(doc))
     with pytest.raises(ValueError, match=r"measured\.json: "):
         fit_measured(["curet_44_linen"], tmp_path, data_dir=shared_data, plots=None,

@@ -401,12 +401,11 @@ def test_threads_sharing_a_prepared(monkeypatch):
 
 
 @needs_drjit
-def test_thread_limit_applies_to_a_loaded_drjit(monkeypatch):
+def test_thread_limit_applies_to_a_loaded_drjit():
     """limit_threads caps the pool of a Dr.Jit already loaded; None gives back a thread a
-    core (with MICROCYL_JIT_THREADS unset); share_cores(N) gives cores // N (at least 1)."""
+    core; share_cores(N) gives cores // N (at least 1)."""
     import os
     import drjit as dr
-    monkeypatch.delenv(jit.THREADS_ENV, raising=False)
     jit.compiled()
     try:
         jit.limit_threads(1)
@@ -462,24 +461,3 @@ def test_rotated_batches_of_few_pairs_run_fused(monkeypatch):
     assert calls                                    # 60 pairs x 16 sets x 40 samples
     ref = with_backend(monkeypatch, "numpy", lambda: fab.prepare(wi, wo).eval_rotated(rot))
     assert_agree(got, ref)
-
-
-@needs_drjit
-@pytest.mark.parametrize("value, expect", [("1", "1"), ("2", "2"), ("", "cores"),
-                                           ("0", "error"), ("two", "error")])
-def test_the_environment_caps_drjits_threads_in_a_new_process(value, expect):
-    """MICROCYL_JIT_THREADS as a user sets it: Dr.Jit's pool in a fresh process; a bad value
-    is one line naming the variable, raised where the kernel is first asked for."""
-    import os
-    import subprocess
-    import sys
-    code = ("import drjit as dr, brdf.jit as j\n"
-            "try:\n    j.compiled()\nexcept ValueError as e:\n    print('error', e)\n"
-            "else:\n    print(dr.thread_count())")
-    env = dict(os.environ, MICROCYL_JIT_THREADS=value)
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                         text=True, timeout=120).stdout.strip()
-    if expect == "error":
-        assert out.startswith("error MICROCYL_JIT_THREADS=") and "whole number >= 1" in out
-    else:
-        assert out == (str(os.cpu_count() or 1) if expect == "cores" else expect), out

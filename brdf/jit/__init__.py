@@ -49,24 +49,6 @@ TINY_COMPONENT = 2.0 ** -250
 #: there (velvet, one thread: 1 pair 0.48 ms NumPy against 0.68 ms Dr.Jit, 1,000 pairs
 #: 8.2 against 3.6 ms; 2026-12-07).
 MIN_ELEMENTS = 1 << 14
-#: The environment variable that caps Dr.Jit's threads in every microcyl process (a whole
-#: number >= 1; unset: one a core): a machine shared with other work, or a test suite that
-#: runs several processes a core (``tests/conftest.py`` sets it to 1).
-THREADS_ENV = "MICROCYL_JIT_THREADS"
-
-
-def _env_limit() -> int | None:
-    """:data:`THREADS_ENV`'s cap, or None where it is unset; a value that is not a whole
-    number >= 1 is one clear error."""
-    text = os.environ.get(THREADS_ENV, "").strip()
-    if not text:
-        return None
-    if not text.isdigit() or int(text) < 1:
-        raise ValueError(f"{THREADS_ENV}={text!r}: must be a whole number >= 1 (Dr.Jit's "
-                         f"threads), or unset for one a core")
-    return int(text)
-
-
 _LIMIT: list[int | None] = [None]      # limit_threads' cap, applied when Dr.Jit loads
 
 
@@ -98,9 +80,8 @@ def limit_threads(n: int | None) -> None:
 
 
 def thread_limit() -> int | None:
-    """The cap :func:`limit_threads` set, else :data:`THREADS_ENV`'s (None: Dr.Jit's
-    default, one thread a core)."""
-    return _LIMIT[0] if _LIMIT[0] is not None else _env_limit()
+    """The cap :func:`limit_threads` set (None: Dr.Jit's default)."""
+    return _LIMIT[0]
 
 
 def share_cores(workers: int) -> int:

@@ -194,21 +194,21 @@ def test_fit_measured_with_progress_killed_and_resumed(tmp_path, shared_data):
     """``microcyl fit-measured`` as a user runs it (progress bar on, a real folder), killed
     with SIGKILL in the middle of its fit and run again: it resumes and finishes."""
     out = tmp_path / "fits"
-    args = ["fit-measured", "curet_07_velvet", "--data", shared_data, "--max-steps", "400",
+    args = ["fit-measured", "curet_07_velvet", "--data", shared_data, "--max-steps", "250",
             "-o", out]
     p = _cli(*args)
-    seen = _wait_for_checkpoint(p, out / "curet_07_velvet", 150)
+    seen = _wait_for_checkpoint(p, out / "curet_07_velvet", 100)
     p.send_signal(signal.SIGKILL)
     p.communicate()
     p = _cli(*args)
     stdout, stderr = p.communicate(timeout=600)
-    assert p.returncode == 1, stderr            # 400 steps: not converged, and it says so
+    assert p.returncode == 1, stderr            # 250 steps: not converged, and it says so
     assert "fits:" in stderr                     # the batch's bar was drawn on the pipe
     kept = int(stdout.split("resumed from step ")[1].split()[0])
     assert kept >= seen
     doc = json.loads((out / "measured.json").read_text())
     e = doc["datasets"]["curet_07_velvet"]
-    assert e["steps"] == 400 and not e["converged"] and "step limit 400" in e["reason"]
+    assert e["steps"] == 250 and not e["converged"] and "step limit 250" in e["reason"]
     res = json.loads((out / "curet_07_velvet" / "results.json").read_text())
     assert res["quality"]["albedo_delta_e2000"] == e["albedo_delta_e2000"]
     assert (out / "curet_07_velvet" / "lobes.png").stat().st_size > 1000

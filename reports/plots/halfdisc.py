@@ -84,14 +84,18 @@ class HalfDiscAxes(PolarAxes):
         return 0.5
 
 
-def snug_height(fig, *, keep_in: float = 0.08, tries: int = 3):
+def snug_height(fig, *, keep_in: float = 0.08, tries: int = 1):
     """Take a constrained-layout figure's height (inches) down to what its content needs.
 
     Panels of a fixed shape (half discs) in a figure taller than they need are centred in
     their rows, so that the surplus lies in bands between them and whatever the layout pins
     to the figure's edges (a legend under the panels, a title over them). Every empty band
     across the figure (the vertical gaps between the extents of its axes, legends and texts)
-    is cut down to ``keep_in`` inches, and the layout redone, ``tries`` times at most.
+    is cut down to ``keep_in`` inches, and the layout redone, ``tries`` times at most. One
+    is the default: of 33 figures checked with three (a fast report of the six presets and
+    five ``microcyl plot`` views, 2026-12-07), 32 had under 0.02 inch left to cut after the
+    first and one had 0.021 inch (1.5 pt), so a second drawing, the dearest part of a lobe
+    figure after its saving, mostly confirmed the first.
 
     Returns
     -------

@@ -62,25 +62,39 @@ def dataset_row(fits: Path, name: str, entry: dict) -> dict:
             "adequate_models": sum(bool(models[m].get("adequate")) for m in models)}
 
 
+def _list_table(head: list[str], body: list[list[str]]) -> list[str]:
+    out = [".. list-table::", "   :header-rows: 1", ""]
+    for cells in [head, *body]:
+        out += [f"   {'*' if i == 0 else ' '} - {c}" for i, c in enumerate(cells)]
+    return out
+
+
 def table_rst(rows: list[dict]) -> list[str]:
-    head = ["dataset", "microcylinder: converged at step (wall)", *(
-        f"{m} elpd" for m in MODELS), "rotation (deg, 95%)", "area1 (95%)", "left/right p",
-        "light/view p"]
-    out = [".. list-table::", "   :header-rows: 1", "", *(
-        f"   {'*' if i == 0 else ' '} - {h}" for i, h in enumerate(head))]
+    """Two tables that fit a page's column: every model's elpd, then the microcylinder's
+    convergence, orientation and residual splits."""
+    elpd = []
     for r in rows:
-        conv = (f"{r['steps']:,} ({r['wall_s']:.0f} s)" if r["converged"]
-                else f"not converged ({r['steps']:,} steps)")
-        cells = [r["name"], conv]
+        cells = [r["name"]]
         for m in MODELS:
             e = r["elpd"].get(m)
             text = "--" if e is None else f"{e[0]:.0f} ± {e[1]:.0f}"
             cells.append(f"**{text}**" if m == r["best"] else text)
-        cells.append(_interval(r["rotation"]) if r["rotation"] else "fixed (0)")
-        cells.append(_interval(r["area1"]) if r["area1"] else "--")
-        cells += [_p(r["left_right"]), _p(r["light_view"])]
-        out += [f"   {'*' if i == 0 else ' '} - {c}" for i, c in enumerate(cells)]
-    return out
+        elpd.append(cells)
+    fits = []
+    for r in rows:
+        conv = (f"{r['steps']:,} ({r['wall_s']:.0f} s)" if r["converged"]
+                else f"not converged ({r['steps']:,} steps)")
+        fits.append([r["name"], conv,
+                     _interval(r["rotation"]) if r["rotation"] else "fixed (0)",
+                     _interval(r["area1"]) if r["area1"] else "--",
+                     _p(r["left_right"]), _p(r["light_view"])])
+    return [*_list_table(["dataset", *MODELS], elpd), "",
+            "The microcylinder's fits: the step its convergence checks passed (its wall time), "
+            "its rotation and area share (median [95% interval]), and the Mann-Whitney p of its "
+            "residuals split left against right and light against view (the adequacy checks' "
+            "region tests):", "",
+            *_list_table(["dataset", "converged at step (wall)", "rotation (deg)", "area1",
+                          "left/right p", "light/view p"], fits)]
 
 
 def sentences(rows: list[dict], wall: float | None) -> list[str]:
@@ -148,7 +162,7 @@ def main(argv=None) -> int:
     lines = [f"Fitted {time.strftime('%Y-%m-%d')} on {platform.machine()} with "
              f"{os.cpu_count()} cores at a load of {load:.1f} (``bench/bench_measured.py``; "
              f"``fit-measured --models all``, seed 0, ``--max-steps 20000``). PSIS-LOO elpd "
-             f"± se per model, the best in bold:", "", *table_rst(rows), "",
+             f"± se of each model's fit, the best in bold:", "", *table_rst(rows), "",
              *sentences(rows, wall), ""]
     print("\n".join(lines))
     if args.rst:

@@ -44,9 +44,9 @@ from pathlib import Path
 import numpy as np
 
 from analysis.fit.results import read_results
-from analysis.fit.swap import fold_thread_swap
+from analysis.fit.swap import with_symmetries
 from analysis.folderlock import output_lock
-from analysis.families import MICROCYLINDER, family_of
+from analysis.families import MICROCYLINDER
 from analysis.lazy import lazy_module
 from analysis.measuredjson import load_measured_json
 from analysis.measuredmodels import fit_folder, models_entry, parse_models, verdict_warnings
@@ -235,9 +235,8 @@ def measured_spec(name, fab=None):
     """
     d = _dataset(name)
     fab = fab if fab is not None else preset_fabric(d.preset)
-    spec = ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties,
-                     periods=family_of(fab).periods(fab))
-    return fold_thread_swap(spec, fab), fab
+    spec = ParamSpec(d.free, defaults=defaults_from_fabric(fab), ties=d.ties)
+    return with_symmetries(spec, fab), fab
 
 
 def fit_measured(names=None, out_dir="fits", *, data_dir=None, seed: int = 0,

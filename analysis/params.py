@@ -134,6 +134,11 @@ class ParamSpec:
         self.upper = np.array([self.params[n].internal_bounds[1] for n in self.free])
         #: A typical scale of each internal coordinate (for step sizes and starting balls).
         self.width = np.full(len(self.free), INTERNAL_WIDTH)
+        # (lo, centre, period) of each circular free parameter: fixed with the bounds and
+        # periods, asked on every evaluation of the prior and every transform
+        self._circles = {n: (self.params[n].lo, 0.5 * (self.params[n].lo + self.params[n].hi),
+                             self.period(n)) for n in self.free if self.period(n) is not None}
+        self._circular = np.array([n in self._circles for n in self.free], dtype=bool)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -238,14 +243,6 @@ class ParamSpec:
             return None
         return period if p.hi - p.lo >= period * (1.0 - 1e-9) else None
 
-    def _circle(self, name: str) -> tuple[float, float, float] | None:
-        """(lo, centre, period) of a circular free parameter, else None."""
-        period = self.period(name)
-        if period is None:
-            return None
-        p = self.params[name]
-        return p.lo, 0.5 * (p.lo + p.hi), period
-
     def to_natural(self, theta) -> np.ndarray:
         """Internal (..., ndim) -> natural values of the free parameters (..., ndim).
 
@@ -263,7 +260,7 @@ class ParamSpec:
         theta = np.asarray(theta, dtype=np.float64)
         out = np.empty_like(theta)
         for i, n in enumerate(self.free):
-            circle = self._circle(n)
+            circle = self._circles.get(n)
             if circle is None:
                 out[..., i] = self.params[n].to_natural(theta[..., i])
             else:
@@ -276,7 +273,7 @@ class ParamSpec:
         x = np.asarray(x, dtype=np.float64)
         out = np.empty_like(x)
         for i, n in enumerate(self.free):
-            circle, p = self._circle(n), self.params[n]
+            circle, p = self._circles.get(n), self.params[n]
             if circle is None:
                 out[..., i] = p.to_internal(x[..., i])
             else:
@@ -289,7 +286,7 @@ class ParamSpec:
     def circular(self) -> np.ndarray:
         """Per free parameter, whether it is circular (bool (ndim,)): its internal coordinate
         is linear and its prior flat in it (:meth:`to_natural`)."""
-        return np.array([self._circle(n) is not None for n in self.free], dtype=bool)
+        return self._circular.copy()
 
     def values(self, theta) -> dict[str, np.ndarray]:
         """Every parameter's natural value for internal coordinates ``theta`` (B..., ndim).
@@ -320,7 +317,7 @@ class ParamSpec:
         theta = np.asarray(theta, dtype=np.float64)
         ok = np.all((theta >= self.lower) & (theta <= self.upper) & np.isfinite(theta), axis=-1)
         with np.errstate(invalid="ignore"):    # a circle's coordinate is linear: no Jacobian
-            jac = -np.where(self.circular, 0.0, np.logaddexp(0.0, theta)
+            jac = -np.where(self._circular, 0.0, np.logaddexp(0.0, theta)
                             + np.logaddexp(0.0, -theta)).sum(axis=-1)
         cls = self.family.cls
         joint = bool(set(cls.CONSTRAINED) & set(self.free))

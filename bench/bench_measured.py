@@ -22,9 +22,11 @@ import sys
 import time
 from pathlib import Path
 
+from analysis.families import model_names
 from gonio.atomic import atomic_write
 
-MODELS = ("microcylinder", "lambert", "charlie", "ashikhmin", "zeltner")
+#: Every registered model, in the registry's order (the microcylinder first).
+MODELS = model_names()
 
 
 def _load(path: Path) -> dict:

@@ -312,7 +312,7 @@ def _verb_modules() -> list[str]:
     for node in TREES["reports.cli"].body:
         if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == \
                 "COMMAND_MODULES":
-            return [e.value for e in node.value.elts]
+            return [e.value for e in node.value.keys]      # {module: (verb, ...)}
     raise AssertionError("reports/cli/__init__.py has no COMMAND_MODULES")
 
 

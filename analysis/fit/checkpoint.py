@@ -27,11 +27,11 @@ from gonio.memory import memory_limit
 from gonio.safeh5 import H5Data, H5Group, read_h5
 from gonio.statefields import FileFields, load_json, loads_json
 
+__all__ = ["FitFolder", "table_digest", "read_config", "checkpoint_layout", "check_checkpoint",
+           "CONFIG_FILE", "CHECKPOINT_FILE"]
 
 #: The proposal's module, on use (it loads emcee: :mod:`analysis.lazy`).
 proposal = lazy_module("analysis.fit.proposal")
-__all__ = ["FitFolder", "table_digest", "read_config", "checkpoint_layout", "check_checkpoint",
-           "CONFIG_FILE", "CHECKPOINT_FILE"]
 
 CONFIG_FILE = "fit_config.json"
 CHECKPOINT_FILE = "checkpoint.h5"

@@ -35,9 +35,10 @@ True
 
 from __future__ import annotations
 
+from analysis.families import family_of
 from analysis.params import ParamSpec
 
-__all__ = ["fold_thread_swap", "AREA"]
+__all__ = ["fold_thread_swap", "with_symmetries", "AREA"]
 
 #: The area shares of the two threads (``area2 = 1 - area1`` when they cover the surface).
 AREA = ("area1", "area2")
@@ -113,3 +114,20 @@ def fold_thread_swap(spec: ParamSpec, fabric) -> ParamSpec:
                      priors={q.name: q.prior for q in ps}, ties=spec.ties,
                      family=spec.family, notes=(*spec.notes, note), periods=spec.periods,
                      folds={**spec.folds, area: 0.5})
+
+
+def with_symmetries(spec: ParamSpec, model) -> ParamSpec:
+    """``spec`` with what the model repeats applied: its periods (a fabric's ``rotation``,
+    circular over one whole period, :meth:`ParamSpec.with_periods`), then the fold of two
+    threads that trade places (:func:`fold_thread_swap`); the one way ``microcyl fit`` and
+    ``fit-measured`` build a spec from a model.
+
+    Examples
+    --------
+    >>> import brdf
+    >>> spec = with_symmetries(ParamSpec("area1,rotation", ties="area2=1-area1"),
+    ...                        brdf.fabric("linen_plain"))
+    >>> spec.period("rotation"), spec.folds
+    (180.0, {'area1': 0.5})
+    """
+    return fold_thread_swap(spec.with_periods(family_of(model).periods(model)), model)

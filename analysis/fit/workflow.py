@@ -18,7 +18,7 @@ from analysis.families import family_of
 from analysis.fit.posterior import forward_model
 from analysis.fit.quality import fit_quality, start_colour_difference
 from analysis.fit.results import FitResult, write_results
-from analysis.fit.swap import fold_thread_swap
+from analysis.fit.swap import with_symmetries
 from analysis.fit.trust import COLOUR_DE_MAX, colour_warnings, fixed_colour_channels
 from analysis.folderlock import output_lock
 from analysis.likelihood import is_grey, is_relative
@@ -66,9 +66,7 @@ def fit_spec(fabric, free=None, ties=None, toml=None, table=None) -> ParamSpec:
     >>> fit_spec(Lambert()).free
     ('base_r', 'base_g', 'base_b')
     """
-    spec = _fit_spec(fabric, free, ties, toml, table).with_periods(
-        family_of(fabric).periods(fabric))
-    return fold_thread_swap(spec, fabric)
+    return with_symmetries(_fit_spec(fabric, free, ties, toml, table), fabric)
 
 
 def _fit_spec(fabric, free, ties, toml, table) -> ParamSpec:

@@ -74,8 +74,8 @@ def prior_draws(spec: ParamSpec, draws: int, rng: np.random.Generator,
 
 def fit_folder_spec(folder) -> tuple[ParamSpec, list[str]]:
     """The ParamSpec a fit folder's ``fit_config.json`` describes (free, ties, bounds,
-    priors, defaults, periods and folds), so that its stored internal coordinates mean what they meant, and its
-    ties as ``--tie`` strings (``"a=b"``, ``"a=1-b"``).
+    priors, defaults, periods and folds), so that its stored internal coordinates mean what
+    they meant, and its ties as ``--tie`` strings (``"a=b"``, ``"a=1-b"``).
 
     Raises
     ------

@@ -22,40 +22,28 @@ from gonio.terminal import shown
 
 __all__ = ["main", "build_parser", "COMMAND_MODULES"]
 
-#: Modules that each contribute one or more verbs, in the order ``--help`` lists them.
-COMMAND_MODULES = (
-    "reports.cli.model",
-    "reports.cli.measure",
-    "reports.cli.plan",
-    "reports.cli.tables",
-    "reports.cli.render",
-    "reports.cli.physics",
-    "reports.cli.fit",
-    "reports.cli.fitimages",
-    "reports.cli.compare",
-    "reports.cli.measured",
-    "reports.cli.batch",
-    "reports.cli.plot",
-    "reports.cli.export",
-    "reports.cli.explore",
-)
-
-
-#: Each verb and the module of :data:`COMMAND_MODULES` that registers it: ``microcyl VERB``
-#: imports that module alone (the others and what they import are not loaded: about 1.2 s
-#: of a short verb's start on the 2-core machine). ``tests/test_cli_verbs.py`` holds it to
-#: what the modules register.
-VERBS = {
-    "fabrics": "reports.cli.model", "eval": "reports.cli.model",
-    "report": "reports.cli.model", "measure": "reports.cli.measure",
-    "plan": "reports.cli.plan", "convert": "reports.cli.tables", "info": "reports.cli.tables",
-    "render": "reports.cli.render", "energy": "reports.cli.physics",
-    "reciprocity": "reports.cli.physics", "sanity": "reports.cli.physics",
-    "fit": "reports.cli.fit", "fit-images": "reports.cli.fitimages",
-    "compare": "reports.cli.compare", "fit-measured": "reports.cli.measured",
-    "fit-batch": "reports.cli.batch", "plot": "reports.cli.plot",
-    "export": "reports.cli.export", "explore": "reports.cli.explore",
+#: Modules that each contribute one or more verbs, in the order ``--help`` lists them, with
+#: the verbs each registers: ``microcyl VERB`` imports its module alone (the others and what
+#: they import are not loaded: about 1.2 s of a short verb's start on the 2-core machine).
+#: ``tests/test_cli_verbs.py`` holds the verbs to what the modules register.
+COMMAND_MODULES = {
+    "reports.cli.model": ("fabrics", "eval", "report"),
+    "reports.cli.measure": ("measure",),
+    "reports.cli.plan": ("plan",),
+    "reports.cli.tables": ("convert", "info"),
+    "reports.cli.render": ("render",),
+    "reports.cli.physics": ("energy", "reciprocity", "sanity"),
+    "reports.cli.fit": ("fit",),
+    "reports.cli.fitimages": ("fit-images",),
+    "reports.cli.compare": ("compare",),
+    "reports.cli.measured": ("fit-measured",),
+    "reports.cli.batch": ("fit-batch",),
+    "reports.cli.plot": ("plot",),
+    "reports.cli.export": ("export",),
+    "reports.cli.explore": ("explore",),
 }
+#: Each verb and its module (from :data:`COMMAND_MODULES`).
+VERBS = {verb: module for module, verbs in COMMAND_MODULES.items() for verb in verbs}
 
 
 class _Parser(argparse.ArgumentParser):

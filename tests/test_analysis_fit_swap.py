@@ -119,3 +119,37 @@ def test_a_linen_with_its_wider_thread_first_is_recovered_as_the_same_fabric(tmp
     assert a["lo95"] <= 0.25 <= a["hi95"], a
     assert rot["lo95"] <= -70.0 <= rot["hi95"], rot
     assert not [w for w in r.warnings if w["kind"] == "at_bound"], r.warnings
+
+
+@pytest.mark.parametrize("key, value, field", [
+    ("periods", {"rotation": "ninety"}, "config.spec.periods.rotation"),
+    ("periods", {"rotation": -180.0}, "config.spec.periods.rotation"),
+    ("folds", {"../../etc/passwd": 0.5}, "config.spec.folds"),
+    ("folds", {"area1": float("nan")}, "config.spec.folds.area1"),
+    ("periods", ["rotation", 180.0], "config.spec.periods"),
+    ("folds", {"<script>\x1b[31m": 0.5}, "config.spec.folds"),
+])
+def test_a_fit_config_from_others_with_bad_periods_or_folds_is_one_line(tmp_path, key, value,
+                                                                         field):
+    """fit_config.json's periods and folds (what a folder's stored coordinates mean) read as
+    a file from others: a value that is not a number >= 0, a name that is not a parameter,
+    is one line naming the file and the field, before any ParamSpec is built."""
+    import json
+
+    from analysis.fit.checkpoint import CONFIG_FILE
+    from analysis.planning.draws import fit_folder_spec
+    spec = measured_spec("curet_44_linen")[0]
+    doc = {"version": 8, "model": "microcylinder", "spec": spec.describe(), "extra": {}}
+    assert doc["spec"]["periods"] == {"rotation": 180.0} and doc["spec"]["folds"]
+    folder = tmp_path / "fit"
+    folder.mkdir()
+    (folder / CONFIG_FILE).write_text(json.dumps({"config": doc}))
+    back, _ = fit_folder_spec(folder)                        # the folder as the fit wrote it
+    assert back.period("rotation") == 180.0 and back.folds == {"area1": 0.5}
+    doc["spec"][key] = value
+    (folder / CONFIG_FILE).write_text(json.dumps({"config": doc}))
+    with pytest.raises(ValueError) as err:
+        fit_folder_spec(folder)
+    text = str(err.value)
+    assert "\n" not in text and str(folder / CONFIG_FILE) in text and field in text, text
+    assert "\x1b" not in text

@@ -67,3 +67,29 @@ def test_split_rhat_is_the_textbook_formula():
     c[..., 2] *= 1e-4                           # a narrow posterior far from 0: the sums of
     c[..., 2] += 5e4                            # squares must not cancel
     np.testing.assert_allclose(split_rhat(c), _textbook_rhat(c), rtol=1e-10)
+
+
+def test_diagnose_in_threads_gives_each_ensembles_own_tau():
+    """``diagnose(threads=2)`` computes the ensembles' tau in threads: each is that
+    ensemble's own emcee estimate (not another's, not reordered), the mean as with one."""
+    from analysis.fit.convergence import diagnose
+
+    class Stored:                       # a Chain's reading interface over stored arrays
+        def __init__(self, x):
+            self.x, self.steps = x, x.shape[0]
+
+        def chain(self, a, b):
+            return self.x[a:b]
+
+        def log_prob(self, a, b):
+            return np.zeros((b - a, self.x.shape[1]))
+
+    rng = np.random.default_rng(7)
+    chains = [Stored(_ar1(rng, (1500, 10, 2), rho)) for rho in (0.0, 0.5, 0.8, 0.95)]
+    one, two = diagnose(chains, 0.2), diagnose(chains, 0.2, threads=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        want = [emcee.autocorr.integrated_time(c.x[300:], tol=0, quiet=True) for c in chains]
+    np.testing.assert_allclose(two.taus, want, rtol=1e-12, atol=0)
+    assert np.array_equal(two.taus, one.taus) and np.array_equal(two.tau, one.tau)
+    assert np.all(np.diff(two.taus[:, 0]) > 0)          # tau grows with rho, in order

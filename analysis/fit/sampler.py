@@ -190,7 +190,7 @@ class FitSampler:
                     self.runner.run_to(self._next_target(), tick)
                     self._refit_due()
                 diag = diagnose(self.chains, c.burn_fraction,
-                                max(p.last_kept for p in self.proposals))
+                                max(p.last_kept for p in self.proposals), o.threads)
                 ok, why = diag.verdict(self.tau_prev, c)
                 before = None if self.tau_prev is None else self.tau_prev.tolist()
                 if not rechecked:       # a recheck repeats the check the checkpoint holds

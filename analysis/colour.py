@@ -13,10 +13,11 @@ import numpy as np
 
 from analysis.likelihood import is_grey
 
-__all__ = ["LUMINANCE_WEIGHTS", "luminance", "albedo_colours", "albedo_delta_e"]
+__all__ = ["LUMINANCE_WEIGHTS", "luminance", "albedo_colours", "albedo_delta_e",
+           "colour_science"]
 
 
-def _colour():
+def colour_science():
     """colour-science, imported on use: ``import colour`` also loads its plotting package and
     matplotlib (about 1.5 s), which every ``microcyl`` verb would pay through this package."""
     import colour
@@ -127,7 +128,7 @@ def albedo_delta_e(measured, predicted) -> float:
     >>> albedo_delta_e([0.2, 0.1, 0.05], [0.2, 0.2, 0.2]) > 5
     True
     """
-    colour = _colour()
+    colour = colour_science()
     labs = [colour.XYZ_to_Lab(colour.sRGB_to_XYZ(np.clip(np.asarray(c, float), 0, None),
                                                  apply_cctf_decoding=False))
             for c in (measured, predicted)]

@@ -3,16 +3,16 @@
 Every RGB value in microcyl (f_r, albedo A, renders) is *linear* RGB with the sRGB / Rec. 709
 primaries and white point D65. This module is the one place where such a value becomes a colour
 on screen: the encoding goes through colour-science (``colour.cctf_encoding`` with the sRGB
-inverse EOTF). Luminance is :func:`analysis.colour.luminance` (re-exported here), the one
-definition of the Rec. 709 weights.
+inverse EOTF), imported on first use (:func:`analysis.colour.colour_science`). Luminance is
+:func:`analysis.colour.luminance` (re-exported here), the one definition of the Rec. 709
+weights.
 """
 
 from __future__ import annotations
 
-import colour as _colour
 import numpy as np
 
-from analysis.colour import LUMINANCE_WEIGHTS, luminance
+from analysis.colour import LUMINANCE_WEIGHTS, colour_science, luminance
 
 __all__ = ["REC709_WEIGHTS", "luminance", "to_srgb", "display_colour", "fabric_colour",
            "line_colour", "CHANNEL_COLOURS"]
@@ -63,7 +63,7 @@ def to_srgb(rgb, exposure: float = 0.0, normalize: bool = False) -> np.ndarray:
     if normalize:
         peak = np.max(arr, axis=-1, keepdims=True)
         arr = np.divide(arr, peak, out=np.zeros_like(arr), where=peak > 0)
-    encoded = _colour.cctf_encoding(np.clip(arr, 0.0, 1.0), function="sRGB")
+    encoded = colour_science().cctf_encoding(np.clip(arr, 0.0, 1.0), function="sRGB")
     return np.clip(np.asarray(encoded, dtype=np.float64), 0.0, 1.0)
 
 

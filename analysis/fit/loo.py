@@ -38,6 +38,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import sys
 import warnings
 from pathlib import Path
 
@@ -78,10 +79,28 @@ _BLOCK_VALUES = 20_000
 _EVAL_CELLS = 2_000_000
 
 
+#: Bokeh's modules that arviz (0.23) imports on import only to copy two docstrings into its
+#: own (``arviz/plots/backends/__init__.py``, ``_copy_docstring``, which takes an ImportError
+#: for an empty docstring): about 0.65 s of CPU a process that fits or compares.
+_BOKEH_FOR_DOCSTRINGS = ("bokeh.plotting", "bokeh.models")
+
+
 def import_arviz():
     """The ``arviz`` module, imported on first use (it loads matplotlib.pyplot: about a
-    second), its import-time FutureWarning silenced (see above)."""
-    import arviz
+    second), its import-time FutureWarning silenced (see above), and without the Bokeh
+    modules it would import for docstrings (:data:`_BOKEH_FOR_DOCSTRINGS`, blocked while
+    arviz imports; imported later, as by the explorer, they load as usual)."""
+    if "arviz" in sys.modules:
+        return sys.modules["arviz"]
+    blocked = [m for m in _BOKEH_FOR_DOCSTRINGS if m not in sys.modules]
+    for m in blocked:
+        sys.modules[m] = None           # an import of m raises ImportError meanwhile
+    try:
+        import arviz
+    finally:
+        for m in blocked:
+            if sys.modules.get(m, 0) is None:
+                del sys.modules[m]
     return arviz
 
 

@@ -15,7 +15,6 @@ import logging
 import textwrap
 from pathlib import Path
 
-import corner
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
@@ -24,6 +23,7 @@ from PIL import Image
 
 from analysis.fit import LogPosterior
 from analysis.fit.adequacy import normal_scores, point_scores, regions
+from analysis.fit.loo import import_arviz
 from analysis.views.posterior import compute_posterior_lobes, posterior_draws
 from gonio import atomic_write
 from reports.plots.common import DPI
@@ -62,6 +62,15 @@ def _save(fig, filename):
         small.save(fh, format="png", optimize=True)
 
 
+def _corner():
+    """The ``corner`` module, imported on use and after arviz (:func:`import_arviz`): corner
+    imports arviz for its InferenceData input, and through import_arviz that import skips
+    the Bokeh modules arviz would load for two docstrings."""
+    import_arviz()
+    import corner        # on use: a verb that draws no corner plot does not pay for arviz
+    return corner
+
+
 def corner_plot(result, truths=None, fig=None, filename=None):
     """Corner plot of the free parameters (``corner`` package), natural units.
 
@@ -86,10 +95,11 @@ def corner_plot(result, truths=None, fig=None, filename=None):
     if fig is None:
         fig = _plt().figure(figsize=(1.5 * d + 0.8, 1.5 * d + 0.8))
     with _corner_log() as said:
-        fig = corner.corner(samples, labels=labels, truths=tr, quantiles=[0.025, 0.5, 0.975],
-                            show_titles=False, fig=fig, max_n_ticks=3, plot_datapoints=False,
-                            plot_density=False, fill_contours=True,
-                            label_kwargs={"fontsize": 8}, labelpad=0.08)
+        fig = _corner().corner(samples, labels=labels, truths=tr,
+                               quantiles=[0.025, 0.5, 0.975], show_titles=False, fig=fig,
+                               max_n_ticks=3, plot_datapoints=False, plot_density=False,
+                               fill_contours=True, label_kwargs={"fontsize": 8},
+                               labelpad=0.08)
     if said:           # corner's own words on the root logger, once, as microcyl says things
         logging.getLogger("microcyl").info(
             f"corner plot: {len(said)} panel(s) drawn without contours (corner: "

@@ -108,22 +108,11 @@ def test_fit_batch_on_a_dask_scheduler_and_two_workers(tables, tmp_path):
             p.wait(timeout=30)
 
 
-@pytest.fixture(scope="module")
-def slow_tables(tmp_path_factory):
-    """Two tables of the default fit's size (3,721 pairs): with the default 8 free
-    parameters each fit runs some seconds past its first checkpoint."""
-    d = tmp_path_factory.mktemp("slow")
-    fab = brdf.fabric("silk_crepe_de_chine")
-    for k in range(2):
-        t = gonio.measure(fab, "full:15:30", gonio.Instrument(snr=20, floor=1e-4), seed=k,
-                          progress=False)
-        gonio.write(t, d / f"silk{k}.csv")
-    return d
-
-
-def test_ctrl_c_stops_the_batch_and_the_same_command_resumes(slow_tables, tmp_path):
+def test_ctrl_c_stops_the_batch_and_the_same_command_resumes(tables, tmp_path):
+    """With the default 8 free parameters each table's fit runs some hundred steps past its
+    first checkpoint (at step 25), so Ctrl-C finds the batch fitting."""
     out = tmp_path / "out"
-    args = [sys.executable, "-m", "reports", "fit-batch", str(slow_tables), "--fabric",
+    args = [sys.executable, "-m", "reports", "fit-batch", str(tables), "--fabric",
             "silk_crepe_de_chine", "--check-every", "25", "--workers", "2", "--no-plots",
             "-o", str(out)]
     p = subprocess.Popen(args, env=ENV, preexec_fn=default_sigint, stdout=subprocess.PIPE,

@@ -1,5 +1,10 @@
 """Shared test fixtures."""
 
+import fcntl
+import os
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -43,3 +48,42 @@ def fit_folder(tmp_path_factory):
     res = fit_fabric(table, fab, spec, out, max_steps=100, ensembles=2, progress=False,
                      config_extra={"fabric": "velvet", "options": fab.options})
     return out, res
+
+
+def run_once(tmp_path_factory, name: str, build) -> Path:
+    """``build(folder)`` once in this test run, whichever xdist worker asks first (the
+    others wait on a lock, then share it): the folder of an expensive artefact several
+    modules read (a fit, a batch). Its readers must not change it. Without xdist it is
+    this process's own, like any session fixture."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    folder, done = root / name, root / f"{name}.done"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            shutil.rmtree(folder, ignore_errors=True)     # a build that failed in another
+            folder.mkdir()
+            build(folder)
+            done.touch()
+    return folder
+
+
+@pytest.fixture(scope="session")
+def velvet_two_models(tmp_path_factory, shared_data):
+    """``microcyl fit-measured curet_07_velvet --models microcylinder,lambert --max-steps 60
+    --no-plots`` as a user runs it, once a test run (:func:`run_once`): (the output folder,
+    its stdout, its stderr). 60 steps: neither fit converges, both are inadequate."""
+    def build(folder):
+        env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]),
+                   COLUMNS="100")
+        r = subprocess.run([sys.executable, "-m", "reports", "fit-measured",
+                            "curet_07_velvet", "--models", "microcylinder,lambert",
+                            "--max-steps", "60", "--no-plots", "--data", str(shared_data),
+                            "-o", str(folder / "out")], env=env, capture_output=True,
+                           text=True, timeout=900)
+        assert r.returncode in (0, 1), r.stderr          # 1: not converged in 60 steps
+        (folder / "stdout.txt").write_text(r.stdout)
+        (folder / "stderr.txt").write_text(r.stderr)
+    folder = run_once(tmp_path_factory, "velvet_two_models", build)
+    return (folder / "out", (folder / "stdout.txt").read_text(),
+            (folder / "stderr.txt").read_text())

@@ -109,27 +109,25 @@ def test_refusals_are_one_line(fits, args, message):
     assert not (fits / "x").exists() and not (fits / "x.json").exists()
 
 
-def test_fit_measured_ranks_the_models_of_a_dataset(tmp_path, shared_data):
-    r = microcyl("fit-measured", "curet_07_velvet", "--models", "microcylinder,lambert",
-                 "--max-steps", "40", "--no-plots", "--data", shared_data, "-o", tmp_path)
-    assert r.returncode in (0, 1), r.stderr          # 1: not converged in 40 steps
-    assert "of 2 fits converged" in r.stdout
-    entry = json.loads((tmp_path / "measured.json").read_text())["datasets"]["curet_07_velvet"]
+def test_fit_measured_ranks_the_models_of_a_dataset(velvet_two_models, tmp_path):
+    out, stdout, _ = velvet_two_models      # conftest's run, shared with test_cli_verdict
+    assert "of 2 fits converged" in stdout
+    entry = json.loads((out / "measured.json").read_text())["datasets"]["curet_07_velvet"]
     models = entry["models"]
     assert set(models) == {"microcylinder", "lambert"}
     assert sorted(m["rank"] for m in models.values()) == [1, 2]
-    assert (tmp_path / "curet_07_velvet-lambert" / "results.json").is_file()
+    assert (out / "curet_07_velvet-lambert" / "results.json").is_file()
     lam = models["lambert"]
     # CUReT is grey and relative: the base fixed, the scale free, and said so
     assert any("relative table" in n for n in lam["identifiability"])
-    doc = json.loads((tmp_path / "curet_07_velvet-lambert" / "results.json").read_text())
+    doc = json.loads((out / "curet_07_velvet-lambert" / "results.json").read_text())
     assert set(doc["parameters"]) == {"scale", "log_noise"}
     worse = max(models.values(), key=lambda m: m["rank"])
     best = min(models.values(), key=lambda m: m["rank"])
     assert worse["d_elpd"] == pytest.approx(best["elpd"] - worse["elpd"], abs=1e-6)
     # the measured page: a table of the models under a verdict sentence
     from reports.report_measured import measured_page, read_measured
-    body, summary = measured_page(tmp_path / "page", read_measured(tmp_path))
+    body, summary = measured_page(tmp_path / "page", read_measured(out))
     text = str(body)
     assert "<h3>Models</h3>" in text and "best − this" in text
     assert ("is preferred over" in text) or ("cannot separate" in text) or (

@@ -30,12 +30,9 @@ def microcyl(*args):
 
 
 @pytest.fixture(scope="module")
-def measured(tmp_path_factory, shared_data):
-    out = tmp_path_factory.mktemp("verdict")
-    r = microcyl("fit-measured", VELVET, "--models", "microcylinder,lambert", "--max-steps",
-                 "60", "--no-plots", "--data", shared_data, "-o", out)
-    assert r.returncode in (0, 1), r.stderr          # 1: not converged in 60 steps
-    return out, r.stdout, r.stderr
+def measured(velvet_two_models):
+    """The short fit-measured run of conftest (shared with test_cli_fit_models)."""
+    return velvet_two_models
 
 
 def _results(out, folder):
@@ -59,7 +56,7 @@ def test_fit_measured_prints_each_fits_verdict_and_warnings_as_fit_does(measured
     assert len(_results(out, VELVET)["warnings"]) >= 3
 
 
-def test_measured_json_keeps_the_verdict_per_dataset_and_model(measured):
+def test_measured_json_keeps_the_verdict_per_dataset_and_model(measured, tmp_path):
     out, _, _ = measured
     entry = json.loads((out / "measured.json").read_text())["datasets"][VELVET]
     doc = _results(out, VELVET)
@@ -76,7 +73,7 @@ def test_measured_json_keeps_the_verdict_per_dataset_and_model(measured):
         assert m["k_threshold"] == pytest.approx(threshold)
         assert m["n_high_k"] == int((loo.pareto_k > threshold).sum())
     # the page's models table shows each fit's warnings and its Pareto k
-    body, _ = measured_page(out / "page", read_measured(out))
+    body, _ = measured_page(tmp_path / "page", read_measured(out))
     text = str(body)
     assert "Pareto k max (values above)" in text and "<th>warnings</th>" in text
     mk = entry["models"]["microcylinder"]
@@ -93,7 +90,7 @@ def test_measured_json_keeps_the_verdict_per_dataset_and_model(measured):
     assert "<td>-</td>" in rows and "&gt; 0.62" not in rows
 
 
-def test_compare_has_adequacy_and_the_words_of_the_measured_page(measured):
+def test_compare_has_adequacy_and_the_words_of_the_measured_page(measured, tmp_path):
     out, _, _ = measured
     folders = [out / VELVET, out / f"{VELVET}-lambert"]
     r = microcyl("compare", *folders, "--json")
@@ -122,7 +119,7 @@ def test_compare_has_adequacy_and_the_words_of_the_measured_page(measured):
     first = min(entry, key=lambda m: entry[m]["rank"])
     second = max(entry, key=lambda m: entry[m]["rank"])
     assert first == best["model"] and second == other["model"]
-    body, _ = measured_page(out / "page2", read_measured(out))
+    body, _ = measured_page(tmp_path / "page2", read_measured(out))
     page_words = gap_sentence(first, second, entry[second]["d_elpd"], entry[second]["d_se"],
                               block_se=entry[second]["d_se_block"],
                               lag1=entry[second]["d_lag1"])
@@ -153,7 +150,7 @@ def test_plot_table_of_an_inadequate_fit_says_so(measured, tmp_path, shared_data
                  "-o", tmp_path / "t.png")
     assert r.returncode == 0, r.stderr
     kinds = sorted({w["kind"] for w in _results(out, VELVET)["warnings"]})
-    assert (f"NOT ADEQUATE (the model does not describe the table to within its noise)"
+    assert ("NOT ADEQUATE (the model does not describe the table to within its noise)"
             in r.stdout)
     assert f"{len(kinds)} kinds of warning: {', '.join(kinds)}" in r.stdout
     assert (tmp_path / "t.png").stat().st_size > 20_000

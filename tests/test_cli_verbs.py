@@ -8,6 +8,7 @@ import importlib
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -56,3 +57,17 @@ def test_a_short_verb_does_not_load_the_fit_the_renderers_or_colour_science(tmp_
     assert out.returncode == 0, out.stderr
     status, mods = json.loads(out.stdout.strip().splitlines()[-1])
     assert status == 0 and mods == [], mods
+
+
+def test_the_report_verb_loads_no_sampler():
+    """``microcyl report`` reads a batch's summary (``analysis.batch.summary``) but fits
+    nothing: importing its modules and the batch package's summary loads neither emcee nor
+    the fit's driver (``analysis.batch`` re-exports its names on first use)."""
+    probe = ("import sys, json; import reports.cli.model, reports.report_batch, "
+             "analysis.batch.summary\n"
+             "print(json.dumps([m for m in ('emcee', 'analysis.fit.driver', "
+             "'analysis.batch.engine') if m in sys.modules]))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         cwd=Path(__file__).resolve().parents[1], timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == []

@@ -23,10 +23,17 @@ resumes from the checkpoint it left. Workers must see the same file system as th
 (trivially so on one machine; a shared folder on a cluster).
 """
 
-from analysis.batch.engine import BatchInterrupted, run_batch
-from analysis.batch.jobs import BatchJob, jobs_from_inputs, parse_samples, read_job_table
-from analysis.batch.summary import SUMMARY_CSV, SUMMARY_JSON, BatchSummary
-from analysis.batch.worker import run_job
+from analysis.lazy import lazy_getattr
 
-__all__ = ["BatchJob", "jobs_from_inputs", "parse_samples", "read_job_table", "run_job", "run_batch",
-           "BatchSummary", "BatchInterrupted", "SUMMARY_CSV", "SUMMARY_JSON"]
+#: Names loaded on first use, with their modules (:mod:`analysis.lazy`): the engine and the
+#: jobs load the fit and with it emcee and scipy.stats (about 0.5 s), which a reader of a
+#: batch's summary (``report --batch``, ``report --fabric``) does not need.
+_LAZY = {name: f"analysis.batch.{module}" for module, names in {
+    "engine": ("BatchInterrupted", "run_batch"),
+    "jobs": ("BatchJob", "jobs_from_inputs", "parse_samples", "read_job_table"),
+    "summary": ("SUMMARY_CSV", "SUMMARY_JSON", "BatchSummary"), "worker": ("run_job",),
+}.items() for name in names}
+__getattr__ = lazy_getattr(__name__, _LAZY, globals())
+
+__all__ = ["BatchJob", "jobs_from_inputs", "parse_samples", "read_job_table", "run_job",
+           "run_batch", "BatchSummary", "BatchInterrupted", "SUMMARY_CSV", "SUMMARY_JSON"]

@@ -59,12 +59,13 @@ def test_a_short_verb_does_not_load_the_fit_the_renderers_or_colour_science(tmp_
     assert status == 0 and mods == [], mods
 
 
-def test_the_report_verb_loads_no_sampler():
-    """``microcyl report`` reads a batch's summary (``analysis.batch.summary``) but fits
-    nothing: importing its modules and the batch package's summary loads neither emcee nor
-    the fit's driver (``analysis.batch`` re-exports its names on first use)."""
+def test_the_report_and_export_verbs_load_no_sampler():
+    """``microcyl report`` reads a batch's summary (``analysis.batch.summary``) and
+    ``microcyl export`` a fit's posterior draws (``analysis.planning.draws``), but neither
+    fits nor plans: importing their modules loads neither emcee nor the fit's driver
+    (``analysis.batch`` and ``analysis.planning`` re-export their names on first use)."""
     probe = ("import sys, json; import reports.cli.model, reports.report_batch, "
-             "analysis.batch.summary\n"
+             "analysis.batch.summary, reports.cli.export, analysis.export.workflow\n"
              "print(json.dumps([m for m in ('emcee', 'analysis.fit.driver', "
              "'analysis.batch.engine') if m in sys.modules]))")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,

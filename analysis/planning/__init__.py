@@ -8,9 +8,16 @@ choose from, uniform designs), draws (the local prior or a fit's posterior), inf
 and :class:`Plan`), workflow (what ``microcyl plan`` does: the plan written as a pairs CSV).
 """
 
-from analysis.planning.candidates import DEFAULT_CANDIDATES, candidates, uniform_pairs
-from analysis.planning.core import DEFAULT_DRAWS, MAX_BUDGET, Plan, plan
-from analysis.planning.draws import LOCAL_SD
+from analysis.lazy import lazy_getattr
+
+#: Names loaded on first use, with their modules (:mod:`analysis.lazy`): the planner loads the
+#: fit (emcee, scipy.stats; about 0.5 s), which ``microcyl export`` does not need when it
+#: reads :mod:`~analysis.planning.draws` for a fit folder's posterior.
+_LAZY = {name: f"analysis.planning.{module}" for module, names in {
+    "candidates": ("DEFAULT_CANDIDATES", "candidates", "uniform_pairs"),
+    "core": ("DEFAULT_DRAWS", "MAX_BUDGET", "Plan", "plan"), "draws": ("LOCAL_SD",),
+}.items() for name in names}
+__getattr__ = lazy_getattr(__name__, _LAZY, globals())
 
 __all__ = ["plan", "Plan", "candidates", "uniform_pairs", "DEFAULT_CANDIDATES",
            "DEFAULT_DRAWS", "MAX_BUDGET", "LOCAL_SD"]

@@ -30,7 +30,8 @@ shrink.
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import log_ndtr, ndtri_exp
+
+from brdf.lazy import special
 
 __all__ = ["theta_range", "azimuth_window", "azimuth_mass", "azimuth_draw", "truncnorm_logmass",
            "truncnorm_draw"]
@@ -169,8 +170,8 @@ def _oriented(za, zb):
     tail's: (flip, a, b, log Phi(b), Phi(a) / Phi(b))."""
     flip = za + zb > 0.0
     a, b = np.where(flip, -zb, za), np.where(flip, -za, zb)
-    lb = log_ndtr(b)
-    return flip, a, b, lb, np.exp(log_ndtr(a) - lb)
+    lb = special.log_ndtr(b)
+    return flip, a, b, lb, np.exp(special.log_ndtr(a) - lb)
 
 
 def truncnorm_logmass(mu, sigma, lo, hi) -> np.ndarray:
@@ -202,5 +203,5 @@ def truncnorm_draw(mu, sigma, lo, hi, v) -> np.ndarray:
     (True, 30.0231)
     """
     flip, a, b, lb, r = _oriented((lo - mu) / sigma, (hi - mu) / sigma)
-    z = np.clip(ndtri_exp(lb + np.log(r + v * (1.0 - r))), a, b)
+    z = np.clip(special.ndtri_exp(lb + np.log(r + v * (1.0 - r))), a, b)
     return np.clip(mu + sigma * np.where(flip, -z, z), lo, hi)

@@ -36,9 +36,9 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from analysis.export.grid import DEFAULT_GRID, HemisphereGrid
+from analysis.lazy import optimize
 from brdf import model_class
 
 __all__ = ["Projection", "project", "project_draws", "target_model", "TARGET_MODELS",
@@ -149,9 +149,9 @@ class _Problem:
     def solve(self, starts) -> tuple[np.ndarray, float]:
         best = None
         for x0 in starts:
-            res = least_squares(self.fun, np.clip(x0, self.lo, self.hi), jac=self.jac,
-                                bounds=(self.lo, self.hi), method="trf", x_scale=1.0,
-                                max_nfev=200)
+            res = optimize.least_squares(self.fun, np.clip(x0, self.lo, self.hi),
+                                         jac=self.jac, bounds=(self.lo, self.hi),
+                                         method="trf", x_scale=1.0, max_nfev=200)
             if best is None or res.cost < best.cost:
                 best = res
         return best.x, float(np.sqrt(2.0 * best.cost))

@@ -13,9 +13,8 @@ r"""Convergence diagnostics for several independent emcee ensembles.
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft
 
-from analysis.lazy import autocorr
+from analysis.lazy import autocorr, fft
 
 __all__ = ["autocorr_time", "split_rhat", "ess", "interval_summary"]
 
@@ -54,16 +53,16 @@ def autocorr_time(chain) -> np.ndarray:
     """
     x = np.asarray(chain, dtype=np.float64)
     n, w, d = x.shape
-    size = scipy.fft.next_fast_len(2 * n - 1, real=True)   # >= 2n - 1: no wrap-around
+    size = fft.next_fast_len(2 * n - 1, real=True)   # >= 2n - 1: no wrap-around
     series = np.ascontiguousarray((x - x.mean(axis=0)).transpose(1, 2, 0))    # (w, d, n)
     f = np.zeros((d, n))                      # sum over walkers of each normalized acf
     step = max(1, _ACF_SERIES // max(d, 1))
     with np.errstate(invalid="ignore", divide="ignore"):
         for k0 in range(0, w, step):
-            spec = scipy.fft.rfft(series[k0:k0 + step], n=size, axis=-1)
+            spec = fft.rfft(series[k0:k0 + step], n=size, axis=-1)
             power = np.square(spec.real)          # |F|^2 (a complex product is 10x slower)
             power += np.square(spec.imag)
-            acf = scipy.fft.irfft(power, n=size, axis=-1)[..., :n]
+            acf = fft.irfft(power, n=size, axis=-1)[..., :n]
             acf /= acf[..., :1]
             f += acf.sum(axis=0)
         taus = (2.0 * np.cumsum(f / w, axis=-1) - 1.0).T                     # (n, d)

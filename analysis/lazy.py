@@ -28,9 +28,10 @@ from __future__ import annotations
 import importlib
 from typing import Callable, Mapping
 
-from brdf.lazy import lazy_module
+from brdf.lazy import lazy_module, special
 
-__all__ = ["lazy_module", "lazy_getattr", "stats", "qmc", "autocorr", "optimize"]
+__all__ = ["lazy_module", "lazy_getattr", "stats", "qmc", "autocorr", "optimize", "fft",
+           "special"]
 
 
 def lazy_getattr(package: str, names: Mapping[str, str], namespace: dict) -> Callable:
@@ -58,3 +59,8 @@ autocorr = lazy_module("emcee.autocorr")
 #: scipy.optimize (0.11 s): the export's projection (least squares); every verb that reads a
 #: fabric source imports :mod:`analysis.export`'s registry.
 optimize = lazy_module("scipy.optimize")
+#: scipy.fft (0.12 s, its array-API layer): the autocorrelation times of a fit's checks
+#: (:func:`analysis.diagnostics.autocorr_time`); ``analysis`` imports the diagnostics.
+fft = lazy_module("scipy.fft")
+# ``special`` is brdf.lazy's scipy.special, imported above: also the internal coordinates'
+# logistic function (analysis.param), which a verb that does not fit never evaluates.

@@ -7,7 +7,8 @@ import dataclasses
 import math
 
 import numpy as np
-import scipy.special
+
+from analysis.lazy import special
 
 __all__ = ["Param", "INTERNAL_LIMIT", "INTERNAL_WIDTH"]
 
@@ -82,7 +83,7 @@ class Param:
     def to_natural(self, u):
         """Internal coordinate -> natural value (within the bounds)."""
         u = np.asarray(u, dtype=np.float64)
-        q = scipy.special.expit(u)
+        q = special.expit(u)
         g0, g1 = self._g(self.lo), self._g(self.hi)
         v = g0 + q * (g1 - g0)
         x = np.exp(v) if self.is_log else v

@@ -23,7 +23,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parents[1]
 VERBS = (["--help"], ["sanity", "velvet"], ["reciprocity", "velvet"],
          ["eval", "velvet", "--wi", "30,0", "--wo", "30,180"],
-         ["plot", "lobes", "velvet", "-o", "{tmp}/lobes.png"])
+         ["plot", "lobes", "velvet", "-o", "{tmp}/lobes.png"],
+         ["export", "velvet", "-o", "{tmp}/velvet.json"])
 
 
 def cpu_of(tree: Path, argv: list[str], tmp: str) -> float:

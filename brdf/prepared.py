@@ -67,14 +67,12 @@ class Prepared:
         self._ok = ~(bad | below)
         wi_ok, wo_ok = wi[self._ok], wo[self._ok]
         self._pairs = (wi_ok, wo_ok)
-        # the Dr.Jit kernel (brdf.jit) shades (float64, float32), but for pairs with a nearly
-        # zero component (``_exact``, NumPy's: brdf.jit's notes); NumPy's geometry on first use
+        # the Dr.Jit kernel (brdf.jit), where it is the backend now, shades (float64,
+        # float32) a batch worth a call, prepared on the first (:meth:`_uses_jit`), but for
+        # pairs with a nearly zero component (``_exact``, NumPy's: brdf.jit's notes);
+        # NumPy's geometry on first use
+        self._drjit = jit.backend() == "drjit"
         self._jit, self._exact, self._jit_all = None, None, None
-        if jit.use_jit(plan, wi_ok.shape[0]):
-            exact = jit.tiny_pairs(wi_ok, wo_ok)
-            self._jit = jit.compiled().PreparedJit(plan, wi_ok[~exact], wo_ok[~exact])
-            self._exact = exact if exact.any() else None
-            self._jit_all = None if exact.any() else self._jit
         self._geoms: list[ThreadGeometry] | None = None
         self._geoms32: list[ThreadGeometry] | None = None
         self._scratch = Scratch()
@@ -116,7 +114,7 @@ class Prepared:
         par, batch = self._params(eta, albedo, kd, gamma_s, gamma_v, area)
         nb = par.eta.shape[0]
         out = (np.empty if self._ok.all() else np.zeros)((nb, self._ok.size, 3))
-        if self._jit is not None:
+        if self._uses_jit(nb):
             vals = self._jit_eval(par, dtype)
             if self._ok.all():
                 out = vals                  # a new array of every pair
@@ -195,15 +193,32 @@ class Prepared:
         """Whether :meth:`eval_rotated` of ``nb`` sets runs Dr.Jit's fused kernel: the
         backend is drjit, the sets' (pair, sample) elements make a call worth it, and no
         pair has a nearly zero component (:func:`brdf.jit.tiny_pairs`)."""
-        if not self._zi.size or self._exact is not None:
+        if not self._zi.size or not jit.use_jit(self.plan, nb * self._zi.size):
             return False
-        if not jit.use_jit(self.plan, nb * self._zi.size):
+        if self._jit is not None:
+            return self._exact is None
+        return not jit.tiny_pairs(*self._pairs).any()
+
+    def _uses_jit(self, nb: int) -> bool:
+        """Whether a batch of ``nb`` sets is shaded by Dr.Jit: the backend was drjit when
+        this was prepared, and the batch's (set, pair, sample) elements make a call worth it
+        (:func:`brdf.jit.worth_a_call`: a fit's batches of tens of sets of a small table do,
+        where one set would not). The kernel's preparation of the pairs is made on the
+        first such batch."""
+        if not (self._drjit and jit.worth_a_call(self.plan, nb * self._zi.size)):
             return False
-        return self._jit is not None or not jit.tiny_pairs(*self._pairs).any()
+        if self._jit is None:
+            wi_ok, wo_ok = self._pairs
+            exact = jit.tiny_pairs(wi_ok, wo_ok)
+            self._jit = jit.compiled().PreparedJit(self.plan, wi_ok[~exact], wo_ok[~exact])
+            self._exact = exact if exact.any() else None
+            if self._jit_all is None and self._exact is None:
+                self._jit_all = self._jit
+        return True
 
     def _eval_par(self, par: ShadeParams, dtype) -> np.ndarray:
         """f_r (nb, pairs above the horizon, 3) of the checked batch ``par``."""
-        if self._jit is not None:
+        if self._uses_jit(par.eta.shape[0]):
             return self._jit_eval(par, dtype)
         return self._numpy_eval(par, dtype, None).copy()
 
@@ -241,8 +256,7 @@ class Prepared:
         f, grads = np.zeros((nb, self._ok.size, 3)), {}
         if self._zi.size:
             gvals = self._jit_all.eval_and_grad(par)[1]
-            vals = (self._jit_eval(par, np.float64) if self._jit is not None   # eval's f_r
-                    else self._numpy_eval(par, np.float64, None).copy())
+            vals = self._eval_par(par, np.float64)                   # eval's f_r
         else:
             vals, gvals = f[:, :0], {k: np.zeros((nb, 0, 3, 2)) for k in GRAD_PARAMS}
         f[:, self._ok] = vals

@@ -140,11 +140,11 @@ def test_batched_eval_agrees_with_numpy(monkeypatch, pairs, preset, options):
     kw = _batch(fab, 5, np.random.default_rng(len(preset) + len(options)))
     preps = {b: with_backend(monkeypatch, b, lambda: fab.prepare(wi, wo))
              for b in ("numpy", "drjit")}
-    assert preps["drjit"]._jit is not None and preps["numpy"]._jit is None
     skip = ill_conditioned(wi, wo)
     for args in (kw, {}):
         ref = preps["numpy"].eval(**args)
         assert_agree(preps["drjit"].eval(**args), ref, skip, axis=ref.ndim - 2)
+    assert preps["drjit"]._jit is not None and preps["numpy"]._jit is None
     assert_agree(preps["drjit"].eval(), with_backend(monkeypatch, "numpy",
                                                       lambda: fab.eval(wi, wo)), skip)
 
@@ -247,9 +247,10 @@ def _central(prep, kw, name, index, h, forward=False):
 
 @needs_drjit
 def test_small_calls_stay_on_numpy(monkeypatch):
-    """Under the drjit backend, calls of fewer than MIN_ELEMENTS (pair, sample) elements
-    run the NumPy kernel (Dr.Jit's tracing would cost more): a Prepared of 10 velvet pairs
-    has no Dr.Jit half, one of 1,000 has, and eval_and_grad works on either."""
+    """Under the drjit backend, calls of fewer than MIN_ELEMENTS (set, pair, sample)
+    elements run the NumPy kernel (Dr.Jit's tracing would cost more): one set of 10 velvet
+    pairs makes no Dr.Jit half, one of 1,000 does, and so does a batch of 100 sets of the 10
+    pairs (a fit's); eval_and_grad works on either."""
     monkeypatch.setattr(jit, "MIN_ELEMENTS", 1 << 14)
     monkeypatch.setenv(jit.BACKEND_ENV, "drjit")
     plan = brdf.fabric("velvet").plan                  # 32 + 32 distinct samples
@@ -257,10 +258,16 @@ def test_small_calls_stay_on_numpy(monkeypatch):
     for n, on in ((10, False), (1000, True)):
         wi, wo = random_pairs(n, np.random.default_rng(n))
         prep = brdf.fabric("velvet").prepare(wi, wo)
-        assert (prep._jit is not None) is on
         f, g = prep.eval_and_grad(eta=[[1.4, 1.5]])
         np.testing.assert_array_equal(f, prep.eval(eta=[[1.4, 1.5]]))
         assert np.abs(g["eta"]).max() > 0
+        assert (prep._jit is not None) is on
+    etas = np.linspace(1.3, 1.6, 200).reshape(100, 2)
+    small = [p[:10] for p in (wi, wo)]
+    prep = with_backend(monkeypatch, "drjit", lambda: brdf.fabric("velvet").prepare(*small))
+    ref = with_backend(monkeypatch, "numpy", lambda: brdf.fabric("velvet").prepare(*small))
+    assert_agree(prep.eval(eta=etas), ref.eval(eta=etas), np.zeros(10, bool), axis=1)
+    assert prep._jit is not None and ref._jit is None   # 100 sets x 10 pairs x 64 samples
 
 
 def test_backend_choice(monkeypatch):
@@ -389,10 +396,10 @@ def test_threads_sharing_a_prepared(monkeypatch):
     fab = brdf.fabric("velvet")
     wi, wo = random_pairs(200, np.random.default_rng(12))
     prep = fab.prepare(wi, wo)
-    assert prep._jit is not None
     batches = [_batch(fab, 3, np.random.default_rng(s)) for s in range(8)]
     dtypes = [np.float64, np.float32] * 4
     serial = [prep.eval(**kw, dtype=dt) for kw, dt in zip(batches, dtypes)]
+    assert prep._jit is not None
     with concurrent.futures.ThreadPoolExecutor(4) as ex:
         got = list(ex.map(lambda a: prep.eval(**a[0], dtype=a[1]), zip(batches, dtypes)))
     for g, s in zip(got, serial):
@@ -434,7 +441,8 @@ def test_rotated_batches_agree_with_numpy(monkeypatch, pairs, preset, options):
     skip = ill_conditioned(wi, wo)
     for rows in (plain, np.ones(len(wi), bool)):      # the fused kernel, then per set
         prep = with_backend(monkeypatch, "drjit", lambda: fab.prepare(wi[rows], wo[rows]))
-        assert (prep._exact is None) == (rows is plain)         # which path runs
+        fused = with_backend(monkeypatch, "drjit", lambda: prep._fused(len(rot)))
+        assert fused == (rows is plain)                          # which path runs
         got = with_backend(monkeypatch, "drjit", lambda: prep.eval_rotated(rot, **kw))
         for b, deg in enumerate(rot):
             turned = fab.replace(rotation=np.radians(deg))

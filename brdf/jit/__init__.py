@@ -33,8 +33,8 @@ import warnings
 import numpy as np
 
 __all__ = ["BackendWarning", "backend", "available", "compiled", "tiny_pairs", "use_jit",
-           "limit_threads", "thread_limit", "share_cores", "MIN_ELEMENTS", "BACKENDS",
-           "BACKEND_ENV", "MIN_LLVM", "TINY_COMPONENT"]
+           "worth_a_call", "limit_threads", "thread_limit", "share_cores", "MIN_ELEMENTS",
+           "BACKENDS", "BACKEND_ENV", "MIN_LLVM", "TINY_COMPONENT"]
 
 #: The kernels ``MICROCYL_BACKEND`` chooses between.
 BACKENDS = ("numpy", "drjit")
@@ -189,8 +189,19 @@ def use_jit(plan, pairs: int) -> bool:
     False
     >>> del os.environ[BACKEND_ENV]
     """
-    if backend() != "drjit":
-        return False
+    return backend() == "drjit" and worth_a_call(plan, pairs)
+
+
+def worth_a_call(plan, pairs: int) -> bool:
+    """Whether ``pairs`` pairs of ``plan`` (of one parameter set, or a batch's sets times its
+    pairs) make the :data:`MIN_ELEMENTS` (pair, sample) elements that pay for a Dr.Jit call
+    (its tracing, about 0.5 ms), whichever backend is chosen.
+
+    >>> import brdf
+    >>> plan = brdf.fabric("velvet").plan              # 32 + 32 distinct samples
+    >>> worth_a_call(plan, 255), worth_a_call(plan, 256)
+    (False, True)
+    """
     return pairs * sum(t.ca.size for t in plan.threads) >= MIN_ELEMENTS
 
 

@@ -256,7 +256,7 @@ def read_config(path) -> dict:
         if not (isinstance(tie, list) and len(tie) == 2 and tie[0] in params
                 and tie[1] in ("equal", "complement") and target in params):
             raise f.error(f"config.spec.ties.{target}", "[SOURCE, \"equal\" or "
-                          f"\"complement\"] with SOURCE and the target among the parameters",
+                          "\"complement\"] with SOURCE and the target among the parameters",
                           tie)
     for key in ("periods", "folds"):            # name -> a positive angle or a fold's value
         for name, v in f.mapping(spec, key, "config.spec", default={}).items():

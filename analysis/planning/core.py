@@ -17,8 +17,6 @@ different emphasis. They rank designs well; the fit's intervals are the final wo
 from __future__ import annotations
 
 import dataclasses
-import math
-from pathlib import Path
 
 import numpy as np
 

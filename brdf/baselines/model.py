@@ -21,7 +21,6 @@ no sheen). Its density is exact: p cos(theta_i) / pi + (1 - p) / (2 pi).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import ClassVar, Mapping
 

@@ -130,7 +130,9 @@ def test_draws_stay_above_the_horizon(name, variant, record_property):
     fab = brdf.fabric(name, **variant)
     th, ph = np.meshgrid(np.radians(SWEEP_THETA), np.radians(SWEEP_PHI), indexing="ij")
     wo = brdf.directions.from_angles(th.ravel(), ph.ravel())            # (V, 3)
-    u = np.random.default_rng(_seed("below", name, variant)).random((3000, wo.shape[0], 2))
+    # 500 draws a viewer measure a share near the 5% bound to +-1% (binomial sd); the
+    # truncated lobes lose none (0 of 3,000 at every viewer of every case, 2026-12-07)
+    u = np.random.default_rng(_seed("below", name, variant)).random((500, wo.shape[0], 2))
     wi, weight, p = fab.sample(wo, u)
     below = np.mean(wi[..., 2] <= 0.0, axis=0)
     record_property("worst_below", float(below.max()))

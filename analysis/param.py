@@ -80,11 +80,21 @@ class Param:
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where((q >= 0) & (q <= 1), np.log(q) - np.log1p(-q), np.nan)
 
+    @property
+    def scale_bounds(self) -> tuple[float, float]:
+        """The bounds on the scale the internal coordinate maps linearly onto: (lo, hi), or
+        their logarithms for a log-uniform prior (what :meth:`to_natural` interpolates).
+
+        >>> Param("g", 1.0, 100.0, "log-uniform", "deg", 10.0).scale_bounds
+        (0.0, 4.605170185988092)
+        """
+        return float(self._g(self.lo)), float(self._g(self.hi))
+
     def to_natural(self, u):
         """Internal coordinate -> natural value (within the bounds)."""
         u = np.asarray(u, dtype=np.float64)
         q = special.expit(u)
-        g0, g1 = self._g(self.lo), self._g(self.hi)
+        g0, g1 = self.scale_bounds
         v = g0 + q * (g1 - g0)
         x = np.exp(v) if self.is_log else v
         return np.clip(x, self.lo, self.hi)

@@ -30,6 +30,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from analysis.families import ModelFamily, family
+from analysis.lazy import special
 from analysis.param import INTERNAL_LIMIT, INTERNAL_WIDTH, Param
 from analysis.paramnames import (BASE_PARAMS, DEFAULT_FREE, DEFAULT_TIES, MODEL_PARAM_NAMES,
                                  PARAM_NAMES, checked_bounds, checked_defaults,
@@ -139,6 +140,14 @@ class ParamSpec:
         self._circles = {n: (self.params[n].lo, 0.5 * (self.params[n].lo + self.params[n].hi),
                              self.period(n)) for n in self.free if self.period(n) is not None}
         self._circular = np.array([n in self._circles for n in self.free], dtype=bool)
+        # each free parameter's map to its natural value as arrays, so that to_natural (in
+        # every evaluation of a fit) runs once over the columns, not a call a parameter
+        free_params = [self.params[n] for n in self.free]
+        scale = np.array([p.scale_bounds for p in free_params])
+        self._g0, self._span = scale[:, 0], scale[:, 1] - scale[:, 0]
+        self._log = np.array([p.is_log for p in free_params], dtype=bool)
+        self._lo = np.array([p.lo for p in free_params])
+        self._hi = np.array([p.hi for p in free_params])
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -258,14 +267,13 @@ class ParamSpec:
         [[-83.75]]
         """
         theta = np.asarray(theta, dtype=np.float64)
-        out = np.empty_like(theta)
-        for i, n in enumerate(self.free):
-            circle = self._circles.get(n)
-            if circle is None:
-                out[..., i] = self.params[n].to_natural(theta[..., i])
-            else:
-                lo, mid, per = circle
-                out[..., i] = lo + np.mod(mid - lo + theta[..., i] * per / INTERNAL_WIDTH, per)
+        v = self._g0 + special.expit(theta) * self._span    # Param.to_natural, all columns
+        if self._log.any():
+            v[..., self._log] = np.exp(v[..., self._log])
+        out = np.clip(v, self._lo, self._hi)
+        for n, (lo, mid, per) in self._circles.items():
+            i = self._index[n]
+            out[..., i] = lo + np.mod(mid - lo + theta[..., i] * per / INTERNAL_WIDTH, per)
         return out
 
     def to_internal(self, x) -> np.ndarray:

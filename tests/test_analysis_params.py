@@ -147,3 +147,24 @@ def test_from_toml_checks_every_key(tmp_path):
         with pytest.raises(ValueError, match=key) as err:
             spec(text)
         assert "s.toml" in str(err.value)
+
+
+def test_to_natural_is_each_parameters_own_map_column_by_column():
+    """ParamSpec.to_natural (one pass over all columns) gives, bit for bit, what each free
+    parameter's Param.to_natural gives its column (log, uniform and circular ones, a NaN
+    and an infinity), for a batch and for one vector."""
+    spec = ParamSpec(["gamma_s1", "kd1", "eta1", "rotation", "albedo1_g"],
+                     periods={"rotation": 180.0})
+    assert spec.circular.tolist() == [False, False, False, True, False]
+    assert spec.params["gamma_s1"].is_log and not spec.params["kd1"].is_log
+    rng = np.random.default_rng(5)
+    theta = rng.normal(size=(40, spec.ndim)) * np.array([3.0, 30.0, 0.5, 9.0, 800.0])
+    theta[0, 1], theta[1, 4] = np.nan, np.inf
+    got = spec.to_natural(theta)
+    for i, name in enumerate(spec.free):
+        if name == "rotation":          # wrapped into [-90, 90): checked by its own test
+            assert np.all((got[:, i] >= -90.0) & (got[:, i] < 90.0))
+            continue
+        want = spec.params[name].to_natural(theta[:, i])
+        assert np.array_equal(got[:, i], want, equal_nan=True), name
+    assert np.array_equal(spec.to_natural(theta[3]), got[3])

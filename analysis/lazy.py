@@ -7,7 +7,8 @@ needs.
   attribute (``stats.norm``); each costly library used this way is named once, here (brdf's
   own in :mod:`brdf.lazy`).
 - :func:`lazy_getattr`: a package's ``__getattr__`` (PEP 562) importing each re-exported name
-  from its module on first use (``analysis``, ``analysis.fit``).
+  from its module on first use (``analysis``, ``analysis.fit``, ``analysis.batch``,
+  ``analysis.planning``).
 
 Examples
 --------

@@ -191,9 +191,11 @@ class Prepared:
 
     def _fused(self, nb: int) -> bool:
         """Whether :meth:`eval_rotated` of ``nb`` sets runs Dr.Jit's fused kernel: the
-        backend is drjit, the sets' (pair, sample) elements make a call worth it, and no
+        backend was drjit when this was prepared (as for :meth:`_uses_jit`), the sets'
+        (pair, sample) elements make a call worth it, and no
         pair has a nearly zero component (:func:`brdf.jit.tiny_pairs`)."""
-        if not self._zi.size or not jit.use_jit(self.plan, nb * self._zi.size):
+        if not (self._zi.size and self._drjit
+                and jit.worth_a_call(self.plan, nb * self._zi.size)):
             return False
         if self._jit is not None:
             return self._exact is None

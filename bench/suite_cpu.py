@@ -11,6 +11,9 @@ then summarize (the sum, the share of subprocesses, the slowest tests and files)
 
     .venv/bin/python bench/suite_cpu.py /tmp/cpu.jsonl [TOP]
 
+The suite forks its CLI runs from a server (``tests/_forkcli.py``): they are not the test's
+children, so record with ``MICROCYL_TEST_SPAWN=1`` in the environment to count their CPU.
+
 Each line of the file is ``{"id", "self", "child", "wall"}`` in seconds; ``__collection__``
 is a process's CPU up to the end of collection (imports of the test modules and doctests).
 """

@@ -11,6 +11,13 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
+import _forkcli
+
+#: ``python -m reports ...`` runs fork from a server that has imported the toolkit once per
+#: worker (``tests/_forkcli.py``); ``MICROCYL_TEST_SPAWN=1`` starts each in a new interpreter.
+if not os.environ.get("MICROCYL_TEST_SPAWN"):
+    _forkcli.install()
+
 #: Property tests take their time on a loaded machine (`make test` runs one worker per core,
 #: beside the fits' and renders' own processes): no per-example deadline by default.
 settings.register_profile("microcyl", deadline=None)

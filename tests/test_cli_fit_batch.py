@@ -154,9 +154,11 @@ def test_a_second_batch_into_the_same_folder_is_refused_at_once(tables, tmp_path
             f"microcyl fit-batch: error: another batch is running in {out} (pid "
             f"{first.pid}); wait for it to end or use another output")
         assert first.poll() is None                    # the first one is untouched
+        _wait_for(out / "silk0" / "checkpoint.h5", timeout=120)    # and fits
     finally:
         first.send_signal(signal.SIGINT)
-        first.communicate(timeout=120)
+        _, err = first.communicate(timeout=120)
+    assert first.returncode == 130, err
     assert not lock.exists()
 
 

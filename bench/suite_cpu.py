@@ -11,8 +11,8 @@ then summarize (the sum, the share of subprocesses, the slowest tests and files)
 
     .venv/bin/python bench/suite_cpu.py /tmp/cpu.jsonl [TOP]
 
-The suite forks its CLI runs from a server (``tests/_forkcli.py``): they are not the test's
-children, so record with ``MICROCYL_TEST_SPAWN=1`` in the environment to count their CPU.
+The suite forks its CLI runs from a server (``tests/_forkcli.py``): their CPU comes from the
+server (``_forkcli.CPU_OF_RUNS``) and counts as the test's subprocesses'.
 
 Each line of the file is ``{"id", "self", "child", "wall"}`` in seconds; ``__collection__``
 is a process's CPU up to the end of collection (imports of the test modules and doctests).
@@ -35,7 +35,8 @@ _OUT = os.environ.get("MICROCYL_SUITE_CPU", "suite_cpu.jsonl")
 def _cpu() -> tuple[float, float]:
     own = resource.getrusage(resource.RUSAGE_SELF)
     kids = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime, kids.ru_utime + kids.ru_stime
+    forked = getattr(sys.modules.get("_forkcli"), "CPU_OF_RUNS", 0.0)
+    return own.ru_utime + own.ru_stime, kids.ru_utime + kids.ru_stime + forked
 
 
 def _record(**row) -> None:

@@ -45,11 +45,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 #: What the server imports before it forks: what the verbs import between them (the fit's
-#: sampler, diagnostics and plots, the reports, the batch engine's client side).
+#: sampler, diagnostics and plots, the reports, the batch engine's client side; not Dr.Jit
+#: or Mitsuba, whose thread pools a fork would lose).
 PRELOAD = (
     "numpy", "scipy.stats", "scipy.optimize", "scipy.special", "scipy.fft",
     "scipy.interpolate", "matplotlib", "matplotlib.pyplot", "matplotlib.figure",
-    "emcee", "h5py", "tqdm", "jinja2",
+    "emcee", "h5py", "tqdm", "jinja2", "distributed",
     "brdf", "gonio", "analysis", "analysis.fit", "analysis.batch", "analysis.planning",
     "reports", "reports.cli", *(m for m in (
         "reports.cli.model", "reports.cli.measure", "reports.cli.plan", "reports.cli.tables",
@@ -128,7 +129,7 @@ def _receive(conn: socket.socket) -> tuple[dict, list[int]]:
 
 def _wait_for(conn: socket.socket, request: dict, fds: list[int]) -> None:
     """In the waiter (a fork of the server): fork the run, send its pid, wait for it, send
-    its wait status, exit."""
+    its wait status and CPU seconds (its own and its waited-for children's), exit."""
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     pid = os.fork()
     if pid == 0:
@@ -138,8 +139,8 @@ def _wait_for(conn: socket.socket, request: dict, fds: list[int]) -> None:
         os.close(fd)
     try:
         conn.sendall(f"{pid}\n".encode())
-        _, status = os.waitpid(pid, 0)
-        conn.sendall(f"{status}\n".encode())
+        _, status, usage = os.wait4(pid, 0)
+        conn.sendall(f"{status} {usage.ru_utime + usage.ru_stime}\n".encode())
     finally:
         os._exit(0)
 
@@ -276,6 +277,9 @@ class _Server:
 
 
 _SERVER = _Server()
+#: CPU seconds of this process's forked runs that have ended (with their children's), for
+#: ``bench/suite_cpu.py``: they are the server's children, not this process's.
+CPU_OF_RUNS = 0.0
 SPAWN = subprocess.Popen
 
 
@@ -357,9 +361,13 @@ class Popen(subprocess.Popen):
         """The run's wait status from its waiter, or None if it runs on (``block`` False)."""
         if not block and not select.select([self._conn], [], [], 0)[0]:
             return None
-        line = _line(self._conn)
+        global CPU_OF_RUNS
+        line = _line(self._conn).split()
         self._conn.close()
-        return int(line) if line else 0
+        if not line:
+            return 0
+        CPU_OF_RUNS += float(line[1])
+        return int(line[0])
 
     def _internal_poll(self, _deadstate=None, **_):
         if self._conn is None:

@@ -132,6 +132,28 @@ def test_ctrl_c_stops_the_batch_and_the_same_command_resumes(tables, tmp_path):
     assert rows["silk0"]["resumed_from"] > 0 or "silk0" in stdout  # resumed, or had ended
 
 
+def test_ctrl_c_while_the_cluster_starts_is_one_line(tables, tmp_path):
+    """Ctrl-C as the progress bar appears, while the workers start: the one line of the
+    interrupt and status 130; no traceback from the half-started cluster, no lock left."""
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "reports", "fit-batch", str(tables), *FIT,
+                          "--workers", "1", "--no-plots", "-o", str(out)], env=ENV,
+                         preexec_fn=default_sigint, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    seen = b""
+    while b"fits:" not in seen:
+        chunk = os.read(p.stderr.fileno(), 4096)
+        assert chunk, seen
+        seen += chunk
+    p.send_signal(signal.SIGINT)
+    _, rest = p.communicate(timeout=120)
+    err = (seen + rest).decode()
+    assert p.returncode == 130, err
+    assert err.strip().splitlines()[-1].startswith("microcyl fit-batch: interrupted"), err
+    assert "Traceback" not in err and "Task exception" not in err
+    assert not (out / ".microcyl.lock").exists()
+
+
 def test_a_second_batch_into_the_same_folder_is_refused_at_once(tables, tmp_path):
     """Two `fit-batch` runs into one -o folder: the second is refused before any work,
     naming the first's pid; the first goes on and resumes like any other."""

@@ -10,6 +10,7 @@ the checkpoint in its folder; a task whose workers die three times (Dask's
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import ctypes
 import logging
@@ -78,8 +79,17 @@ def _client(workers: int | None, scheduler: str | None):
             client.close()
         return
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=":0", silence_logs=logging.ERROR)
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=":0", silence_logs=logging.ERROR)
+    except KeyboardInterrupt:
+        # Ctrl-C while the cluster starts: its worker processes are daemons and end with
+        # this process, but distributed's own close at exit would fail on a worker still
+        # starting, and asyncio would report the abandoned start (tracebacks after the one
+        # line of the interrupt)
+        atexit.unregister(_distributed().deploy.spec.close_clusters)
+        logging.getLogger("asyncio").setLevel(logging.CRITICAL)
+        raise
     try:
         with Client(cluster) as client:
             client.run(_ignore_sigint)

@@ -50,6 +50,7 @@ TINY_COMPONENT = 2.0 ** -250
 #: 8.2 against 3.6 ms; 2026-12-07).
 MIN_ELEMENTS = 1 << 14
 _LIMIT: list[int | None] = [None]      # limit_threads' cap, applied when Dr.Jit loads
+_INTERRUPTED: list[bool] = []          # Dr.Jit's import was cut by Ctrl-C: never again
 
 
 def limit_threads(n: int | None) -> None:
@@ -105,11 +106,36 @@ def compiled():
     Raises
     ------
     ImportError
-        Dr.Jit is not installed.
+        Dr.Jit is not installed, or its import was interrupted earlier in this process.
+    KeyboardInterrupt
+        Ctrl-C came while Dr.Jit imported.
     """
-    # optional dependency, loaded on use (drjit, about a second): llvm imports it at its top
-    from brdf.jit import llvm
+    if _INTERRUPTED:
+        raise ImportError("Dr.Jit's import was interrupted (Ctrl-C) in this process")
+    try:
+        # optional dependency, loaded on use (drjit, about a second): llvm imports it at its top
+        from brdf.jit import llvm
+    except BaseException as exc:
+        if not _by_interrupt(exc):
+            raise
+        # nanobind leaves the extension half registered: a second import would abort the
+        # process ("Critical nanobind error"), so this process runs NumPy from now on
+        _INTERRUPTED.append(True)
+        raise KeyboardInterrupt from exc
     return llvm
+
+
+def _by_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` is, or was raised while handling, a KeyboardInterrupt (an interrupt
+    inside an extension's initialisation surfaces as an ImportError, and Dr.Jit's package
+    then fails on a NameError)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 @functools.cache

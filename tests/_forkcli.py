@@ -11,7 +11,7 @@ test's pipes or terminal) of the request, SIGINT as the test's ``subprocess`` ca
 it, its exit status or the signal that killed it; it runs ``reports.__main__`` as ``python -m
 reports`` does (its children, the Dask workers among them, start the same way). What it does
 not repeat is the interpreter's start and the imports: a test of what a verb *imports* must
-start a real interpreter (``python -c``, or ``MICROCYL_TESTSPAWN=1``).
+start a real interpreter (``python -c``, or ``MICROCYL_TEST_SPAWN=1``).
 
 The routing is in :class:`Popen`, which :func:`install` puts in place of
 ``subprocess.Popen`` for the suite (``subprocess.run`` uses it too). A call is forked only
@@ -19,7 +19,8 @@ when it is exactly ``[sys.executable, "-m", "reports", ...]``, its environment d
 the server's only in variables read after start-up (:data:`LATE_ENV`), and it asks for
 nothing a fork cannot give (``preexec_fn`` other than :func:`_signals.default_sigint`, user
 or group changes, extra descriptors); every other call starts a real process, as does every
-call with ``MICROCYL_TESTSPAWN=1`` in the suite's environment. ``tests/test_forkcli.py``
+run of the suite with ``MICROCYL_TEST_SPAWN=1`` in its environment (tests/conftest.py then
+leaves ``subprocess.Popen`` as it is). ``tests/test_forkcli.py``
 holds forked and spawned runs of the same commands to the same output and status.
 """
 
@@ -100,7 +101,10 @@ def serve(path: str) -> None:
     sys.stdout.flush()
     while True:
         ready, _, _ = select.select([srv, sys.stdin], [], [])
-        if sys.stdin in ready:
+        if sys.stdin in ready:                 # the worker has gone: so does its socket
+            srv.close()
+            os.unlink(path)
+            os.rmdir(os.path.dirname(path))
             return
         conn, _ = srv.accept()
         try:
@@ -286,7 +290,7 @@ SPAWN = subprocess.Popen
 def _routed(args, executable, preexec_fn, pass_fds, shell, gid, gids, uid, umask,
             process_group, env) -> bool:
     from _signals import default_sigint
-    if os.environ.get("MICROCYL_TESTSPAWN") or shell or executable is not None:
+    if shell or executable is not None:
         return False
     if not isinstance(args, (list, tuple)) or len(args) < 3:
         return False

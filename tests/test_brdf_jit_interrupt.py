@@ -1,6 +1,6 @@
-"""Ctrl-C while Dr.Jit imports: nanobind leaves its extension half registered, and a second
-import aborts the process ("Critical nanobind error"), so brdf.jit never imports it again and
-runs NumPy; the interrupt stays an interrupt."""
+"""Ctrl-C while Dr.Jit imports: inside the extension's initialisation it crashed the process
+(nanobind's std::terminate, a segfault, or a NameError and then an abort at the next import);
+brdf.jit holds it back until the import has ended, then it is an ordinary interrupt."""
 
 import os
 import subprocess
@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 
 import pytest
+
+from _signals import default_sigint
 
 pytest.importorskip("drjit")
 REPO = Path(__file__).resolve().parents[1]
@@ -29,12 +31,10 @@ print(first, jit.available(), jit.backend())
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.01, 0.02, 0.05, 0.1])
-def test_an_import_of_drjit_cut_by_ctrl_c_is_an_interrupt_and_then_numpy(delay):
+def test_ctrl_c_during_the_import_of_drjit_is_an_interrupt_after_it(delay):
     r = subprocess.run([sys.executable, "-c", CHILD, str(delay)], cwd=REPO, text=True,
+                       preexec_fn=default_sigint,
                        env=dict(os.environ, PYTHONPATH=str(REPO)), capture_output=True,
                        timeout=120)
     assert r.returncode == 0 and "nanobind" not in r.stderr, r.stderr[-2000:]
-    first, *rest = r.stdout.split(maxsplit=1)
-    assert first == "interrupt", r.stdout
-    if "(False" in rest[0]:               # the interrupt cut the import: numpy from then on
-        assert "interrupted" in rest[0] and rest[0].rstrip().endswith("numpy"), rest
+    assert r.stdout.split() == ["interrupt", "(True,", "'')", "drjit"], r.stdout

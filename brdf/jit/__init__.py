@@ -25,9 +25,12 @@ process that shares the cores with others: each of N batch workers on C cores ta
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
+import signal
 import sys
+import threading
 import warnings
 
 import numpy as np
@@ -50,7 +53,6 @@ TINY_COMPONENT = 2.0 ** -250
 #: 8.2 against 3.6 ms; 2026-12-07).
 MIN_ELEMENTS = 1 << 14
 _LIMIT: list[int | None] = [None]      # limit_threads' cap, applied when Dr.Jit loads
-_INTERRUPTED: list[bool] = []          # Dr.Jit's import was cut by Ctrl-C: never again
 
 
 def limit_threads(n: int | None) -> None:
@@ -106,36 +108,34 @@ def compiled():
     Raises
     ------
     ImportError
-        Dr.Jit is not installed, or its import was interrupted earlier in this process.
+        Dr.Jit is not installed.
     KeyboardInterrupt
-        Ctrl-C came while Dr.Jit imported.
+        Ctrl-C came while Dr.Jit imported (raised once the import has ended).
     """
-    if _INTERRUPTED:
-        raise ImportError("Dr.Jit's import was interrupted (Ctrl-C) in this process")
-    try:
+    with _ctrl_c_held():
         # optional dependency, loaded on use (drjit, about a second): llvm imports it at its top
         from brdf.jit import llvm
-    except BaseException as exc:
-        if not _by_interrupt(exc):
-            raise
-        # nanobind leaves the extension half registered: a second import would abort the
-        # process ("Critical nanobind error"), so this process runs NumPy from now on
-        _INTERRUPTED.append(True)
-        raise KeyboardInterrupt from exc
     return llvm
 
 
-def _by_interrupt(exc: BaseException) -> bool:
-    """Whether ``exc`` is, or was raised while handling, a KeyboardInterrupt (an interrupt
-    inside an extension's initialisation surfaces as an ImportError, and Dr.Jit's package
-    then fails on a NameError)."""
-    seen = set()
-    while exc is not None and id(exc) not in seen:
-        if isinstance(exc, KeyboardInterrupt):
-            return True
-        seen.add(id(exc))
-        exc = exc.__cause__ or exc.__context__
-    return False
+@contextlib.contextmanager
+def _ctrl_c_held():
+    """Ctrl-C held back until the block has run, then acted on (in the main thread, where
+    Python's handler runs; no other thread receives it): a KeyboardInterrupt inside Dr.Jit's
+    extension initialising crashes the process (nanobind's std::terminate, a segfault, or a
+    half-registered module whose next import aborts), 2026-12-08, Dr.Jit 1.5.0."""
+    handler = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or not callable(handler):
+        yield
+        return
+    came = []
+    signal.signal(signal.SIGINT, lambda *args: came.append(args))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, handler)
+    for args in came[:1]:
+        handler(*args)
 
 
 @functools.cache

@@ -35,8 +35,8 @@ import warnings
 
 import numpy as np
 
-__all__ = ["BackendWarning", "backend", "available", "compiled", "tiny_pairs", "use_jit",
-           "worth_a_call", "limit_threads", "thread_limit", "share_cores", "MIN_ELEMENTS",
+__all__ = ["BackendWarning", "backend", "available", "compiled", "ctrl_c_held", "tiny_pairs",
+           "use_jit", "worth_a_call", "limit_threads", "thread_limit", "share_cores", "MIN_ELEMENTS",
            "BACKENDS", "BACKEND_ENV", "MIN_LLVM", "TINY_COMPONENT"]
 
 #: The kernels ``MICROCYL_BACKEND`` chooses between.
@@ -112,18 +112,28 @@ def compiled():
     KeyboardInterrupt
         Ctrl-C came while Dr.Jit imported (raised once the import has ended).
     """
-    with _ctrl_c_held():
+    with ctrl_c_held():
         # optional dependency, loaded on use (drjit, about a second): llvm imports it at its top
         from brdf.jit import llvm
     return llvm
 
 
 @contextlib.contextmanager
-def _ctrl_c_held():
-    """Ctrl-C held back until the block has run, then acted on (in the main thread, where
-    Python's handler runs; no other thread receives it): a KeyboardInterrupt inside Dr.Jit's
-    extension initialising crashes the process (nanobind's std::terminate, a segfault, or a
-    half-registered module whose next import aborts), 2026-12-08, Dr.Jit 1.5.0."""
+def ctrl_c_held():
+    """Ctrl-C held back until the block has run, then acted on: for the imports of Dr.Jit
+    and Mitsuba, whose extensions crash the process when a KeyboardInterrupt comes while
+    they initialise (nanobind's std::terminate, a segfault, or a half-registered module
+    whose next import aborts; Dr.Jit 1.5.0, 2026-12-08). In the main thread, where Python
+    runs its handler (no other thread receives the interrupt), and where the handler is
+    Python's (an ignored or default SIGINT is left as it is).
+
+    Examples
+    --------
+    >>> with ctrl_c_held():
+    ...     done = True            # an interrupt here would be raised after the block
+    >>> done
+    True
+    """
     handler = signal.getsignal(signal.SIGINT)
     if threading.current_thread() is not threading.main_thread() or not callable(handler):
         yield

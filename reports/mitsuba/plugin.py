@@ -37,6 +37,7 @@ from __future__ import annotations
 
 from analysis.fabricfile import (OPTION_KEYS, PLUGIN_NAME, THREAD_KEYS, fabric_from_dict,
                                  plugin_dict, plugin_xml)
+from brdf import jit
 
 __all__ = ["register", "plugin_dict", "plugin_xml", "fabric_from_dict", "PLUGIN_NAME", "THREAD_KEYS",
            "OPTION_KEYS", "RGB_VARIANTS"]
@@ -55,8 +56,9 @@ def mitsuba_modules():
     ImportError
         Mitsuba is not installed.
     """
-    # optional dependency, loaded on use: bsdf and scene import mitsuba and drjit at their top
-    from reports.mitsuba import bsdf, scene
+    with jit.ctrl_c_held():        # (an interrupt inside the extensions' start crashes)
+        # optional dependency, loaded on use: bsdf and scene import mitsuba and drjit at their top
+        from reports.mitsuba import bsdf, scene
     return bsdf.mi, bsdf.dr, bsdf, scene
 
 

@@ -36,8 +36,8 @@ import warnings
 import numpy as np
 
 __all__ = ["BackendWarning", "backend", "available", "compiled", "ctrl_c_held", "tiny_pairs",
-           "use_jit", "worth_a_call", "limit_threads", "thread_limit", "share_cores", "MIN_ELEMENTS",
-           "BACKENDS", "BACKEND_ENV", "MIN_LLVM", "TINY_COMPONENT"]
+           "use_jit", "worth_a_call", "limit_threads", "thread_limit", "share_cores",
+           "MIN_ELEMENTS", "BACKENDS", "BACKEND_ENV", "MIN_LLVM", "TINY_COMPONENT"]
 
 #: The kernels ``MICROCYL_BACKEND`` chooses between.
 BACKENDS = ("numpy", "drjit")

@@ -126,9 +126,14 @@ def _receive(conn: socket.socket) -> tuple[dict, list[int]]:
     for level, kind, payload in anc:
         if level == socket.SOL_SOCKET and kind == socket.SCM_RIGHTS:
             fds.frombytes(payload[:len(payload) - len(payload) % fds.itemsize])
-    if len(fds) != 3:
-        raise ValueError("a request carries three descriptors")
-    return json.loads(data.decode()), list(fds)
+    try:
+        if len(fds) != 3:
+            raise ValueError("a request carries three descriptors")
+        return json.loads(data.decode()), list(fds)
+    except ValueError:                  # (json's errors are ValueErrors too)
+        for fd in fds:
+            os.close(fd)
+        raise
 
 
 def _wait_for(conn: socket.socket, request: dict, fds: list[int]) -> None:

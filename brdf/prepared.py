@@ -73,6 +73,7 @@ class Prepared:
         # NumPy's geometry on first use
         self._drjit = jit.backend() == "drjit"
         self._jit, self._exact, self._jit_all = None, None, None
+        self._tiny: np.ndarray | None = None        # jit.tiny_pairs of the pairs, found once
         self._geoms: list[ThreadGeometry] | None = None
         self._geoms32: list[ThreadGeometry] | None = None
         self._scratch = Scratch()
@@ -197,9 +198,14 @@ class Prepared:
         if not (self._zi.size and self._drjit
                 and jit.worth_a_call(self.plan, nb * self._zi.size)):
             return False
-        if self._jit is not None:
-            return self._exact is None
-        return not jit.tiny_pairs(*self._pairs).any()
+        return not self._tiny_pairs().any()
+
+    def _tiny_pairs(self) -> np.ndarray:
+        """:func:`brdf.jit.tiny_pairs` of the pairs above the horizon, found on first use
+        (the fused and the prepared kernels leave the same pairs to NumPy)."""
+        if self._tiny is None:
+            self._tiny = jit.tiny_pairs(*self._pairs)
+        return self._tiny
 
     def _uses_jit(self, nb: int) -> bool:
         """Whether a batch of ``nb`` sets is shaded by Dr.Jit: the backend was drjit when
@@ -211,7 +217,7 @@ class Prepared:
             return False
         if self._jit is None:
             wi_ok, wo_ok = self._pairs
-            exact = jit.tiny_pairs(wi_ok, wo_ok)
+            exact = self._tiny_pairs()
             self._jit = jit.compiled().PreparedJit(self.plan, wi_ok[~exact], wo_ok[~exact])
             self._exact = exact if exact.any() else None
             if self._jit_all is None and self._exact is None:

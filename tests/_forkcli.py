@@ -276,10 +276,14 @@ class _Server:
         base["PYTHONPATH"] = str(ROOT)
         return base == self.env
 
-    def connect(self) -> socket.socket:
+    def running(self) -> None:
+        """Start the server unless it runs."""
         with self.lock:
             if self.proc is None or self.proc.poll() is not None:
                 self.start()
+
+    def connect(self) -> socket.socket:
+        self.running()
         conn = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         conn.connect(self.path)
         return conn
@@ -309,7 +313,7 @@ def _routed(args, executable, preexec_fn, pass_fds, shell, gid, gids, uid, umask
         return False
     if _SERVER.env is None:
         try:
-            _SERVER.connect()
+            _SERVER.running()
         except (OSError, RuntimeError):        # e.g. no Unix sockets here: start real ones
             _SERVER.broken = True
             return False

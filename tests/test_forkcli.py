@@ -13,7 +13,14 @@ import _forkcli
 from _signals import default_sigint
 
 ROOT = Path(__file__).resolve().parents[1]
-ENV = dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="100")
+
+
+def _env(**extra) -> dict:
+    """The worker's environment as it is now (a library imported by another test module may
+    have added a variable since collection: KMP_DUPLICATE_LIB_OK), with the suite's own."""
+    return dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="100", **extra)
+
+
 EVAL = ["eval", "velvet", "--wi", "30,0", "--wo", "30,180"]
 CASES = [
     ["--help"],
@@ -26,7 +33,7 @@ CASES = [
 
 def _run(argv, spawn, **kw):
     cls = _forkcli.SPAWN if spawn else _forkcli.Popen
-    kw.setdefault("env", ENV)
+    kw.setdefault("env", _env())
     with cls([sys.executable, "-m", "reports", *argv], stdout=subprocess.PIPE,
              stderr=subprocess.PIPE, text=True, **kw) as p:
         out, err = p.communicate(timeout=300)
@@ -48,13 +55,13 @@ def test_a_forked_run_prints_and_exits_as_a_new_interpreter(argv):
 def test_environment_directory_and_streams_are_the_requests(tmp_path):
     """The environment as given (a variable the toolkit reads when it runs), the working
     directory for relative paths, the streams the test passes."""
-    env = dict(ENV, MICROCYL_BACKEND="bogus")
+    env = _env(MICROCYL_BACKEND="bogus")
     forked, out, err = _run(EVAL, spawn=False, env=env)
     spawned, out2, err2 = _run(EVAL, spawn=True, env=env)
     assert _forked(forked) and forked.returncode == 1 and "'bogus'" in err
     assert (forked.returncode, out, err) == (spawned.returncode, out2, err2)
     p = _forkcli.Popen([sys.executable, "-m", "reports", "plot", "lobes", "velvet", "-o",
-                        "lobes.png"], env=ENV, cwd=tmp_path, stdin=subprocess.PIPE,
+                        "lobes.png"], env=_env(), cwd=tmp_path, stdin=subprocess.PIPE,
                        stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
     p.communicate("", timeout=300)
     assert _forked(p) and p.returncode == 0
@@ -62,7 +69,7 @@ def test_environment_directory_and_streams_are_the_requests(tmp_path):
 
 
 def test_a_start_up_variable_that_differs_starts_a_real_interpreter():
-    p, out, err = _run(["--help"], spawn=False, env=dict(ENV, MPLBACKEND="pdf"))
+    p, out, err = _run(["--help"], spawn=False, env=_env(MPLBACKEND="pdf"))
     assert not _forked(p) and p.returncode == 0
 
 
@@ -72,7 +79,7 @@ def test_a_killed_run_has_the_status_of_a_killed_child(tmp_path):
     ``test_cli_fit_batch``.)"""
     png = tmp_path / "a.png"
     p = _forkcli.Popen([sys.executable, "-m", "reports", "plot", "lobes", "velvet", "-o",
-                        str(png)], env=ENV, preexec_fn=default_sigint,
+                        str(png)], env=_env(), preexec_fn=default_sigint,
                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert _forked(p) and p.poll() is None
     p.kill()
@@ -83,6 +90,6 @@ def test_a_killed_run_has_the_status_of_a_killed_child(tmp_path):
 def test_the_suite_routes_cli_runs_through_the_server():
     assert subprocess.Popen is (_forkcli.SPAWN if os.environ.get("MICROCYL_TEST_SPAWN")
                                 else _forkcli.Popen)
-    r = subprocess.run([sys.executable, "-m", "reports", "--version"], env=ENV,
+    r = subprocess.run([sys.executable, "-m", "reports", "--version"], env=_env(),
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and r.stdout.startswith("microcyl ")

@@ -39,6 +39,11 @@ def _cpu() -> tuple[float, float]:
     return own.ru_utime + own.ru_stime, kids.ru_utime + kids.ru_stime + forked
 
 
+def _unforked() -> collections.Counter:
+    """The worker's CLI runs so far that were not forked, by the variable that kept them."""
+    return collections.Counter(getattr(sys.modules.get("_forkcli"), "UNFORKED", {}))
+
+
 def _record(**row) -> None:
     with open(_OUT, "a", encoding="utf-8") as fh:
         fh.write(json.dumps(row) + "\n")
@@ -48,10 +53,12 @@ def _record(**row) -> None:
 def pytest_runtest_protocol(item, nextitem):
     """Setup, call and teardown of one test (its fixtures built there included)."""
     s0, c0 = _cpu()
+    n0 = _unforked()
     w0 = time.perf_counter()
     yield
     s1, c1 = _cpu()
-    _record(id=item.nodeid, self=s1 - s0, child=c1 - c0, wall=time.perf_counter() - w0)
+    _record(id=item.nodeid, self=s1 - s0, child=c1 - c0, wall=time.perf_counter() - w0,
+            unforked=dict(_unforked() - n0))
 
 
 def pytest_collection_finish(session):
@@ -73,6 +80,9 @@ def summarize(path: str, top: int = 15) -> None:
     print(f"{len(cpu)} tests, {total:.0f} s CPU ({child:.0f} s in subprocesses)")
     for name, sec in sorted(cpu.items(), key=lambda kv: -kv[1])[:top]:
         print(f"{sec:8.1f}  {name}")
+    unforked = sum((collections.Counter(r.get("unforked", {})) for r in rows),
+                   collections.Counter())
+    print(f"CLI runs not forked, by the variable that differed: {dict(unforked) or 'none'}")
     print("files:")
     for name, sec in files.most_common(top):
         print(f"{sec:8.1f}  {name}")

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import array
 import atexit
+import collections
 import importlib
 import io
 import json
@@ -254,9 +255,7 @@ class _Server:
     def start(self) -> None:
         folder = tempfile.mkdtemp(prefix="microcyl-fork-")
         self.path = os.path.join(folder, "s")
-        self.env = dict(os.environ, PYTHONPATH=str(ROOT))
-        for key in [k for k in self.env if _late(k)]:
-            del self.env[key]
+        self.env = self._base(self._worker())
         self.proc = SPAWN([sys.executable, "-c", f"import sys; sys.path.insert(0, "
                             f"{str(Path(__file__).parent)!r}); import _forkcli; "
                             f"_forkcli.serve({self.path!r})"],
@@ -268,13 +267,51 @@ class _Server:
             self.proc = None
             raise RuntimeError("the fork server did not start")
 
-    def takes(self, env: dict) -> bool:
-        """Whether a run with environment ``env`` is the same as one forked from here."""
+    def stop(self) -> None:
+        """End the server (its socket goes with it); the runs it forked go on to their end."""
+        if self.proc is not None:
+            self.proc.stdin.close()
+            self.proc.stdout.close()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+            self.proc = None
+
+    @staticmethod
+    def _worker() -> dict:
+        """The environment of this worker's runs: its own, importing this tree."""
+        return dict(os.environ, PYTHONPATH=str(ROOT))
+
+    @staticmethod
+    def _base(env) -> dict | None:
+        """``env`` without the late variables, or None if it imports another tree."""
         base = {k: v for k, v in env.items() if not _late(k)}
         if base.get("PYTHONPATH", str(ROOT)) != str(ROOT):
-            return False
+            return None
         base["PYTHONPATH"] = str(ROOT)
-        return base == self.env
+        return base
+
+    def takes(self, env: dict) -> bool:
+        """Whether a run with environment ``env`` is the same as one forked from here. When
+        the worker's own environment has changed since the server started (a library
+        imported by a test sets a variable, as OpenMP's builds set KMP_DUPLICATE_LIB_OK),
+        a run in that environment gets a new server, so the suite's runs still fork."""
+        base = self._base(env)
+        if base is None:
+            UNFORKED["PYTHONPATH"] += 1
+            return False
+        if base == self.env:
+            return True
+        if base != self._base(self._worker()):
+            UNFORKED.update(k for k in base.keys() | self.env.keys()
+                            if base.get(k) != self.env.get(k))
+            return False
+        with self.lock:
+            self.stop()
+            self.start()
+        return True
 
     def running(self) -> None:
         """Start the server unless it runs."""
@@ -294,6 +331,9 @@ _SERVER = _Server()
 #: ``bench/suite_cpu.py``: they are the server's children, not this process's.
 CPU_OF_RUNS = 0.0
 SPAWN = subprocess.Popen
+#: ``python -m reports`` runs that started a new interpreter because their environment was
+#: not the server's, by the variable that differed (``bench/suite_cpu.py`` reports them).
+UNFORKED: collections.Counter = collections.Counter()
 
 
 def _routed(args, executable, preexec_fn, pass_fds, shell, gid, gids, uid, umask,
@@ -317,7 +357,11 @@ def _routed(args, executable, preexec_fn, pass_fds, shell, gid, gids, uid, umask
         except (OSError, RuntimeError):        # e.g. no Unix sockets here: start real ones
             _SERVER.broken = True
             return False
-    return _SERVER.takes(dict(os.environ if env is None else env))
+    try:
+        return _SERVER.takes(dict(os.environ if env is None else env))
+    except (OSError, RuntimeError):            # a new server could not start: so be it
+        _SERVER.broken = True
+        return False
 
 
 def _line(conn: socket.socket) -> str:
@@ -405,3 +449,4 @@ class Popen(subprocess.Popen):
 def install() -> None:
     """Route the suite's ``python -m reports`` runs through the fork server (module notes)."""
     subprocess.Popen = Popen
+    atexit.register(_SERVER.stop)

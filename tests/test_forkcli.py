@@ -73,6 +73,21 @@ def test_a_start_up_variable_that_differs_starts_a_real_interpreter():
     assert not _forked(p) and p.returncode == 0
 
 
+def test_a_variable_set_in_the_worker_after_the_server_started_still_forks(monkeypatch):
+    """A library imported by one test module may set a variable in the worker (CI saw this:
+    every run after it started a new interpreter). The worker's runs then get a server in
+    the new environment, and the run sees the variable."""
+    _run(EVAL, spawn=False)                                  # the server runs
+    monkeypatch.setenv("SET_BY_A_LIBRARY", "1")
+    forked, out, err = _run(["eval", "no_such_fabric", "--wi", "30,0", "--wo", "30,180"],
+                            spawn=False)
+    assert _forked(forked) and forked.returncode == 1 and "no_such_fabric" in err
+    env = _env(MICROCYL_BACKEND="bogus")                     # and the environment reaches it
+    assert env["SET_BY_A_LIBRARY"] == "1"
+    forked, out, err = _run(EVAL, spawn=False, env=env)
+    assert _forked(forked) and forked.returncode == 1 and "'bogus'" in err
+
+
 def test_a_killed_run_has_the_status_of_a_killed_child(tmp_path):
     """SIGKILL: status -9 as for any child, and nothing written. (Ctrl-C, with
     ``default_sigint``, is each long verb's own test: ``test_cli_fit_e2e``,

@@ -47,7 +47,7 @@ def _run(argv) -> float:
 
 
 def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
-             mc_seeds: int = 3) -> None:
+             mc_seeds: int = 3, first: int = 0) -> None:
     """The intervals' coverage over ``n`` image sets (module notes)."""
     from analysis.imagefit import NoiseModel, Observation, fit_images
     from reports.render.files import render_image
@@ -64,7 +64,7 @@ def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
 
     hits = {k: [0, 0] for k in truth}
     t0 = time.perf_counter()
-    for rep in range(n):
+    for rep in range(first, first + n):
         folder = work / f"set{rep}"
         folder.mkdir(parents=True, exist_ok=True)
         paths = write_truth_images(folder, fabric, width=64, height=36, spp=image_spp,
@@ -84,7 +84,7 @@ def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
         print(f"set {rep}: " + ", ".join(line) + f"; chi2 ratio "
               f"{doc['noise']['chi2_ratio']:.3f}", flush=True)
     print(f"{engine}, images at {image_spp} spp, {mc_seeds} Monte Carlo seeds: {n} image "
-          f"sets in {time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f}")
+          f"sets ({first} to {first + n - 1}) in {time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f}")
     for k, (h68, h95) in hits.items():
         print(f"{k}: inside the 68% interval {h68} of {n}, the 95% interval {h95} of {n}")
 
@@ -102,11 +102,13 @@ def main() -> int:
                     help="--coverage's renderer (builtin)")
     ap.add_argument("--image-spp", type=int, default=8, help="--coverage's images' spp (8)")
     ap.add_argument("--mc-seeds", type=int, default=3, help="--coverage's fits' (3)")
+    ap.add_argument("--first-set", type=int, default=0,
+                    help="--coverage's first image set (its noise's seeds): 0")
     args = ap.parse_args()
     if args.coverage:
         coverage(args.coverage, args.engine,
                  Path(args.keep or tempfile.mkdtemp(prefix="bench_fit_images_")),
-                 args.image_spp, args.mc_seeds)
+                 args.image_spp, args.mc_seeds, args.first_set)
         return 0
     free = args.free.split(",")
     truth = {k: TRUTH[k] for k in free}

@@ -23,6 +23,18 @@ if not os.environ.get("MICROCYL_TEST_SPAWN"):
 settings.register_profile("microcyl", deadline=None)
 settings.load_profile("microcyl")
 
+@pytest.fixture(autouse=True)
+def _environment_restored():
+    """Each test leaves the worker's environment as it found it, whatever a library it ran
+    set there: the next test's runs (and their fork server, ``tests/_forkcli.py``, which
+    forks only runs in the worker's environment) see the suite's environment."""
+    before = dict(os.environ)
+    yield
+    if os.environ != before:
+        os.environ.clear()
+        os.environ.update(before)
+
+
 #: ../shared/data, the measured BRDF data kept beside this repository (never copied in).
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 

@@ -86,10 +86,16 @@ def test_a_rerun_does_not_redo_converged_fits(batch):
     assert again.rows["t1"] == summary.rows["t1"]
 
 
-def test_a_changed_table_is_fitted_again(tmp_path):
+def test_a_changed_table_is_fitted_again(tmp_path, monkeypatch):
     d = _tables(tmp_path / "in", ["full:30:45"])
     jobs = jobs_from_inputs([str(d / "t0.csv")], preset=PRESET, free=FREE, ties=())
+    for key in ("OMP_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_", "__DASK_PARENT_PID"):
+        monkeypatch.delenv(key, raising=False)
+    before = dict(os.environ)
     run_batch(jobs, tmp_path / "out", workers=1, progress=False, echo=None)
+    # Dask's nanny sets its workers' variables (OMP_NUM_THREADS=1 ...) in the caller's own
+    # environment; the batch leaves the caller's environment as it found it
+    assert dict(os.environ) == before
     _tables(d, ["full:30"])                       # same name, other pairs
     jobs = jobs_from_inputs([str(d / "t0.csv")], preset=PRESET, free=FREE, ties=())
     assert not BatchSummary(tmp_path / "out").done(jobs[0])

@@ -79,6 +79,30 @@ def _client(workers: int | None, scheduler: str | None):
             client.close()
         return
     n = workers or os.cpu_count() or 1
+    with _environment_kept():
+        yield from _local_client(n, Client, LocalCluster)
+
+
+@contextlib.contextmanager
+def _environment_kept():
+    """This process's environment as it was, once the local cluster has closed: Dask's
+    nanny sets its workers' variables (``OMP_NUM_THREADS=1``, ``MALLOC_TRIM_THRESHOLD_``,
+    ``PYTHONHASHSEED`` ...) in the parent's own ``os.environ`` before it starts each one,
+    and leaves them there for every process the caller starts afterwards."""
+    before = dict(os.environ)
+    try:
+        yield
+    finally:
+        for key in set(os.environ) - set(before):
+            del os.environ[key]
+        for key, value in before.items():
+            if os.environ.get(key) != value:
+                os.environ[key] = value
+
+
+def _local_client(n: int, Client, LocalCluster):
+    """A client of a new LocalCluster of ``n`` worker processes (a generator for
+    :func:`_client`)."""
     try:
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=":0", silence_logs=logging.ERROR)

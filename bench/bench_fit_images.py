@@ -71,7 +71,7 @@ def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
                                    shot=SHOT, read=READ, seed=1000 + 10 * rep, scenes=("cylinder",),
                                    engine=engine, variant=variant)
         obs = [Observation(p.name, read_exr(p), read_scene_file(scene_file_path(p)).scene,
-                           1001 + 10 * rep + k) for k, p in enumerate(paths)]
+                           1001 + 10 * rep + k, 4 / image_spp) for k, p in enumerate(paths)]
         doc = fit_images(obs, brdf.fabric("linen_plain"), "kd1,gamma_s1", folder / "fit",
                          render=render, noise=NoiseModel(SHOT, READ), mc_seeds=mc_seeds)
         line = []
@@ -123,7 +123,7 @@ def main() -> int:
     t_images = time.perf_counter() - t0
     t_camera = _run(["fit-images", *map(str, images), "--fabric", "linen_plain", "--free",
                      args.free, "--shot-noise", str(SHOT), "--read-noise", str(READ),
-                     "--spp", "4", "-o", str(work / "camera")])
+                     "--spp", "4", "--rendered", "-o", str(work / "camera")])
     write_fabric_file(work / "hidden.json", fabric)
     t_measure = _run(["measure", str(work / "hidden.json"), "--geometry", args.geometry,
                       "--snr", args.snr, "--seed", "5", "-o", str(work / "table.csv")])

@@ -156,9 +156,12 @@ def laplace(J, prior_sd, scale: float = 1.0, v=None) -> np.ndarray:
     """The covariance of the flat coordinates at the optimum.
 
     The data's information is the sandwich ``F = H M^+ H / scale`` of the estimating equation
-    ``g = 0``: ``H = J'J`` (``J`` the two seeds' mean Jacobian), ``M = J' diag(v) J`` with
-    ``v`` the variance of each normalized residual of the two renders' mean (1 where None),
-    ``scale`` the residuals' variance in units of the noise model's. To it is added a Gaussian
+    ``g = 0``: ``H = J'J`` (``J`` the two seeds' mean Jacobian), ``M`` the covariance of
+    ``J' r`` for ``r`` the normalized residuals of the two renders' mean: ``J' diag(v) J``
+    for ``v`` of shape (n,), each residual's variance (1 where None); ``sum_p J_p' v_p J_p``
+    for ``v`` of shape (n / 3, 3, 3), the covariance of each pixel's three channels (``J_p``
+    its three rows), whose Monte Carlo errors are correlated; ``scale`` the residuals'
+    variance in units of the noise model's. To it is added a Gaussian
     of the prior's sd standing in for the flat prior (it keeps a parameter the images cannot
     see at about the prior's spread instead of an infinite one); the covariance is the
     inverse of the sum.
@@ -168,9 +171,23 @@ def laplace(J, prior_sd, scale: float = 1.0, v=None) -> np.ndarray:
     >>> J = np.array([[2.0, 0.0], [0.0, 0.0]])
     >>> np.round(np.sqrt(np.diag(laplace(J, np.array([1.0, 0.3])))), 4).tolist()
     [0.4472, 0.3]
+
+    One pixel's three channels, each moving as the parameter does: independent errors tell
+    the parameter to 1 / sqrt(3); one error shared by the three (a correlation of 1), to 1.
+
+    >>> J, prior = np.ones((3, 1)), np.array([1e6])
+    >>> [round(float(np.sqrt(laplace(J, prior, v=c[None])[0, 0])), 4)
+    ...  for c in (np.eye(3), np.ones((3, 3)))]
+    [0.5774, 1.0]
     """
     J = np.asarray(J, float)
     H = J.T @ J
-    M = H if v is None else J.T @ (np.asarray(v, float)[:, None] * J)
+    if v is None:
+        M = H
+    elif np.ndim(v) == 3:
+        Jp = J.reshape(len(v), 3, J.shape[1])
+        M = np.einsum("pci,pcd,pdj->ij", Jp, np.asarray(v, float), Jp, optimize=True)
+    else:
+        M = J.T @ (np.asarray(v, float)[:, None] * J)
     F = H @ np.linalg.pinv(M, rcond=1e-12, hermitian=True) @ H / scale
     return np.linalg.inv(F + np.diag(1.0 / np.asarray(prior_sd, float) ** 2))

@@ -35,7 +35,7 @@ import numpy as np
 import brdf
 from analysis.fit.outputs import check_fit_folder, claim_fit_folder
 from analysis.folderlock import output_lock
-from analysis.imagefit.noise import NoiseModel, mc_variance
+from analysis.imagefit.noise import NoiseModel, mc_covariance
 from analysis.imagefit.solver import laplace, levenberg_marquardt
 from analysis.imagefit.summary import Params, summaries, warnings_of
 from analysis.paramnames import parse_free
@@ -56,12 +56,15 @@ PAIR_OFFSET = 104729
 @dataclasses.dataclass(frozen=True)
 class Observation:
     """One image: ``name`` (its file), ``image`` (H, W, 3) linear RGB, ``scene`` (whatever
-    ``render`` takes) and ``seed`` (the fit's renders of it)."""
+    ``render`` takes), ``seed`` (the fit's renders of it) and ``image_mc``: the image's own
+    Monte Carlo variance in units of one of the fit's renders' (0, a photograph's; an image
+    rendered at N samples a pixel, fitted by renders of n, has n / N)."""
 
     name: str
     image: np.ndarray
     scene: object
     seed: int
+    image_mc: float = 0.0
 
 
 def _checked(observations, fabric, free) -> tuple[list, Params]:
@@ -74,6 +77,11 @@ def _checked(observations, fabric, free) -> tuple[list, Params]:
         img = np.asarray(ob.image)
         if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
             raise ValueError(f"{ob.name}: must be a finite (H, W, 3) RGB image")
+        mc = ob.image_mc
+        if isinstance(mc, bool) or not isinstance(mc, (int, float)) \
+                or not (np.isfinite(mc) and mc >= 0):
+            raise ValueError(f"{ob.name}: image_mc {mc!r}: must be a finite number >= 0 (the "
+                             f"image's Monte Carlo variance in units of a fit render's)")
     names = parse_free(free)
     values = fabric.values()
     bad = [n for n in names if n not in values]
@@ -88,7 +96,7 @@ def _digest(observations, params, start, noise, mc_seeds) -> str:
     h = hashlib.sha256()
     for ob in observations:
         h.update(ob.image.tobytes())
-        h.update(repr((ob.name, ob.scene, ob.seed)).encode())
+        h.update(repr((ob.name, ob.scene, ob.seed, float(ob.image_mc))).encode())
     h.update(repr((params.names, start.tolist(), noise, mc_seeds)).encode())
     return h.hexdigest()
 
@@ -118,14 +126,24 @@ class _Model:
         return out
 
     def estimate_noise(self, u, noise, mc_seeds) -> None:
-        """The residuals' sd (camera and Monte Carlo) and ``v``, the variance of the mean
-        of two seeds' normalized residuals (camera plus half the Monte Carlo's)."""
+        """The residuals' sd (camera, the render's Monte Carlo and the image's own), and the
+        covariance ``C`` of each pixel's three normalized residuals of the mean of two
+        seeds' renders (camera, half the render's Monte Carlo covariance, the image's
+        own), ``v`` its diagonal."""
         runs = [self.images(u, SEED_STRIDE * (k + 1)) for k in range(mc_seeds)]
-        mc = [mc_variance([r[i] for r in runs]) for i in range(len(self.obs))]
-        mean = [np.mean([r[i] for r in runs], axis=0) for i in range(len(self.obs))]
-        var = [noise.variance(m, v) for m, v in zip(mean, mc)]
-        self.sd = [np.sqrt(x) for x in var]
-        self.v = np.concatenate([((x - m / 2) / x).ravel() for x, m in zip(var, mc)])
+        self.sd, blocks = [], []
+        for i, ob in enumerate(self.obs):
+            cov = mc_covariance([r[i] for r in runs])
+            mc = np.diagonal(cov, axis1=-2, axis2=-1)
+            mean = np.mean([r[i] for r in runs], axis=0)
+            var = noise.variance(mean, mc * (1.0 + ob.image_mc))
+            sd = np.sqrt(var)
+            camera = var - mc * (1.0 + ob.image_mc)
+            c = cov * (0.5 + ob.image_mc) + camera[..., None] * np.eye(3)
+            blocks.append((c / (sd[..., :, None] * sd[..., None, :])).reshape(-1, 3, 3))
+            self.sd.append(sd)
+        self.C = np.concatenate(blocks)
+        self.v = np.diagonal(self.C, axis1=-2, axis2=-1).ravel()
 
     def residuals(self, u, offset=0) -> np.ndarray:
         return np.concatenate([((m - ob.image) / sd).ravel() for m, ob, sd
@@ -263,7 +281,7 @@ def _document(model, sol, start, noise, mc_seeds, seconds) -> dict:
     n, p = r.size, len(params.names)
     chi2, expected = float(r @ r), float(model.v.sum())
     scale = max(1.0, chi2 / max(expected - p, 1.0))
-    cov = laplace(0.5 * (sol.J[0] + sol.J[1]), params.prior_sd, scale, model.v)
+    cov = laplace(0.5 * (sol.J[0] + sol.J[1]), params.prior_sd, scale, model.C)
     sd = np.sqrt(np.diag(cov))
     per_image, offset = [], 0
     for ob in model.obs:
@@ -286,6 +304,7 @@ def _document(model, sol, start, noise, mc_seeds, seconds) -> dict:
         "parameters": summaries(params, sol.u, cov, start),
         "correlation": (cov / np.outer(sd, sd)).tolist(),
         "noise": {**noise.describe(), "mc_seeds": mc_seeds, "values": n,
+                  "image_mc": {ob.name: float(ob.image_mc) for ob in model.obs},
                   "chi2": chi2, "chi2_expected": expected,
                   "chi2_ratio": chi2 / max(expected - p, 1.0), "scale": scale},
         "fit": {"steps": len(sol.history), "renders": model.renders, "seconds": seconds,

@@ -2,13 +2,16 @@
 
     microcyl fit-images IMAGE.exr... --fabric START --free P1,P2,... -o DIR
         [--scene FILE]... [--shot-noise K] [--read-noise S] [--spp N] [--seed N]
-        [--mc-seeds 4] [--max-steps 30] [--workers N] [--no-plots] [--no-progress] [-q]
+        [--rendered] [--mc-seeds 4] [--max-steps 30] [--workers N] [--no-plots]
+        [--no-progress] [-q]
 
 Each IMAGE (linear RGB OpenEXR) comes with the scene it shows: ``IMAGE.scene.json`` beside it
 (``microcyl render`` writes one) or ``--scene FILE`` (once for every image, or once an image,
 in order). The fit renders each scene with the engine, size and samples its file names
 (``--spp`` replaces the samples), two seeds an image: ``--seed`` and ``--seed`` + 104729
-(default: the file's seed + 1, so no render reuses the image's random numbers). The work is
+(default: the file's seed + 1, so no render reuses the image's random numbers). With
+``--rendered`` the images are renders of their scene files (a test with the truth known): their
+own Monte Carlo noise, at the file's samples a pixel, joins the noise model. The work is
 :func:`analysis.imagefit.fit_images` (method, noise model, ``results.json``); this module reads
 the inputs, passes the renderer in, and prints the summary.
 """
@@ -57,6 +60,10 @@ def register(sub):
                                                          "renders (the scene file's)")
     p.add_argument("--seed", type=int, default=None,
                    help="seed of the fit's renders (the scene file's + 1)")
+    p.add_argument("--rendered", action="store_true",
+                   help="the images are renders of their scene files at the files' samples "
+                        "a pixel (a test with the truth known), not photographs: their own "
+                        "Monte Carlo noise joins the noise model")
     p.add_argument("--mc-seeds", type=int, default=4, metavar="K",
                    help="renders of independent seeds for the Monte Carlo noise (4)")
     p.add_argument("--max-steps", type=int, default=30, metavar="N",
@@ -97,10 +104,12 @@ def _observations(args) -> list:
         if image.shape[:2] != (st["height"], st["width"]):
             raise ValueError(f"{path}: {image.shape[1]} x {image.shape[0]} pixels, its scene "
                              f"{st['width']} x {st['height']}")
-        job = (sf.scene, st["engine"], st["width"], st["height"],
-               st["spp"] if args.spp is None else args.spp, st["variant"], st["max_depth"])
+        spp = st["spp"] if args.spp is None else args.spp
+        job = (sf.scene, st["engine"], st["width"], st["height"], spp, st["variant"],
+               st["max_depth"])
         seed = st["seed"] + 1 if args.seed is None else args.seed
-        obs.append(Observation(Path(path).name, image, job, seed))
+        image_mc = spp / st["spp"] if args.rendered else 0.0
+        obs.append(Observation(Path(path).name, image, job, seed, image_mc))
     return obs
 
 

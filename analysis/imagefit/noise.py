@@ -15,7 +15,7 @@ would favour the pixels whose noise fell low, and pull the fit down):
   independent seeds (:func:`mc_variance`: ``K`` seeds, each pixel's sample variance pooled
   over its 3 x 3 neighbourhood, so ``9 (K - 1)`` degrees of freedom a pixel), times
   ``1 + image_mc`` when the image is itself a render (a test with the truth known) whose
-  Monte Carlo variance is ``image_mc`` of the fit's renders';
+  own Monte Carlo variance is ``image_mc`` times a fit render's;
 - ``floor``: ``(1e-4 max|render|)^2``, so that a black pixel of a noiseless image has a
   variance.
 

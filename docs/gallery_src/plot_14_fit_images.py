@@ -32,8 +32,10 @@ def render(scene, fabric, seed):
 
 
 panels = []      # what fit_images hands its plots callable: image, fitted render, residual
-obs = [Observation(p.name, read_exr(p), read_scene_file(scene_file_path(p)).scene, 1 + k)
-       for k, p in enumerate(paths)]
+# The images are renders at 8 samples a pixel and the fit's at 4: the images' own Monte Carlo
+# noise, half a fit render's, is in the noise model (image_mc; --rendered on the command line)
+obs = [Observation(p.name, read_exr(p), read_scene_file(scene_file_path(p)).scene, 1 + k,
+                   image_mc=4 / 8) for k, p in enumerate(paths)]
 doc = fit_images(obs, brdf.fabric("linen_plain"), "kd1,gamma_s1", work / "fit", render=render,
                  noise=NoiseModel(shot=1e-4, read=0.002), mc_seeds=3,
                  plots=lambda doc, got, out: panels.extend(got) or {})

@@ -21,7 +21,8 @@ would favour the pixels whose noise fell low, and pull the fit down):
 
 The three channels' Monte Carlo errors of a pixel are correlated (one path carries light to
 all three): the intervals use each pixel's channel covariance (:func:`mc_covariance`), not
-three independent variances.
+three independent variances, and each pixel's own, not pooled: pooling spreads a highlight's
+large variance over its darker neighbours, where the highlight's pixels tell the most.
 
 The fit renders every step with one seed (common random numbers), so the render is a smooth
 function of the parameters whose Monte Carlo error stays put from step to step; ``var_mc``
@@ -35,7 +36,7 @@ import math
 
 import numpy as np
 
-__all__ = ["NoiseModel", "mc_variance", "mc_covariance", "FLOOR"]
+__all__ = ["NoiseModel", "mc_variance", "mc_covariance", "pool", "FLOOR"]
 
 #: The variance floor's share of the image's largest magnitude (as a standard deviation).
 FLOOR = 1e-4
@@ -83,17 +84,22 @@ class NoiseModel:
                 "floor": f"({FLOOR:g} * max|render|)^2"}
 
 
-def mc_covariance(renders) -> np.ndarray:
+def mc_covariance(renders, pooled: bool = True) -> np.ndarray:
     """The Monte Carlo covariance of one render's three channels, per pixel, from renders of
     independent seeds: each pixel's sample covariance (ddof 1), averaged over its 3 x 3
-    neighbourhood (edges: the pixels inside). A path's light reaches all three channels, so
-    their Monte Carlo errors are correlated (0.7 to 0.99 in the validation's cylinder): three
-    channels of a pixel carry less than three independent values.
+    neighbourhood (edges: the pixels inside) when ``pooled``. A path's light reaches all
+    three channels, so their Monte Carlo errors are correlated (0.7 to 0.99 in the
+    validation's cylinder): three channels of a pixel carry less than three independent
+    values.
 
     Parameters
     ----------
     renders : sequence of (H, W, 3) arrays
         At least two renders of the same scene and fabric, independent seeds.
+    pooled : bool
+        Averaged over 3 x 3 pixels (steadier, for weights), or each pixel's own (unbiased
+        where the variance changes from pixel to pixel, as at a highlight: for sums over
+        many pixels).
 
     Returns
     -------
@@ -112,10 +118,10 @@ def mc_covariance(renders) -> np.ndarray:
         raise ValueError("mc_covariance: needs at least two renders of shape (H, W, 3)")
     dev = stack - stack.mean(axis=0)
     cov = np.einsum("khwc,khwd->hwcd", dev, dev) / (len(stack) - 1)
-    return _pooled(cov)
+    return pool(cov) if pooled else cov
 
 
-def _pooled(x) -> np.ndarray:
+def pool(x) -> np.ndarray:
     """``x`` (H, W, ...) averaged over each pixel's 3 x 3 neighbourhood (the pixels inside)."""
     h, w = x.shape[:2]
     pad = np.pad(x, ((1, 1), (1, 1)) + ((0, 0),) * (x.ndim - 2))
@@ -149,4 +155,4 @@ def mc_variance(renders) -> np.ndarray:
     stack = np.asarray(renders, float)
     if stack.ndim != 4 or len(stack) < 2:
         raise ValueError("mc_variance: needs at least two renders of shape (H, W, 3)")
-    return _pooled(stack.var(axis=0, ddof=1))
+    return pool(stack.var(axis=0, ddof=1))

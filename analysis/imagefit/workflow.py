@@ -35,7 +35,7 @@ import numpy as np
 import brdf
 from analysis.fit.outputs import check_fit_folder, claim_fit_folder
 from analysis.folderlock import output_lock
-from analysis.imagefit.noise import NoiseModel, mc_covariance
+from analysis.imagefit.noise import NoiseModel, mc_covariance, pool
 from analysis.imagefit.solver import laplace, levenberg_marquardt
 from analysis.imagefit.summary import Params, summaries, warnings_of
 from analysis.paramnames import parse_free
@@ -126,15 +126,17 @@ class _Model:
         return out
 
     def estimate_noise(self, u, noise, mc_seeds) -> None:
-        """The residuals' sd (camera, the render's Monte Carlo and the image's own), and the
-        covariance ``C`` of each pixel's three normalized residuals of the mean of two
-        seeds' renders (camera, half the render's Monte Carlo covariance, the image's
-        own), ``v`` its diagonal."""
+        """The residuals' sd (camera, the render's Monte Carlo and the image's own: the
+        weights, from the Monte Carlo variance pooled over 3 x 3 pixels), and the covariance
+        ``C`` of each pixel's three normalized residuals of the mean of two seeds' renders
+        (camera, half the render's Monte Carlo covariance, the image's own; each pixel's
+        own Monte Carlo covariance, unbiased for the sums over pixels it enters), ``v`` its
+        diagonal."""
         runs = [self.images(u, SEED_STRIDE * (k + 1)) for k in range(mc_seeds)]
         self.sd, blocks = [], []
         for i, ob in enumerate(self.obs):
-            cov = mc_covariance([r[i] for r in runs])
-            mc = np.diagonal(cov, axis1=-2, axis2=-1)
+            cov = mc_covariance([r[i] for r in runs], pooled=False)   # each pixel's own
+            mc = np.diagonal(pool(cov), axis1=-2, axis2=-1)       # pooled, for the weights
             mean = np.mean([r[i] for r in runs], axis=0)
             var = noise.variance(mean, mc * (1.0 + ob.image_mc))
             sd = np.sqrt(var)

@@ -84,7 +84,8 @@ def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
         print(f"set {rep}: " + ", ".join(line) + f"; chi2 ratio "
               f"{doc['noise']['chi2_ratio']:.3f}", flush=True)
     print(f"{engine}, images at {image_spp} spp, {mc_seeds} Monte Carlo seeds: {n} image "
-          f"sets ({first} to {first + n - 1}) in {time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f}")
+          f"sets ({first} to {first + n - 1}) in {time.perf_counter() - t0:.0f} s, "
+          f"load {os.getloadavg()[0]:.1f}")
     for k, (h68, h95) in hits.items():
         print(f"{k}: inside the 68% interval {h68} of {n}, the 95% interval {h95} of {n}")
 

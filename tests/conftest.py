@@ -23,6 +23,7 @@ if not os.environ.get("MICROCYL_TEST_SPAWN"):
 settings.register_profile("microcyl", deadline=None)
 settings.load_profile("microcyl")
 
+
 @pytest.fixture(autouse=True)
 def _environment_restored():
     """Each test leaves the worker's environment as it found it, whatever a library it ran

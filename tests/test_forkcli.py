@@ -76,7 +76,7 @@ def test_a_start_up_variable_that_differs_starts_a_real_interpreter():
 def test_a_variable_set_in_the_worker_after_the_server_started_still_forks(monkeypatch):
     """A library imported by one test module may set a variable in the worker (CI saw this:
     every run after it started a new interpreter). The worker's runs then get a server in
-    the new environment, and the run sees the variable."""
+    the new environment, and a variable of the run's environment still reaches the run."""
     _run(EVAL, spawn=False)                                  # the server runs
     monkeypatch.setenv("SET_BY_A_LIBRARY", "1")
     forked, out, err = _run(["eval", "no_such_fabric", "--wi", "30,0", "--wo", "30,180"],

@@ -58,8 +58,10 @@ def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
     fabric = brdf.fabric("linen_plain").with_values(truth)
     variant, depth = ("llvm_ad_rgb", 2) if engine == "mitsuba" else (None, None)
 
+    fit_spp = 4
+
     def render(scene, fab, seed):
-        return render_image(scene, fab, engine=engine, width=64, height=36, spp=4, seed=seed,
+        return render_image(scene, fab, engine=engine, width=64, height=36, spp=fit_spp, seed=seed,
                             workers=1, variant=variant, max_depth=depth)
 
     hits = {k: [0, 0] for k in truth}
@@ -71,7 +73,7 @@ def coverage(n: int, engine: str, work: Path, image_spp: int = 8,
                                    shot=SHOT, read=READ, seed=1000 + 10 * rep, scenes=("cylinder",),
                                    engine=engine, variant=variant)
         obs = [Observation(p.name, read_exr(p), read_scene_file(scene_file_path(p)).scene,
-                           1001 + 10 * rep + k, 4 / image_spp) for k, p in enumerate(paths)]
+                           1001 + 10 * rep + k, fit_spp / image_spp) for k, p in enumerate(paths)]
         doc = fit_images(obs, brdf.fabric("linen_plain"), "kd1,gamma_s1", folder / "fit",
                          render=render, noise=NoiseModel(SHOT, READ), mc_seeds=mc_seeds)
         line = []

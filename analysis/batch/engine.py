@@ -65,10 +65,9 @@ def _distributed():
 @contextlib.contextmanager
 def _client(workers: int | None, scheduler: str | None):
     """A Dask client: of a new LocalCluster, or connected to ``scheduler``."""
-    Client, LocalCluster = _distributed().Client, _distributed().LocalCluster
     if scheduler is not None:
         try:
-            client = Client(scheduler, timeout="20s")
+            client = _distributed().Client(scheduler, timeout="20s")
         except OSError as exc:
             raise OSError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
         try:
@@ -78,9 +77,8 @@ def _client(workers: int | None, scheduler: str | None):
         finally:
             client.close()
         return
-    n = workers or os.cpu_count() or 1
-    with _environment_kept():
-        yield from _local_client(n, Client, LocalCluster)
+    with _environment_kept(), _local_client(workers or os.cpu_count() or 1) as client:
+        yield client
 
 
 @contextlib.contextmanager
@@ -100,9 +98,10 @@ def _environment_kept():
                 os.environ[key] = value
 
 
-def _local_client(n: int, Client, LocalCluster):
-    """A client of a new LocalCluster of ``n`` worker processes (a generator for
-    :func:`_client`)."""
+@contextlib.contextmanager
+def _local_client(n: int):
+    """A client of a new LocalCluster of ``n`` worker processes."""
+    Client, LocalCluster = _distributed().Client, _distributed().LocalCluster
     try:
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=":0", silence_logs=logging.ERROR)

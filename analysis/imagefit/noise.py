@@ -12,8 +12,9 @@ would favour the pixels whose noise fell low, and pull the fit down):
   sensor of gain g electrons per unit has ``shot = 1 / g``);
 - ``read`` (``--read-noise``): the camera's read noise, a standard deviation in linear units;
 - ``var_mc``: the render's own Monte Carlo noise, the variance of a pixel between renders of
-  independent seeds (:func:`mc_variance`: ``K`` seeds, each pixel's sample variance pooled
-  over its 3 x 3 neighbourhood, so ``9 (K - 1)`` degrees of freedom a pixel), times
+  independent seeds (the diagonal of :func:`mc_covariance`: ``K`` seeds, each pixel's sample
+  variance pooled over its 3 x 3 neighbourhood by :func:`pool`, so ``9 (K - 1)`` degrees of
+  freedom a pixel), times
   ``1 + image_mc`` when the image is itself a render (a test with the truth known) whose
   own Monte Carlo variance is ``image_mc`` times a fit render's;
 - ``floor``: ``(1e-4 max|render|)^2``, so that a black pixel of a noiseless image has a
@@ -36,7 +37,7 @@ import math
 
 import numpy as np
 
-__all__ = ["NoiseModel", "mc_variance", "mc_covariance", "pool", "FLOOR"]
+__all__ = ["NoiseModel", "mc_covariance", "pool", "FLOOR"]
 
 #: The variance floor's share of the image's largest magnitude (as a standard deviation).
 FLOOR = 1e-4
@@ -129,30 +130,3 @@ def pool(x) -> np.ndarray:
     total = sum(pad[i:i + h, j:j + w] for i in range(3) for j in range(3))
     count = sum(ones[i:i + h, j:j + w] for i in range(3) for j in range(3))
     return total / count.reshape((h, w) + (1,) * (x.ndim - 2))
-
-
-def mc_variance(renders) -> np.ndarray:
-    """The Monte Carlo variance of one render, per pixel and channel, from renders of
-    independent seeds: each pixel's sample variance (ddof 1), averaged over its 3 x 3
-    neighbourhood (edges: the pixels inside).
-
-    Parameters
-    ----------
-    renders : sequence of (H, W, 3) arrays
-        At least two renders of the same scene and fabric, independent seeds.
-
-    Returns
-    -------
-    (H, W, 3) float64 ndarray
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(0)
-    >>> v = mc_variance([rng.normal(0.0, 0.1, (20, 30, 3)) for _ in range(8)])
-    >>> v.shape, bool(abs(v.mean() - 0.01) < 0.001)
-    ((20, 30, 3), True)
-    """
-    stack = np.asarray(renders, float)
-    if stack.ndim != 4 or len(stack) < 2:
-        raise ValueError("mc_variance: needs at least two renders of shape (H, W, 3)")
-    return pool(stack.var(axis=0, ddof=1))

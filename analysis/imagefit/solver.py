@@ -157,10 +157,10 @@ def laplace(J, prior_sd, scale: float = 1.0, v=None) -> np.ndarray:
 
     The data's information is the sandwich ``F = H M^+ H / scale`` of the estimating equation
     ``g = 0``: ``H = J'J`` (``J`` the two seeds' mean Jacobian), ``M`` the covariance of
-    ``J' r`` for ``r`` the normalized residuals of the two renders' mean: ``J' diag(v) J``
-    for ``v`` of shape (n,), each residual's variance (1 where None); ``sum_p J_p' v_p J_p``
-    for ``v`` of shape (n / 3, 3, 3), the covariance of each pixel's three channels (``J_p``
-    its three rows), whose Monte Carlo errors are correlated; ``scale`` the residuals'
+    ``J' r`` for ``r`` the normalized residuals of the two renders' mean,
+    ``sum_p J_p' v_p J_p`` for ``v`` of shape (n / 3, 3, 3), the covariance of each pixel's
+    three channels (``J_p`` its three rows), whose Monte Carlo errors are correlated (``H``
+    where ``v`` is None: independent residuals of variance 1); ``scale`` the residuals'
     variance in units of the noise model's. To it is added a Gaussian
     of the prior's sd standing in for the flat prior (it keeps a parameter the images cannot
     see at about the prior's spread instead of an infinite one); the covariance is the
@@ -184,10 +184,8 @@ def laplace(J, prior_sd, scale: float = 1.0, v=None) -> np.ndarray:
     H = J.T @ J
     if v is None:
         M = H
-    elif np.ndim(v) == 3:
+    else:
         Jp = J.reshape(len(v), 3, J.shape[1])
         M = np.einsum("pci,pcd,pdj->ij", Jp, np.asarray(v, float), Jp, optimize=True)
-    else:
-        M = J.T @ (np.asarray(v, float)[:, None] * J)
     F = H @ np.linalg.pinv(M, rcond=1e-12, hermitian=True) @ H / scale
     return np.linalg.inv(F + np.diag(1.0 / np.asarray(prior_sd, float) ** 2))

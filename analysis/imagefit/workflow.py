@@ -130,8 +130,7 @@ class _Model:
         weights, from the Monte Carlo variance pooled over 3 x 3 pixels), and the covariance
         ``C`` of each pixel's three normalized residuals of the mean of two seeds' renders
         (camera, half the render's Monte Carlo covariance, the image's own; each pixel's
-        own Monte Carlo covariance, unbiased for the sums over pixels it enters), ``v`` its
-        diagonal."""
+        own Monte Carlo covariance, unbiased for the sums over pixels it enters)."""
         runs = [self.images(u, SEED_STRIDE * (k + 1)) for k in range(mc_seeds)]
         self.sd, blocks = [], []
         for i, ob in enumerate(self.obs):
@@ -145,7 +144,12 @@ class _Model:
             blocks.append((c / (sd[..., :, None] * sd[..., None, :])).reshape(-1, 3, 3))
             self.sd.append(sd)
         self.C = np.concatenate(blocks)
-        self.v = np.diagonal(self.C, axis1=-2, axis2=-1).ravel()
+
+    @property
+    def v(self) -> np.ndarray:
+        """Each normalized residual's variance (the diagonal of ``C``), in the residuals'
+        order."""
+        return np.diagonal(self.C, axis1=-2, axis2=-1).ravel()
 
     def residuals(self, u, offset=0) -> np.ndarray:
         return np.concatenate([((m - ob.image) / sd).ravel() for m, ob, sd
